@@ -1,0 +1,580 @@
+/* collide.c -- footprints, exact vertical ray casts, contact candidates and
+ * effective widths of box, sphere, cylinder and capsule colliders
+ * (DESIGN 2.4, 2.6).  Pure functions: no allocation, no printing. */
+#include "collide.h"
+
+#include <math.h>
+
+#include "ss_math.h"
+
+#define SS_PI 3.14159265358979323846
+
+/* the circle table is built from one quadrant */
+_Static_assert(SS_FOOTPRINT_SEGMENTS % 4 == 0, "SS_FOOTPRINT_SEGMENTS must be a multiple of 4");
+
+/* points fed to the hull: two caps of SS_FOOTPRINT_SEGMENTS each at most */
+#define HULL_IN_MAX (2 * SS_FOOTPRINT_SEGMENTS)
+
+/* room for a convex polygon clipped by four half-planes, plus slack */
+#define CLIP_MAX (SS_POLY_MAX + 8)
+
+/* relative tolerance (of the squared extent) below which three hull points
+ * count as collinear: removes duplicated and near-duplicated corners */
+#define HULL_COLLINEAR_EPS 1e-14
+
+typedef struct pt2 {
+  double x, y;
+} pt2;
+
+/* ---------------------------------------------------------------------- */
+/* convex hull                                                             */
+
+static int pt_less(const pt2 *a, const pt2 *b)
+{
+  return a->x < b->x || (a->x == b->x && a->y < b->y);
+}
+
+static void sift_down(pt2 *p, int root, int n)
+{
+  for (;;) {
+    int child = 2 * root + 1;
+    if (child >= n) return;
+    if (child + 1 < n && pt_less(&p[child], &p[child + 1])) child++;
+    if (!pt_less(&p[root], &p[child])) return;
+    pt2 t = p[root];
+    p[root] = p[child];
+    p[child] = t;
+    root = child;
+  }
+}
+
+/* heapsort: qsort may allocate for inputs of this size */
+static void sort_points(pt2 *p, int n)
+{
+  for (int i = n / 2 - 1; i >= 0; i--) sift_down(p, i, n);
+  for (int end = n - 1; end > 0; end--) {
+    pt2 t = p[0];
+    p[0] = p[end];
+    p[end] = t;
+    sift_down(p, 0, end);
+  }
+}
+
+static double cross3(const pt2 *o, const pt2 *a, const pt2 *b)
+{
+  return (a->x - o->x) * (b->y - o->y) - (a->y - o->y) * (b->x - o->x);
+}
+
+/* Andrew's monotone chain; strictly convex turns only, so collinear and
+ * duplicated points (degenerate projections) are dropped.  Sorts p. */
+static void convex_hull(pt2 *p, int n, ssPoly2 *out)
+{
+  pt2 h[2 * HULL_IN_MAX + 2];
+  out->n = 0;
+  if (n <= 0) return;
+  sort_points(p, n);
+
+  /* collinearity tolerance scaled by the point set's extent */
+  double ylo = p[0].y, yhi = p[0].y;
+  for (int i = 1; i < n; i++) {
+    if (p[i].y < ylo) ylo = p[i].y;
+    if (p[i].y > yhi) yhi = p[i].y;
+  }
+  double ext = fmax(p[n - 1].x - p[0].x, yhi - ylo);
+  if (!(ext > 0)) {
+    out->n = 1;
+    out->x[0] = p[0].x;
+    out->y[0] = p[0].y;
+    return;
+  }
+  double tol = HULL_COLLINEAR_EPS * ext * ext;
+
+  /* lower chain left to right, then upper chain right to left */
+  int k = 0;
+  for (int i = 0; i < n; i++) {
+    while (k >= 2 && cross3(&h[k - 2], &h[k - 1], &p[i]) <= tol) k--;
+    h[k++] = p[i];
+  }
+  for (int i = n - 2, lower = k + 1; i >= 0; i--) {
+    while (k >= lower && cross3(&h[k - 2], &h[k - 1], &p[i]) <= tol) k--;
+    h[k++] = p[i];
+  }
+  k--; /* the last point repeats the first */
+  if (k < 1) k = 1;
+  if (k > SS_POLY_MAX) k = SS_POLY_MAX; /* cannot happen: k <= n */
+  out->n = k;
+  for (int i = 0; i < k; i++) {
+    out->x[i] = h[i].x;
+    out->y[i] = h[i].y;
+  }
+}
+
+/* ---------------------------------------------------------------------- */
+/* footprints                                                              */
+
+/* Unit circle polygon scaled to the circle's area (radius k > 1) and turned
+ * so that its support along +x and -x is exactly 1: the hull of two such
+ * polygons translated along y is then exactly 2 wide, so a lying wheel's
+ * footprint is 2r x L and a capsule's is pi r^2 + 2 r L.  Quarter symmetry
+ * keeps the four quadrants identical. */
+static void circle_table(double c[SS_FOOTPRINT_SEGMENTS], double s[SS_FOOTPRINT_SEGMENTS])
+{
+  const int n = SS_FOOTPRINT_SEGMENTS, q = SS_FOOTPRINT_SEGMENTS / 4;
+  double step = 2 * SS_PI / n;
+  double k = sqrt(2 * SS_PI / (n * sin(step)));
+  double phi0 = acos(1 / k);
+  for (int i = 0; i < q; i++) {
+    double ci = k * cos(phi0 + step * i), si = k * sin(phi0 + step * i);
+    c[i] = ci;          s[i] = si;
+    c[i + q] = -si;     s[i + q] = ci;
+    c[i + 2 * q] = -ci; s[i + 2 * q] = -si;
+    c[i + 3 * q] = si;  s[i + 3 * q] = -ci;
+  }
+}
+
+/* the affine image centre + u c_i + v s_i of the circle table */
+static int put_ellipse(pt2 *p, int np, const double c[], const double s[],
+                       double ox, double oy, const double u[2], const double v[2])
+{
+  for (int i = 0; i < SS_FOOTPRINT_SEGMENTS; i++) {
+    p[np].x = ox + u[0] * c[i] + v[0] * s[i];
+    p[np].y = oy + u[1] * c[i] + v[1] * s[i];
+    np++;
+  }
+  return np;
+}
+
+/* Horizontal unit vector w perpendicular to the axis a (any when a is
+ * vertical).  Built from the axis alone, so spinning a wheel about its axle
+ * leaves its footprint unchanged. */
+static void axis_side(const double a[3], double w[3])
+{
+  double m = fmax(fabs(a[0]), fabs(a[1]));
+  if (m > 0) {
+    w[0] = -a[1] / m;
+    w[1] = a[0] / m;
+    w[2] = 0;
+    ss_v3_normalize(w);
+  } else {
+    ss_v3_set(w, 1, 0, 0);
+  }
+}
+
+void ss_shape_footprint(const ssShape *s, ssPoly2 *out)
+{
+  pt2 p[HULL_IN_MAX];
+  int np = 0;
+  const double *R = s->R, *c = s->pos;
+  out->n = 0;
+
+  switch (s->type) {
+  case SS_GEOM_BOX: {
+    /* the 8 corners projected along z */
+    double h[3] = {0.5 * s->size[0], 0.5 * s->size[1], 0.5 * s->size[2]};
+    for (int i = 0; i < 8; i++) {
+      double lx = (i & 1) ? h[0] : -h[0];
+      double ly = (i & 2) ? h[1] : -h[1];
+      double lz = (i & 4) ? h[2] : -h[2];
+      p[np].x = c[0] + R[0] * lx + R[1] * ly + R[2] * lz;
+      p[np].y = c[1] + R[3] * lx + R[4] * ly + R[5] * lz;
+      np++;
+    }
+    break;
+  }
+  case SS_GEOM_SPHERE: {
+    double ct[SS_FOOTPRINT_SEGMENTS], st[SS_FOOTPRINT_SEGMENTS];
+    double r = s->size[0], u[2] = {r, 0}, v[2] = {0, r};
+    circle_table(ct, st);
+    np = put_ellipse(p, np, ct, st, c[0], c[1], u, v);
+    break;
+  }
+  case SS_GEOM_CYLINDER:
+  case SS_GEOM_CAPSULE: {
+    double ct[SS_FOOTPRINT_SEGMENTS], st[SS_FOOTPRINT_SEGMENTS];
+    double a[3] = {R[2], R[5], R[8]}, w[3], b[3], u[2], v[2];
+    double r = s->size[0], hl = 0.5 * s->size[1];
+    circle_table(ct, st);
+    axis_side(a, w);
+    if (s->type == SS_GEOM_CYLINDER) {
+      /* cap discs: in-plane axes w and a x w, projected to xy */
+      ss_v3_cross(b, a, w);
+      u[0] = r * w[0]; u[1] = r * w[1];
+      v[0] = r * b[0]; v[1] = r * b[1];
+    } else {
+      /* end spheres project to full circles */
+      u[0] = r * w[0];  u[1] = r * w[1];
+      v[0] = -r * w[1]; v[1] = r * w[0];
+    }
+    np = put_ellipse(p, np, ct, st, c[0] + hl * a[0], c[1] + hl * a[1], u, v);
+    np = put_ellipse(p, np, ct, st, c[0] - hl * a[0], c[1] - hl * a[1], u, v);
+    break;
+  }
+  default:
+    return;
+  }
+  convex_hull(p, np, out);
+}
+
+/* ---------------------------------------------------------------------- */
+/* bounds                                                                  */
+
+void ss_shape_aabb(const ssShape *s, double lo[3], double hi[3])
+{
+  const double *R = s->R;
+  double e[3] = {0, 0, 0};
+  switch (s->type) {
+  case SS_GEOM_BOX:
+    for (int k = 0; k < 3; k++)
+      e[k] = 0.5 * (fabs(R[3 * k]) * s->size[0] + fabs(R[3 * k + 1]) * s->size[1] +
+                    fabs(R[3 * k + 2]) * s->size[2]);
+    break;
+  case SS_GEOM_SPHERE:
+    e[0] = e[1] = e[2] = s->size[0];
+    break;
+  case SS_GEOM_CYLINDER:
+    /* the cap rim's extent along k is r sqrt(1 - a_k^2) */
+    for (int k = 0; k < 3; k++) {
+      double ak = R[3 * k + 2];
+      e[k] = 0.5 * s->size[1] * fabs(ak) + s->size[0] * sqrt(fmax(0.0, 1 - ak * ak));
+    }
+    break;
+  case SS_GEOM_CAPSULE:
+    for (int k = 0; k < 3; k++)
+      e[k] = 0.5 * s->size[1] * fabs(R[3 * k + 2]) + s->size[0];
+    break;
+  default:
+    break;
+  }
+  for (int k = 0; k < 3; k++) {
+    lo[k] = s->pos[k] - e[k];
+    hi[k] = s->pos[k] + e[k];
+  }
+}
+
+/* ---------------------------------------------------------------------- */
+/* polygons                                                                */
+
+double ss_poly_area(const ssPoly2 *p)
+{
+  if (p->n < 3) return 0;
+  /* relative to the first vertex, so distant polygons keep their digits */
+  double x0 = p->x[0], y0 = p->y[0], a2 = 0;
+  for (int i = 1; i + 1 < p->n; i++)
+    a2 += (p->x[i] - x0) * (p->y[i + 1] - y0) - (p->x[i + 1] - x0) * (p->y[i] - y0);
+  return 0.5 * a2;
+}
+
+/* the point where edge P -> Q crosses c = b, placed exactly on the line */
+static inline int put_cut(double *oc, double *oo, int m, double b, double pc,
+                          double po, double qc, double qo)
+{
+  oc[m] = b;
+  oo[m] = po + (b - pc) / (qc - pc) * (qo - po);
+  return m + 1;
+}
+
+/* Sutherland-Hodgman against the slab lo <= c <= hi in one pass (c is x or
+ * y, o the other coordinate): each edge P -> Q contributes its part inside
+ * the slab.  Input is shifted by (-offc, -offo) as it is read. */
+static int clip_slab(const double *ic, const double *io, int n, double offc,
+                     double offo, double *oc, double *oo, double lo, double hi)
+{
+  int m = 0;
+  if (n <= 0) return 0;
+  double pc = ic[n - 1] - offc, po = io[n - 1] - offo;
+  for (int j = 0; j < n && m <= CLIP_MAX - 2; j++) {
+    double qc = ic[j] - offc, qo = io[j] - offo;
+    if (qc >= lo && qc <= hi) {
+      /* entering (unless Q itself is the entry), then Q */
+      if (pc < lo && qc > lo) m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
+      else if (pc > hi && qc < hi) m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
+      oc[m] = qc;
+      oo[m] = qo;
+      m++;
+    } else if (qc < lo) {
+      /* leaving below (unless P itself was the exit), maybe crossing all */
+      if (pc > hi) {
+        m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
+        m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
+      } else if (pc > lo) {
+        m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
+      }
+    } else {
+      /* leaving above, likewise */
+      if (pc < lo) {
+        m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
+        m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
+      } else if (pc < hi) {
+        m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
+      }
+    }
+    pc = qc;
+    po = qo;
+  }
+  return m;
+}
+
+double ss_poly_rect_area(const ssPoly2 *p, double x0, double x1, double y0,
+                         double y1, double *cx, double *cy)
+{
+  double ax[CLIP_MAX], ay[CLIP_MAX], bx[CLIP_MAX], by[CLIP_MAX];
+  if (p->n < 3 || !(x1 > x0) || !(y1 > y0)) return 0;
+
+  /* work about the rectangle's centre: small numbers, exact corners */
+  double mx = 0.5 * (x0 + x1), my = 0.5 * (y0 + y1);
+  int n = clip_slab(p->x, p->y, p->n, mx, my, ax, ay, x0 - mx, x1 - mx);
+  if (n < 3) return 0;
+  n = clip_slab(ay, ax, n, 0, 0, by, bx, y0 - my, y1 - my);
+  if (n < 3) return 0;
+
+  /* shoelace area and centroid */
+  double a2 = 0, sx = 0, sy = 0;
+  for (int i = 0, j = n - 1; i < n; j = i++) {
+    double cr = bx[j] * by[i] - bx[i] * by[j];
+    a2 += cr;
+    sx += (bx[j] + bx[i]) * cr;
+    sy += (by[j] + by[i]) * cr;
+  }
+  if (a2 == 0) return 0;
+  if (cx && cy) {
+    *cx = mx + sx / (3 * a2);
+    *cy = my + sy / (3 * a2);
+  }
+  return fabs(0.5 * a2);
+}
+
+int ss_poly_contains(const ssPoly2 *p, double x, double y)
+{
+  if (p->n < 3) return 0;
+  /* inside a convex polygon of either orientation: no edge sees the point
+   * on its other side; "on" allows a rounding-level distance, scaled by the
+   * edge so that points at a vertex count too */
+  int pos = 0, neg = 0;
+  for (int i = 0, j = p->n - 1; i < p->n; j = i++) {
+    double ex = p->x[i] - p->x[j], ey = p->y[i] - p->y[j];
+    double rx = x - p->x[j], ry = y - p->y[j];
+    double cr = ex * ry - ey * rx;
+    double el = fabs(ex) + fabs(ey);
+    double tol = 1e-12 * el * (el + fabs(rx) + fabs(ry));
+    if (cr > tol) pos = 1;
+    else if (cr < -tol) neg = 1;
+    if (pos && neg) return 0;
+  }
+  return 1;
+}
+
+/* ---------------------------------------------------------------------- */
+/* vertical ray casts                                                      */
+
+/* Parameter interval [*t0, *t1] of the line o + t d inside the finite
+ * cylinder x^2 + y^2 <= r^2, |z| <= hl (shape frame).  0 when it misses. */
+static int cylinder_interval(const double o[3], const double d[3], double r,
+                             double hl, double *t0, double *t1)
+{
+  double lin = -INFINITY, lout = INFINITY, sin_ = -INFINITY, sout = INFINITY;
+
+  /* lateral surface: infinite cylinder */
+  double a = d[0] * d[0] + d[1] * d[1];
+  double b = o[0] * d[0] + o[1] * d[1];
+  double c = o[0] * o[0] + o[1] * o[1] - r * r;
+  if (a == 0) {
+    if (c > 0) return 0;
+  } else {
+    double disc = b * b - a * c;
+    if (disc < 0) return 0;
+    /* stable roots q / a and c / q */
+    double q = -(b + copysign(sqrt(disc), b));
+    if (q == 0) {
+      lin = lout = 0;
+    } else {
+      double r1 = q / a, r2 = c / q;
+      lin = fmin(r1, r2);
+      lout = fmax(r1, r2);
+    }
+  }
+
+  /* caps: the slab between them */
+  if (d[2] == 0) {
+    if (fabs(o[2]) > hl) return 0;
+  } else {
+    double s1 = (-hl - o[2]) / d[2], s2 = (hl - o[2]) / d[2];
+    sin_ = fmin(s1, s2);
+    sout = fmax(s1, s2);
+  }
+
+  double tin = fmax(lin, sin_), tout = fmin(lout, sout);
+  if (!(tin <= tout)) return 0;
+  *t0 = tin;
+  *t1 = tout;
+  return 1;
+}
+
+/* lowest z of a sphere over (x, y), in the caller's frame */
+static int sphere_lowest(const double c[3], double r, double x, double y,
+                         double *z)
+{
+  double dx = x - c[0], dy = y - c[1];
+  double h = r * r - (dx * dx + dy * dy);
+  if (h < 0) return 0;
+  *z = c[2] - sqrt(h);
+  return 1;
+}
+
+int ss_shape_lowest_z(const ssShape *s, double x, double y, double *z)
+{
+  const double *R = s->R;
+
+  if (s->type == SS_GEOM_SPHERE) return sphere_lowest(s->pos, s->size[0], x, y, z);
+  if (s->type != SS_GEOM_BOX && s->type != SS_GEOM_CYLINDER &&
+      s->type != SS_GEOM_CAPSULE)
+    return 0;
+
+  /* the line through (x, y, pos_z) in the shape frame: z = pos_z + t */
+  double w[3] = {x - s->pos[0], y - s->pos[1], 0}, o[3];
+  double d[3] = {R[6], R[7], R[8]};
+  ss_m3_mulvT(o, R, w);
+
+  if (s->type == SS_GEOM_BOX) {
+    /* slab method; a line parallel to a slab is in it or misses */
+    double tin = -INFINITY, tout = INFINITY;
+    for (int k = 0; k < 3; k++) {
+      double h = 0.5 * s->size[k];
+      if (d[k] == 0) {
+        if (fabs(o[k]) > h) return 0;
+        continue;
+      }
+      double t1 = (-h - o[k]) / d[k], t2 = (h - o[k]) / d[k];
+      tin = fmax(tin, fmin(t1, t2));
+      tout = fmin(tout, fmax(t1, t2));
+    }
+    if (!(tin <= tout)) return 0;
+    *z = s->pos[2] + tin;
+    return 1;
+  }
+
+  double r = s->size[0], hl = 0.5 * s->size[1], t0, t1;
+  int hit = cylinder_interval(o, d, r, hl, &t0, &t1);
+  double best = hit ? s->pos[2] + t0 : INFINITY;
+  if (s->type == SS_GEOM_CAPSULE) {
+    /* union with the end spheres: the first entry of any piece */
+    for (int e = -1; e <= 1; e += 2) {
+      double ce[3] = {s->pos[0] + e * hl * R[2], s->pos[1] + e * hl * R[5],
+                      s->pos[2] + e * hl * R[8]}, ze;
+      if (sphere_lowest(ce, r, x, y, &ze)) {
+        hit = 1;
+        best = fmin(best, ze);
+      }
+    }
+  }
+  if (!hit) return 0;
+  *z = best;
+  return 1;
+}
+
+/* ---------------------------------------------------------------------- */
+/* candidates and widths                                                   */
+
+static void put_point(double pts[][3], int *k, int max, const double p[3])
+{
+  if (*k < max) ss_v3_copy(pts[*k], p);
+  if (*k < max) (*k)++;
+}
+
+int ss_shape_candidates(const ssShape *s, const double n[3], double pts[][3],
+                        int max)
+{
+  const double *R = s->R, *c = s->pos;
+  double p[3];
+  int k = 0;
+  if (max <= 0) return 0;
+
+  switch (s->type) {
+  case SS_GEOM_BOX:
+    for (int i = 0; i < 8; i++) {
+      double l[3] = {(i & 1) ? 0.5 * s->size[0] : -0.5 * s->size[0],
+                     (i & 2) ? 0.5 * s->size[1] : -0.5 * s->size[1],
+                     (i & 4) ? 0.5 * s->size[2] : -0.5 * s->size[2]};
+      ss_m3_mulv(p, R, l);
+      ss_v3_add(p, p, c);
+      put_point(pts, &k, max, p);
+    }
+    break;
+  case SS_GEOM_SPHERE:
+    ss_v3_copy(p, c);
+    ss_v3_addscl(p, n, -s->size[0]);
+    put_point(pts, &k, max, p);
+    break;
+  case SS_GEOM_CAPSULE:
+    for (int e = -1; e <= 1; e += 2) {
+      ss_v3_set(p, c[0] + e * 0.5 * s->size[1] * R[2],
+                c[1] + e * 0.5 * s->size[1] * R[5],
+                c[2] + e * 0.5 * s->size[1] * R[8]);
+      ss_v3_addscl(p, n, -s->size[0]);
+      put_point(pts, &k, max, p);
+    }
+    break;
+  case SS_GEOM_CYLINDER: {
+    static const double c8[8] = {1, 0.70710678118654752, 0, -0.70710678118654752,
+                                 -1, -0.70710678118654752, 0, 0.70710678118654752};
+    double a[3] = {R[2], R[5], R[8]}, u[3] = {R[0], R[3], R[6]},
+           v[3] = {R[1], R[4], R[7]}, m[3];
+    double r = s->size[0], hl = 0.5 * s->size[1];
+
+    /* rim direction lowest along n: -n with its axial part removed */
+    ss_v3_scale(m, n, -1);
+    ss_v3_addscl(m, a, ss_v3_dot(n, a));
+    if (ss_v3_normalize(m) < 1e-12) ss_v3_copy(m, u);
+
+    /* the two lowest rim points first, then 8 per cap */
+    for (int e = -1; e <= 1; e += 2) {
+      ss_v3_copy(p, c);
+      ss_v3_addscl(p, a, e * hl);
+      ss_v3_addscl(p, m, r);
+      put_point(pts, &k, max, p);
+    }
+    for (int e = -1; e <= 1; e += 2)
+      for (int i = 0; i < 8; i++) {
+        ss_v3_copy(p, c);
+        ss_v3_addscl(p, a, e * hl);
+        ss_v3_addscl(p, u, r * c8[i]);
+        ss_v3_addscl(p, v, r * c8[(i + 6) & 7]);
+        put_point(pts, &k, max, p);
+      }
+    break;
+  }
+  default:
+    break;
+  }
+  return k;
+}
+
+double ss_shape_width(const ssShape *s, const double n[3])
+{
+  const double *R = s->R;
+  switch (s->type) {
+  case SS_GEOM_BOX: {
+    /* drop the axis most nearly along n; the shorter of the other two */
+    int drop = 0;
+    double best = -1;
+    for (int k = 0; k < 3; k++) {
+      double dk = fabs(n[0] * R[k] + n[1] * R[3 + k] + n[2] * R[6 + k]);
+      if (dk > best) {
+        best = dk;
+        drop = k;
+      }
+    }
+    return fmin(s->size[(drop + 1) % 3], s->size[(drop + 2) % 3]);
+  }
+  case SS_GEOM_CYLINDER: {
+    /* axle within 45 degrees of the bed plane: a wheel, b = tread width */
+    double an = fabs(n[0] * R[2] + n[1] * R[5] + n[2] * R[8]);
+    if (an * an <= 0.5 * ss_v3_dot(n, n)) return s->size[1];
+    return 2 * s->size[0];
+  }
+  case SS_GEOM_SPHERE:
+  case SS_GEOM_CAPSULE:
+    return 2 * s->size[0];
+  default:
+    return 0;
+  }
+}

@@ -1,0 +1,67 @@
+/* collide.h -- geometry of colliders: footprints on a bed plane, exact
+ * vertical ray casts (depth under a shape), rigid contact candidates and the
+ * effective width b of DESIGN 2.4.
+ *
+ * Everything here works in one Cartesian frame chosen by the caller,
+ * normally a height map's local frame (bed normal = +z).  Pure functions:
+ * no allocation, no model or data access. */
+#ifndef SS_COLLIDE_H
+#define SS_COLLIDE_H
+
+#include "soilsim.h"
+
+/* A collider placed in the caller's frame. */
+typedef struct ssShape {
+  int type;        /* ssGeomType (box, sphere, cylinder, capsule) */
+  double size[3];  /* as ssModel.geom_size */
+  double pos[3];   /* centre */
+  double R[9];     /* rotation shape-local -> frame, row-major (columns are
+                      the shape's local axes expressed in the frame) */
+} ssShape;
+
+/* A convex polygon in the frame's xy plane, counter-clockwise. */
+#define SS_POLY_MAX 192
+typedef struct ssPoly2 {
+  int n;
+  double x[SS_POLY_MAX], y[SS_POLY_MAX];
+} ssPoly2;
+
+/* Number of segments used for a full circle in footprints; arcs are
+ * scaled so that each circle's polygon has the circle's exact area. */
+#define SS_FOOTPRINT_SEGMENTS 64
+
+/* The shape's footprint: its projection along z onto the xy plane, as a
+ * convex polygon.  Exact for boxes (hull of the 8 projected corners); for
+ * spheres, cylinders and capsules the projected circles/ellipses are
+ * area-matched polygons of SS_FOOTPRINT_SEGMENTS segments. */
+void ss_shape_footprint(const ssShape *s, ssPoly2 *out);
+/* Axis-aligned bounds of the shape in the frame. */
+void ss_shape_aabb(const ssShape *s, double lo[3], double hi[3]);
+/* Signed area of a polygon (positive when counter-clockwise). */
+double ss_poly_area(const ssPoly2 *p);
+/* Area of (convex polygon) ∩ [x0,x1]×[y0,y1], exact (clipping).  When the
+ * area is > 0 and cx, cy are not NULL they receive its centroid. */
+double ss_poly_rect_area(const ssPoly2 *p, double x0, double x1, double y0,
+                         double y1, double *cx, double *cy);
+/* 1 if (x, y) lies inside or on the polygon. */
+int ss_poly_contains(const ssPoly2 *p, double x, double y);
+/* Lowest point of the shape's surface on the vertical line through (x, y):
+ * the z where the upward ray first enters the solid.  Exact ray/shape
+ * intersection.  Returns 1 and sets *z on a hit, 0 if the line misses. */
+int ss_shape_lowest_z(const ssShape *s, double x, double y, double *z);
+/* Rigid contact candidates against a surface with unit normal n: points of
+ * the shape that can be lowest along n -- box: its 8 corners; sphere: the
+ * point c - r n; capsule: c_i - r n for both end spheres; cylinder: for each
+ * cap the rim point lowest along n, plus 8 evenly spaced rim points of each
+ * cap (so a cylinder standing on its end rests on its rim).  Returns the
+ * count (<= max). */
+int ss_shape_candidates(const ssShape *s, const double n[3], double pts[][3],
+                        int max);
+/* Effective width b (DESIGN 2.4), measured in the shape's own frame so that
+ * heading does not change it: box -> the shorter of its two edge lengths
+ * whose axes are most nearly in the plane normal to n; cylinder with its
+ * axis within 45 degrees of the plane -> its length (tread width), else its
+ * diameter; sphere, capsule -> diameter. */
+double ss_shape_width(const ssShape *s, const double n[3]);
+
+#endif /* SS_COLLIDE_H */

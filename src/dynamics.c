@@ -1,0 +1,133 @@
+/* dynamics.c -- single rigid bodies in generalized coordinates.
+ *
+ * A free body has qpos = (COM position, orientation quaternion) and
+ * qvel = (COM linear velocity, angular velocity), both in the world frame.
+ * Time stepping is semi-implicit Euler: velocities first (forces at the
+ * step start, contact impulses solved implicitly at the end-of-step
+ * velocity), then positions from the new velocities; orientations advance
+ * by the exact exponential map of omega dt. */
+#include "dynamics.h"
+#include "ss_math.h"
+
+#include <string.h>
+
+static int sys_dynamic(const ssModel *m, const ssData *d, int s)
+{
+  return m->sys_type[s] == SS_SYS_FREE && d->sys_active[s];
+}
+
+void ss_dyn_free_velocity(const ssModel *m, ssData *d)
+{
+  const double dt = m->opt.timestep;
+  for (int s = 0; s < m->nsys; s++) {
+    if (!sys_dynamic(m, d, s)) continue;
+    int b = m->sys_bodyadr[s];
+    double *v = d->qvel + m->sys_vadr[s], *w = v + 3;
+    const double *R = d->body_xmat + 9 * b;
+    double mass = m->body_mass[b];
+
+    /* world inverse inertia R I^-1 R^T, and world inertia for the
+     * gyroscopic term */
+    double Ib_inv[9], tmp[9], Rt[9], Iw[9];
+    ss_m3_inv(Ib_inv, m->body_inertia + 9 * b);
+    ss_m3_transpose(Rt, R);
+    ss_m3_mul(tmp, R, Ib_inv);
+    ss_m3_mul(d->body_iinv + 9 * b, tmp, Rt);
+    ss_m3_mul(tmp, R, m->body_inertia + 9 * b);
+    ss_m3_mul(Iw, tmp, Rt);
+
+    double f[3], tau[3];
+    ss_v3_scale(f, m->opt.gravity, mass);
+    ss_v3_set(tau, 0, 0, 0);
+    for (int k = 0; k < m->nxforce; k++) {
+      if (m->xforce_body[k] != b) continue;
+      if (d->time < m->xforce_time[2 * k] || d->time >= m->xforce_time[2 * k + 1])
+        continue;
+      ss_v3_add(f, f, m->xforce_force + 3 * k);
+      ss_v3_add(tau, tau, m->xforce_torque + 3 * k);
+    }
+    /* gyroscopic torque -w x (I w), explicit */
+    double Iw_w[3], gyro[3];
+    ss_m3_mulv(Iw_w, Iw, w);
+    ss_v3_cross(gyro, w, Iw_w);
+    ss_v3_sub(tau, tau, gyro);
+
+    double dw[3];
+    ss_m3_mulv(dw, d->body_iinv + 9 * b, tau);
+    ss_v3_addscl(v, f, dt / mass);
+    ss_v3_addscl(w, dw, dt);
+  }
+}
+
+void ss_dyn_contact_jacobian(const ssModel *m, const ssData *d, int s,
+                             const double p[3], const double frame[9],
+                             double *J, double *W, double G[9])
+{
+  int b = m->sys_bodyadr[s];
+  double r[3], inv_m = 1.0 / m->body_mass[b];
+  const double *Iinv = d->body_iinv + 9 * b;
+  ss_v3_sub(r, p, d->body_xpos + 3 * b);
+  double ang[3][3], wang[3][3];
+  for (int k = 0; k < 3; k++) {
+    const double *f = frame + 3 * k;
+    ss_v3_cross(ang[k], r, f);
+    ss_m3_mulv(wang[k], Iinv, ang[k]);
+    /* J row k = [f, r x f]; W column k = [f / m, I^-1 (r x f)] */
+    for (int i = 0; i < 3; i++) {
+      J[6 * k + i] = f[i];
+      J[6 * k + 3 + i] = ang[k][i];
+      W[3 * i + k] = f[i] * inv_m;
+      W[3 * (3 + i) + k] = wang[k][i];
+    }
+  }
+  for (int a = 0; a < 3; a++)
+    for (int c = 0; c < 3; c++)
+      G[3 * a + c] = ss_v3_dot(frame + 3 * a, frame + 3 * c) * inv_m +
+                     ss_v3_dot(ang[a], wang[c]);
+}
+
+void ss_dyn_point_velocity(const ssModel *m, const ssData *d, int s,
+                           const double p[3], double v[3])
+{
+  if (m->sys_nv[s] == 0 || !d->sys_active[s]) {
+    ss_v3_set(v, 0, 0, 0);
+    return;
+  }
+  int b = m->sys_bodyadr[s];
+  const double *u = d->qvel + m->sys_vadr[s];
+  double r[3], wr[3];
+  ss_v3_sub(r, p, d->body_xpos + 3 * b);
+  ss_v3_cross(wr, u + 3, r);
+  ss_v3_add(v, u, wr);
+}
+
+void ss_dyn_integrate(const ssModel *m, ssData *d)
+{
+  const double dt = m->opt.timestep;
+  for (int s = 0; s < m->nsys; s++) {
+    if (!sys_dynamic(m, d, s)) continue;
+    double *q = d->qpos + m->sys_qadr[s];
+    const double *u = d->qvel + m->sys_vadr[s];
+    ss_v3_addscl(q, u, dt);
+    double rv[3], dq[4];
+    ss_v3_scale(rv, u + 3, dt);
+    ss_quat_from_rotvec(dq, rv);
+    ss_quat_mul(q + 3, dq, q + 3);
+    ss_quat_normalize(q + 3);
+  }
+}
+
+int ss_dyn_check_finite(const ssModel *m, const ssData *d)
+{
+  /* 1e8 m/s: far beyond anything physical; a sign the step blew up */
+  for (int s = 0; s < m->nsys; s++) {
+    if (!d->sys_active[s]) continue;
+    for (int k = 0; k < m->sys_nq[s]; k++)
+      if (!isfinite(d->qpos[m->sys_qadr[s] + k])) return s;
+    for (int k = 0; k < m->sys_nv[s]; k++) {
+      double v = d->qvel[m->sys_vadr[s] + k];
+      if (!isfinite(v) || fabs(v) > 1e8) return s;
+    }
+  }
+  return -1;
+}

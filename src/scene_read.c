@@ -1,0 +1,1771 @@
+/* scene_read.c -- world XML (DESIGN 4.1) into a model and its data.
+ *
+ * The accepted format, the safety measures and the error conventions are
+ * described in scene.h.  The reader parses the whole document with libxml2
+ * (safely), then walks the tree once, building the model with the model
+ * builder; every element is checked against a list of allowed attributes
+ * and children so that typos are reported instead of ignored. */
+#include "scene.h"
+#include "ss_math.h"
+
+#include <libxml/parser.h>
+#include <libxml/parserInternals.h>
+#include <libxml/tree.h>
+#include <libxml/xmlerror.h>
+
+#include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+/* attributes per element kept (no element allows nearly as many) */
+#define MAX_ATTR 40
+#define NAME_CAP 64
+/* largest height map (vertices), as in the model builder */
+#define MAX_VERTICES 100000000L
+
+/* ---------------------------------------------------------------------- */
+/* files, locale, numbers                                                  */
+
+ssStatus ss_read_file(const char *path, long max_bytes, char **buf,
+                      size_t *len, ssError *err)
+{
+  *buf = NULL;
+  *len = 0;
+  if (!path || !*path)
+    return ss_error_set(err, SS_ERR_IO, "", 0, "no file name given");
+  /* O_NONBLOCK: opening a FIFO must not wait for a writer; it is refused
+   * below as not a regular file */
+  int fd = open(path, O_RDONLY | O_NONBLOCK);
+  if (fd < 0)
+    return ss_error_set(err, SS_ERR_IO, path, 0, "cannot open: %s",
+                        strerror(errno));
+  struct stat st;
+  if (fstat(fd, &st) != 0) {
+    int e = errno;
+    close(fd);
+    return ss_error_set(err, SS_ERR_IO, path, 0, "cannot read: %s",
+                        strerror(e));
+  }
+  if (!S_ISREG(st.st_mode)) {
+    close(fd);
+    return ss_error_set(err, SS_ERR_IO, path, 0,
+                        "cannot read: not a regular file");
+  }
+  if (st.st_size > max_bytes) {
+    close(fd);
+    return ss_error_set(err, SS_ERR_IO, path, 0,
+                        "file is %lld bytes, larger than the limit of %ld",
+                        (long long)st.st_size, max_bytes);
+  }
+  size_t n = (size_t)st.st_size;
+  char *b = malloc(n + 1);
+  if (!b) {
+    close(fd);
+    return ss_error_set(err, SS_ERR_NOMEM, path, 0,
+                        "out of memory reading %zu bytes", n);
+  }
+  size_t got = 0;
+  while (got < n) {
+    ssize_t r = read(fd, b + got, n - got);
+    if (r < 0 && errno == EINTR) continue;
+    if (r < 0) {
+      int e = errno;
+      free(b);
+      close(fd);
+      return ss_error_set(err, SS_ERR_IO, path, 0, "cannot read: %s",
+                          strerror(e));
+    }
+    if (r == 0) break; /* the file shrank: take what is there */
+    got += (size_t)r;
+  }
+  close(fd);
+  b[got] = 0;
+  *buf = b;
+  *len = got;
+  return SS_OK;
+}
+
+int ss_scene_c_locale_push(ssCLocale *l)
+{
+  l->loc = (locale_t)0;
+  l->old = (locale_t)0;
+  locale_t c = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
+  if (c == (locale_t)0) return -1;
+  l->old = uselocale(c);
+  l->loc = c;
+  return 0;
+}
+
+void ss_scene_c_locale_pop(ssCLocale *l)
+{
+  if (l->loc == (locale_t)0) return;
+  uselocale(l->old);
+  freelocale(l->loc);
+  l->loc = (locale_t)0;
+}
+
+static int is_digit(char ch) { return ch >= '0' && ch <= '9'; }
+
+int ss_scene_parse_double(const char *s, const char *end, double *out)
+{
+  /* grammar first: [+-] digits [. digits] [(e|E) [+-] digits], at least one
+   * mantissa digit; this keeps out nan, inf, hexadecimal and junk */
+  const char *p = s;
+  if (p < end && (*p == '+' || *p == '-')) p++;
+  int nd = 0;
+  while (p < end && is_digit(*p)) p++, nd++;
+  if (p < end && *p == '.') {
+    p++;
+    while (p < end && is_digit(*p)) p++, nd++;
+  }
+  if (nd == 0) return 1;
+  if (p < end && (*p == 'e' || *p == 'E')) {
+    p++;
+    if (p < end && (*p == '+' || *p == '-')) p++;
+    int ne = 0;
+    while (p < end && is_digit(*p)) p++, ne++;
+    if (ne == 0) return 1;
+  }
+  if (p != end) return 1;
+  /* the token is followed by a separator or the end of the string, so
+   * strtod stops exactly at `end` */
+  char *e = NULL;
+  errno = 0;
+  double v = strtod(s, &e);
+  if (e != end) return 1;
+  /* underflow (ERANGE with a tiny result) is accepted: subnormals must read
+   * back exactly; overflow is not */
+  if (!isfinite(v) || (errno == ERANGE && fabs(v) > 1)) return 2;
+  *out = v;
+  return 0;
+}
+
+int ss_scene_parse_long(const char *s, const char *end, long *out)
+{
+  const char *p = s;
+  if (p < end && (*p == '+' || *p == '-')) p++;
+  if (p == end) return 1;
+  for (const char *q = p; q < end; q++)
+    if (!is_digit(*q)) return 1;
+  char *e = NULL;
+  errno = 0;
+  long v = strtol(s, &e, 10);
+  if (e != end) return 1;
+  if (errno == ERANGE) return 2;
+  *out = v;
+  return 0;
+}
+
+/* ---------------------------------------------------------------------- */
+/* reader context and messages                                             */
+
+typedef struct pendingSoil {
+  int hfield, line;
+  double *sinkage, *plastic, *shear; /* (nx*ny) or NULL */
+} pendingSoil;
+
+typedef struct readCtx {
+  const char *path;  /* scene path for messages */
+  char dir[1024];    /* [THIS_DIR] */
+  xmlDocPtr doc;
+  ssModel *m;
+  ssError e;
+  int npend, cappend;
+  pendingSoil *pend;
+  int clock_given;
+  double clock_time;
+  long clock_step;
+  int camera_line;
+} readCtx;
+
+static ssStatus fail(readCtx *c, ssStatus code, int line, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+
+static ssStatus fail(readCtx *c, ssStatus code, int line, const char *fmt, ...)
+{
+  c->e.code = code;
+  snprintf(c->e.file, sizeof c->e.file, "%s", c->path);
+  c->e.line = line;
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(c->e.message, sizeof c->e.message, fmt, ap);
+  va_end(ap);
+  return code;
+}
+
+/* After a builder call failed: point the error at the scene and element. */
+static ssStatus fix_error(readCtx *c, int line, const char *prefix)
+{
+  snprintf(c->e.file, sizeof c->e.file, "%s", c->path);
+  if (c->e.line == 0) c->e.line = line;
+  if (prefix) {
+    char msg[sizeof c->e.message];
+    snprintf(msg, sizeof msg, "%.100s: %.900s", prefix, c->e.message);
+    memcpy(c->e.message, msg, sizeof msg);
+  }
+  if (c->e.code == SS_OK) c->e.code = SS_ERR_VALUE;
+  return c->e.code;
+}
+
+/* ---------------------------------------------------------------------- */
+/* elements and attributes                                                 */
+
+typedef struct xAttr {
+  const char *raw;      /* name as written */
+  char name[NAME_CAP];  /* snake_case */
+  const char *val;
+} xAttr;
+
+typedef struct xEl {
+  xmlNodePtr node;
+  const char *raw;
+  char name[NAME_CAP];
+  int line;
+  char label[200];      /* "box 'plate'", "box 'plate' <dim>", "<gravity>" */
+  int nattr;
+  xAttr attr[MAX_ATTR];
+  xmlChar *owned[MAX_ATTR];
+} xEl;
+
+/* camelCase -> snake_case; `timestep` -> time_step.  Names too long for
+ * the buffer become "?" (never a valid name). */
+static void norm_name(const char *in, char out[NAME_CAP])
+{
+  size_t k = 0;
+  for (const char *p = in; *p; p++) {
+    char ch = *p;
+    if (k + 3 >= NAME_CAP) {
+      strcpy(out, "?");
+      return;
+    }
+    if (ch >= 'A' && ch <= 'Z') {
+      if (k > 0 && out[k - 1] != '_') out[k++] = '_';
+      out[k++] = (char)(ch - 'A' + 'a');
+    } else {
+      out[k++] = ch;
+    }
+  }
+  out[k] = 0;
+  if (!strcmp(out, "timestep")) strcpy(out, "time_step");
+}
+
+/* The line where an element's start tag begins, recorded while parsing
+ * (libxml2's own node line is where the start tag ends, the last line of a
+ * multi-line tag, and stops at 65535). */
+static int line_of(xmlNodePtr n)
+{
+  if (n->type == XML_ELEMENT_NODE && n->_private)
+    return (int)(intptr_t)n->_private;
+  long l = xmlGetLineNo(n);
+  return l > 0 && l < INT_MAX ? (int)l : 0;
+}
+
+static void el_free(xEl *e)
+{
+  for (int i = 0; i < e->nattr; i++)
+    if (e->owned[i]) xmlFree(e->owned[i]);
+  e->nattr = 0;
+}
+
+/* Collect node's attributes with normalised names; spellings of one name
+ * given twice are an error. */
+static ssStatus el_open(readCtx *c, xmlNodePtr node, const char *parent_label,
+                        xEl *e)
+{
+  memset(e, 0, sizeof *e);
+  e->node = node;
+  e->raw = (const char *)node->name;
+  norm_name(e->raw, e->name);
+  e->line = line_of(node);
+  if (parent_label)
+    snprintf(e->label, sizeof e->label, "%s <%s>", parent_label, e->name);
+  else
+    snprintf(e->label, sizeof e->label, "<%s>", e->name);
+  for (xmlAttrPtr a = node->properties; a; a = a->next) {
+    if (e->nattr == MAX_ATTR)
+      return fail(c, SS_ERR_PARSE, e->line, "%s: too many attributes (at most %d)",
+                  e->label, MAX_ATTR);
+    xAttr *x = &e->attr[e->nattr];
+    x->raw = (const char *)a->name;
+    norm_name(x->raw, x->name);
+    if (a->children && a->children->type == XML_TEXT_NODE && !a->children->next &&
+        a->children->content) {
+      x->val = (const char *)a->children->content;
+    } else {
+      xmlChar *v = xmlNodeListGetString(c->doc, a->children, 1);
+      e->owned[e->nattr] = v;
+      x->val = v ? (const char *)v : "";
+    }
+    e->nattr++;
+    for (int i = 0; i < e->nattr - 1; i++)
+      if (!strcmp(e->attr[i].name, x->name))
+        return fail(c, SS_ERR_PARSE, e->line,
+                    "%s: attribute '%s' given twice (as '%s' and '%s')",
+                    e->label, x->name, e->attr[i].raw, x->raw);
+  }
+  return SS_OK;
+}
+
+static void join_names(char *out, size_t cap, const char *const *names)
+{
+  size_t k = 0;
+  out[0] = 0;
+  for (int i = 0; names[i]; i++) {
+    int n = snprintf(out + k, cap - k, "%s%s", i ? ", " : "", names[i]);
+    if (n < 0 || (size_t)n >= cap - k) break;
+    k += (size_t)n;
+  }
+}
+
+static int in_list(const char *name, const char *const *list)
+{
+  for (int i = 0; list[i]; i++)
+    if (!strcmp(list[i], name)) return 1;
+  return 0;
+}
+
+/* Every attribute must be in `allowed` (NULL-terminated). */
+static ssStatus el_allow(readCtx *c, xEl *e, const char *const *allowed)
+{
+  for (int i = 0; i < e->nattr; i++)
+    if (!in_list(e->attr[i].name, allowed)) {
+      char list[600];
+      join_names(list, sizeof list, allowed);
+      return fail(c, SS_ERR_PARSE, e->line,
+                  "unknown attribute '%s' on <%s> (allowed: %s)", e->attr[i].raw,
+                  e->name, allowed[0] ? list : "none");
+    }
+  return SS_OK;
+}
+
+static const char *el_find(xEl *e, const char *name)
+{
+  for (int i = 0; i < e->nattr; i++)
+    if (!strcmp(e->attr[i].name, name)) return e->attr[i].val;
+  return NULL;
+}
+
+static ssStatus missing(readCtx *c, xEl *e, const char *name)
+{
+  return fail(c, SS_ERR_PARSE, e->line, "%s: missing required attribute '%s'",
+              e->label, name);
+}
+
+static ssStatus get_str(readCtx *c, xEl *e, const char *name, int required,
+                        const char **out)
+{
+  const char *v = el_find(e, name);
+  if (!v) return required ? missing(c, e, name) : SS_OK;
+  *out = v;
+  return SS_OK;
+}
+
+static int is_space(char ch)
+{
+  return ch == ' ' || ch == '\t' || ch == '\n' || ch == '\r';
+}
+
+/* Next value of a vector: separated by white space or one comma.  Returns
+ * 1 with [*tb, *te), 0 at the end, -1 on an empty value (",," or a comma
+ * at either end). */
+static int vec_next(const char **pp, int first, const char **tb, const char **te)
+{
+  const char *p = *pp;
+  while (is_space(*p)) p++;
+  if (*p == ',') {
+    if (first) return -1;
+    p++;
+    while (is_space(*p)) p++;
+    if (*p == 0 || *p == ',') return -1;
+  }
+  if (*p == 0) {
+    *pp = p;
+    return 0;
+  }
+  *tb = p;
+  while (*p && !is_space(*p) && *p != ',') p++;
+  *te = p;
+  *pp = p;
+  return 1;
+}
+
+/* Count the values of a vector attribute; -1 on a syntax error. */
+static long vec_count(const char *v)
+{
+  const char *p = v, *tb, *te;
+  long n = 0;
+  int r;
+  while ((r = vec_next(&p, n == 0, &tb, &te)) == 1) n++;
+  return r < 0 ? -1 : n;
+}
+
+static ssStatus bad_number(readCtx *c, xEl *e, const char *name, const char *tb,
+                           const char *te, long index, long n, int why)
+{
+  int len = (int)(te - tb) > 40 ? 40 : (int)(te - tb);
+  char where[64] = "";
+  if (n > 1) snprintf(where, sizeof where, " (value %ld of %ld)", index + 1, n);
+  return fail(c, SS_ERR_PARSE, e->line,
+              "%s: bad number '%.*s'%s in attribute '%s' (%s)", e->label, len,
+              tb, where, name,
+              why == 2 ? "out of range" : "expected a finite decimal number");
+}
+
+/* Parse exactly n values of attribute `name` into out; `what` describes
+ * the expected count for messages (NULL: just the number). */
+static ssStatus parse_values(readCtx *c, xEl *e, const char *name,
+                             const char *v, long n, const char *what,
+                             double *out)
+{
+  long got = vec_count(v);
+  if (got < 0)
+    return fail(c, SS_ERR_PARSE, e->line,
+                "%s: attribute '%s' has an empty value (values are separated "
+                "by white space or by one comma)", e->label, name);
+  if (got != n) {
+    if (what)
+      return fail(c, SS_ERR_PARSE, e->line,
+                  "%s: attribute '%s' has %ld values, expected %s = %ld",
+                  e->label, name, got, what, n);
+    return fail(c, SS_ERR_PARSE, e->line,
+                "%s: attribute '%s' has %ld value%s, expected %ld", e->label,
+                name, got, got == 1 ? "" : "s", n);
+  }
+  const char *p = v, *tb = NULL, *te = NULL;
+  for (long k = 0; k < n; k++) {
+    vec_next(&p, k == 0, &tb, &te);
+    int r = ss_scene_parse_double(tb, te, &out[k]);
+    if (r) return bad_number(c, e, name, tb, te, k, n, r);
+  }
+  return SS_OK;
+}
+
+static ssStatus get_vec(readCtx *c, xEl *e, const char *name, int n,
+                        int required, double *out)
+{
+  const char *v = el_find(e, name);
+  if (!v) return required ? missing(c, e, name) : SS_OK;
+  return parse_values(c, e, name, v, n, NULL, out);
+}
+
+static ssStatus get_num(readCtx *c, xEl *e, const char *name, int required,
+                        double *out)
+{
+  return get_vec(c, e, name, 1, required, out);
+}
+
+/* Parse a whole array attribute (expected n values) into a malloc'd
+ * buffer; *out stays NULL when the attribute is absent. */
+static ssStatus get_array(readCtx *c, xEl *e, const char *name, long n,
+                          const char *what, int required, double **out)
+{
+  *out = NULL;
+  const char *v = el_find(e, name);
+  if (!v) return required ? missing(c, e, name) : SS_OK;
+  double *a = malloc((size_t)(n > 0 ? n : 1) * sizeof *a);
+  if (!a) return fail(c, SS_ERR_NOMEM, e->line, "out of memory");
+  ssStatus st = parse_values(c, e, name, v, n, what, a);
+  if (st != SS_OK) {
+    free(a);
+    return st;
+  }
+  *out = a;
+  return SS_OK;
+}
+
+static ssStatus get_long(readCtx *c, xEl *e, const char *name, int required,
+                         long lo, long hi, long *out)
+{
+  const char *v = el_find(e, name);
+  if (!v) return required ? missing(c, e, name) : SS_OK;
+  const char *p = v, *tb = NULL, *te = NULL;
+  long n = vec_count(v);
+  int r = 1;
+  long x = 0;
+  if (n == 1) {
+    vec_next(&p, 1, &tb, &te);
+    r = ss_scene_parse_long(tb, te, &x);
+  }
+  if (r != 0) {
+    int len = (int)strlen(v) > 40 ? 40 : (int)strlen(v);
+    return fail(c, SS_ERR_PARSE, e->line,
+                "%s: attribute '%s' is '%.*s', expected an integer", e->label,
+                name, len, v);
+  }
+  if (x < lo || x > hi)
+    return fail(c, SS_ERR_VALUE, e->line,
+                "%s: %s = %ld is invalid: must be in [%ld, %ld]", e->label,
+                name, x, lo, hi);
+  *out = x;
+  return SS_OK;
+}
+
+static ssStatus get_int(readCtx *c, xEl *e, const char *name, int required,
+                        int lo, int hi, int *out)
+{
+  long x = *out;
+  ssStatus st = get_long(c, e, name, required, lo, hi, &x);
+  if (st == SS_OK) *out = (int)x;
+  return st;
+}
+
+static ssStatus get_bool(readCtx *c, xEl *e, const char *name, int *out)
+{
+  const char *v = el_find(e, name);
+  if (!v) return SS_OK;
+  const char *p = v, *tb = NULL, *te = NULL;
+  if (vec_count(v) == 1) {
+    vec_next(&p, 1, &tb, &te);
+    size_t n = (size_t)(te - tb);
+    if ((n == 4 && !strncmp(tb, "true", 4)) || (n == 1 && *tb == '1')) {
+      *out = 1;
+      return SS_OK;
+    }
+    if ((n == 5 && !strncmp(tb, "false", 5)) || (n == 1 && *tb == '0')) {
+      *out = 0;
+      return SS_OK;
+    }
+  }
+  return fail(c, SS_ERR_PARSE, e->line,
+              "%s: attribute '%s' is '%.40s' (allowed: true, false, 1, 0)",
+              e->label, name, v);
+}
+
+/* One of two spellings of an attribute (x_sample / x_samples). */
+static const char *get_alias(readCtx *c, xEl *e, const char *a, const char *b,
+                             const char **used, ssStatus *st)
+{
+  const char *va = el_find(e, a), *vb = el_find(e, b);
+  *st = SS_OK;
+  if (va && vb) {
+    *st = fail(c, SS_ERR_PARSE, e->line,
+               "%s: give either '%s' or '%s', not both", e->label, a, b);
+    return NULL;
+  }
+  *used = va ? a : b;
+  return va ? va : vb;
+}
+
+static int is_blank(const xmlChar *s)
+{
+  if (!s) return 1;
+  for (; *s; s++)
+    if (!is_space((char)*s)) return 0;
+  return 1;
+}
+
+/* Non-element children: blank text, comments and processing instructions
+ * are fine; anything else is an error. */
+static ssStatus check_other_node(readCtx *c, xmlNodePtr n, const xEl *parent)
+{
+  switch (n->type) {
+  case XML_TEXT_NODE:
+  case XML_CDATA_SECTION_NODE:
+    if (is_blank(n->content)) return SS_OK;
+    {
+      const char *t = (const char *)n->content;
+      while (is_space(*t)) t++;
+      int len = 0;
+      while (t[len] && !is_space(t[len]) && len < 30) len++;
+      return fail(c, SS_ERR_PARSE, line_of(n) ? line_of(n) : parent->line,
+                  "unexpected text '%.*s' inside <%s> (values go in "
+                  "attributes)", len, t, parent->name);
+    }
+  case XML_COMMENT_NODE:
+  case XML_PI_NODE:
+  case XML_XINCLUDE_START:
+  case XML_XINCLUDE_END:
+    return SS_OK;
+  default:
+    return fail(c, SS_ERR_PARSE, line_of(n) ? line_of(n) : parent->line,
+                "unexpected content inside <%s>", parent->name);
+  }
+}
+
+static ssStatus unknown_child(readCtx *c, xmlNodePtr n, const xEl *parent,
+                              const char *const *allowed)
+{
+  char list[400];
+  join_names(list, sizeof list, allowed);
+  if (!allowed[0])
+    return fail(c, SS_ERR_PARSE, line_of(n),
+                "unknown element <%s> inside <%s> (<%s> has no child "
+                "elements)", (const char *)n->name, parent->name, parent->name);
+  return fail(c, SS_ERR_PARSE, line_of(n),
+              "unknown element <%s> inside <%s> (allowed: %s)",
+              (const char *)n->name, parent->name, list);
+}
+
+/* A leaf element: no element children, no text. */
+static ssStatus check_leaf(readCtx *c, const xEl *e)
+{
+  static const char *const none[] = {NULL};
+  for (xmlNodePtr n = e->node->children; n; n = n->next) {
+    ssStatus st = n->type == XML_ELEMENT_NODE ? unknown_child(c, n, e, none)
+                                              : check_other_node(c, n, e);
+    if (st) return st;
+  }
+  return SS_OK;
+}
+
+/* Open a leaf child element with its allowed attributes. */
+static ssStatus open_leaf(readCtx *c, xmlNodePtr n, const char *parent_label,
+                          const char *const *allowed, xEl *e)
+{
+  ssStatus st = el_open(c, n, parent_label, e);
+  if (!st) st = el_allow(c, e, allowed);
+  if (!st) st = check_leaf(c, e);
+  return st;
+}
+
+static ssStatus once(readCtx *c, int *seen, const xEl *e)
+{
+  if (*seen)
+    return fail(c, SS_ERR_PARSE, e->line,
+                "element <%s> given twice in the same place (first at line %d)",
+                e->name, *seen);
+  *seen = e->line ? e->line : -1;
+  return SS_OK;
+}
+
+/* Expand [THIS_DIR]; a relative path without it is relative to the scene's
+ * folder. */
+static ssStatus resolve_path(readCtx *c, xEl *e, const char *name,
+                             const char *raw, char *out, size_t cap)
+{
+  if (!*raw)
+    return fail(c, SS_ERR_PARSE, e->line, "%s: attribute '%s' is empty",
+                e->label, name);
+  static const char tag[] = "[THIS_DIR]";
+  size_t k = 0, tl = sizeof tag - 1;
+  int expanded = 0;
+  out[0] = 0;
+  for (const char *p = raw; *p;) {
+    const char *piece = p;
+    size_t plen = 1;
+    if (!strncmp(p, tag, tl)) {
+      piece = c->dir;
+      plen = strlen(c->dir);
+      p += tl;
+      expanded = 1;
+    } else {
+      p++;
+    }
+    if (k + plen + 1 > cap)
+      return fail(c, SS_ERR_VALUE, e->line, "%s: path in '%s' is too long",
+                  e->label, name);
+    memcpy(out + k, piece, plen);
+    k += plen;
+  }
+  out[k] = 0;
+  if (!expanded && raw[0] != '/') {
+    size_t dl = strlen(c->dir);
+    if (dl + 1 + k + 1 > cap)
+      return fail(c, SS_ERR_VALUE, e->line, "%s: path in '%s' is too long",
+                  e->label, name);
+    memmove(out + dl + 1, out, k + 1);
+    memcpy(out, c->dir, dl);
+    out[dl] = '/';
+  }
+  return SS_OK;
+}
+
+static int quat_is_zero(const double q[4])
+{
+  return q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] < 1e-18;
+}
+
+/* A quaternion already of unit length (to 1e-14) is stored as written, so
+ * that an exported state reads back bit for bit (normalising it again could
+ * move the last bit). */
+static void keep_unit_quat(double *dst, const double q[4])
+{
+  double n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+  if (fabs(n2 - 1) <= 1e-14) memcpy(dst, q, 4 * sizeof(double));
+}
+
+/* ---------------------------------------------------------------------- */
+/* objects                                                                 */
+
+static ssStatus read_ground(readCtx *c, xmlNodePtr n)
+{
+  static const char *const allowed[] = {"name", "height", "material", NULL};
+  xEl e;
+  ssStatus st = open_leaf(c, n, NULL, allowed, &e);
+  const char *name = NULL, *mat = NULL;
+  double h = 0;
+  if (!st) st = get_str(c, &e, "name", 1, &name);
+  if (!st) snprintf(e.label, sizeof e.label, "ground '%s'", name);
+  if (!st) st = get_num(c, &e, "height", 0, &h);
+  if (!st) st = get_str(c, &e, "material", 0, &mat);
+  if (!st && ss_model_add_plane(c->m, name, h, mat, e.line, &c->e) < 0)
+    st = fix_error(c, e.line, NULL);
+  el_free(&e);
+  return st;
+}
+
+typedef struct xforceDef {
+  double force[3], torque[3], start, end;
+  int line;
+} xforceDef;
+
+static ssStatus read_dim(readCtx *c, xmlNodePtr n, const char *label,
+                         ssBodyDef *def)
+{
+  static const char *const box[] = {"x", "y", "z", NULL};
+  static const char *const sph[] = {"radius", NULL};
+  static const char *const cyl[] = {"radius", "height", NULL};
+  const char *const *names = def->shape == SS_GEOM_BOX      ? box
+                             : def->shape == SS_GEOM_SPHERE ? sph
+                                                            : cyl;
+  xEl e;
+  ssStatus st = open_leaf(c, n, label, names, &e);
+  for (int k = 0; !st && names[k]; k++) {
+    st = get_num(c, &e, names[k], 1, &def->size[k]);
+    if (!st && !(def->size[k] > 0))
+      st = fail(c, SS_ERR_VALUE, e.line, "%s: %s = %g is invalid: must be > 0",
+                e.label, names[k], def->size[k]);
+  }
+  el_free(&e);
+  return st;
+}
+
+static ssStatus read_state(readCtx *c, xmlNodePtr n, const char *label,
+                           ssBodyDef *def)
+{
+  static const char *const allowed[] = {"pos", "quat", "lin_vel", "ang_vel",
+                                        NULL};
+  xEl e;
+  ssStatus st = open_leaf(c, n, label, allowed, &e);
+  if (!st) st = get_vec(c, &e, "pos", 3, 0, def->pos);
+  if (!st) st = get_vec(c, &e, "quat", 4, 0, def->quat);
+  if (!st) st = get_vec(c, &e, "lin_vel", 3, 0, def->lin_vel);
+  if (!st) st = get_vec(c, &e, "ang_vel", 3, 0, def->ang_vel);
+  if (!st && quat_is_zero(def->quat))
+    st = fail(c, SS_ERR_VALUE, e.line,
+              "%s: quat = %g %g %g %g has zero length (quaternions are w x y z)",
+              e.label, def->quat[0], def->quat[1], def->quat[2], def->quat[3]);
+  el_free(&e);
+  return st;
+}
+
+static ssStatus read_inertia(readCtx *c, xmlNodePtr n, const char *label,
+                             ssBodyDef *def)
+{
+  static const char *const allowed[] = {"xx", "xy", "xz", "yy", "yz", "zz",
+                                        NULL};
+  xEl e;
+  double *I = def->inertia;
+  I[1] = I[2] = I[4] = 0;
+  ssStatus st = open_leaf(c, n, label, allowed, &e);
+  if (!st) st = get_num(c, &e, "xx", 1, &I[0]);
+  if (!st) st = get_num(c, &e, "xy", 0, &I[1]);
+  if (!st) st = get_num(c, &e, "xz", 0, &I[2]);
+  if (!st) st = get_num(c, &e, "yy", 1, &I[3]);
+  if (!st) st = get_num(c, &e, "yz", 0, &I[4]);
+  if (!st) st = get_num(c, &e, "zz", 1, &I[5]);
+  if (!st) {
+    /* Sylvester: leading principal minors > 0 */
+    double m2 = I[0] * I[3] - I[1] * I[1];
+    double det = I[0] * (I[3] * I[5] - I[4] * I[4]) -
+                 I[1] * (I[1] * I[5] - I[4] * I[2]) +
+                 I[2] * (I[1] * I[4] - I[3] * I[2]);
+    if (!(I[0] > 0) || !(m2 > 0) || !(det > 0))
+      st = fail(c, SS_ERR_VALUE, e.line,
+                "%s: the inertia matrix must be positive definite (xx, yy, zz "
+                "> 0 and the products of inertia small enough)", e.label);
+  }
+  def->inertia_given = 1;
+  el_free(&e);
+  return st;
+}
+
+static ssStatus read_xforce(readCtx *c, xmlNodePtr n, const char *label,
+                            xforceDef *x)
+{
+  static const char *const allowed[] = {"force", "torque", "start", "end",
+                                        NULL};
+  xEl e;
+  memset(x, 0, sizeof *x);
+  x->end = INFINITY;
+  x->line = line_of(n);
+  ssStatus st = open_leaf(c, n, label, allowed, &e);
+  if (!st) st = get_vec(c, &e, "force", 3, 0, x->force);
+  if (!st) st = get_vec(c, &e, "torque", 3, 0, x->torque);
+  if (!st) st = get_num(c, &e, "start", 0, &x->start);
+  if (!st) st = get_num(c, &e, "end", 0, &x->end);
+  if (!st && !(x->start <= x->end))
+    st = fail(c, SS_ERR_VALUE, e.line,
+              "%s: start = %g is after end = %g (times in s; end defaults to "
+              "never)", e.label, x->start, x->end);
+  el_free(&e);
+  return st;
+}
+
+static ssStatus read_body(readCtx *c, xmlNodePtr n, ssGeomType shape)
+{
+  static const char *const allowed[] = {"name", "mass", "material",
+                                        "body_type", "rgba", NULL};
+  static const char *const kids[] = {"dim", "state", "inertia",
+                                     "external_force", NULL};
+  ssBodyDef def = ss_body_def_default();
+  def.shape = shape;
+  xEl e;
+  xforceDef *xf = NULL;
+  int nxf = 0;
+  const char *type = NULL;
+  ssStatus st = el_open(c, n, NULL, &e);
+  if (!st) st = el_allow(c, &e, allowed);
+  if (!st) st = get_str(c, &e, "name", 1, &def.name);
+  if (!st) snprintf(e.label, sizeof e.label, "%s '%s'", e.name, def.name);
+  if (!st) st = get_str(c, &e, "body_type", 0, &type);
+  if (!st && type) {
+    if (!strcmp(type, "static"))
+      def.is_static = 1;
+    else if (strcmp(type, "dynamic"))
+      st = fail(c, SS_ERR_PARSE, e.line,
+                "%s: body_type is '%.40s' (allowed: static, dynamic)", e.label,
+                type);
+  }
+  if (!st) st = get_num(c, &e, "mass", !def.is_static, &def.mass);
+  if (!st && !def.is_static && !(def.mass > 0))
+    st = fail(c, SS_ERR_VALUE, e.line,
+              "%s: mass = %g is invalid: a dynamic body needs a mass > 0 kg",
+              e.label, def.mass);
+  if (!st) st = get_str(c, &e, "material", 0, &def.material);
+  if (!st && el_find(&e, "rgba")) {
+    st = get_vec(c, &e, "rgba", 4, 0, def.rgba);
+    for (int k = 0; !st && k < 4; k++)
+      if (!(def.rgba[k] >= 0 && def.rgba[k] <= 1))
+        st = fail(c, SS_ERR_VALUE, e.line,
+                  "%s: rgba component %d = %g is invalid: must be in [0, 1]",
+                  e.label, k + 1, def.rgba[k]);
+  }
+  int seen_dim = 0, seen_state = 0, seen_inertia = 0;
+  double quat_read[4] = {1, 0, 0, 0};
+  for (xmlNodePtr k = n->children; !st && k; k = k->next) {
+    if (k->type != XML_ELEMENT_NODE) {
+      st = check_other_node(c, k, &e);
+      continue;
+    }
+    char kn[NAME_CAP];
+    norm_name((const char *)k->name, kn);
+    xEl tmp;
+    tmp.line = line_of(k);
+    snprintf(tmp.name, sizeof tmp.name, "%s", kn);
+    if (!strcmp(kn, "dim")) {
+      st = once(c, &seen_dim, &tmp);
+      if (!st) st = read_dim(c, k, e.label, &def);
+    } else if (!strcmp(kn, "state")) {
+      st = once(c, &seen_state, &tmp);
+      if (!st) st = read_state(c, k, e.label, &def);
+      memcpy(quat_read, def.quat, sizeof quat_read);
+    } else if (!strcmp(kn, "inertia")) {
+      st = once(c, &seen_inertia, &tmp);
+      if (!st) st = read_inertia(c, k, e.label, &def);
+    } else if (!strcmp(kn, "external_force")) {
+      xforceDef *p = realloc(xf, (size_t)(nxf + 1) * sizeof *xf);
+      if (!p) {
+        st = fail(c, SS_ERR_NOMEM, tmp.line, "out of memory");
+        break;
+      }
+      xf = p;
+      st = read_xforce(c, k, e.label, &xf[nxf]);
+      if (!st) nxf++;
+    } else {
+      st = unknown_child(c, k, &e, kids);
+    }
+  }
+  if (!st && !seen_dim)
+    st = fail(c, SS_ERR_PARSE, e.line, "%s: missing its <dim> element",
+              e.label);
+  if (!st) {
+    def.line = e.line;
+    int s = ss_model_add_body(c->m, &def, &c->e);
+    if (s < 0) {
+      st = fix_error(c, e.line, NULL);
+    } else {
+      keep_unit_quat(c->m->qpos0 + c->m->sys_qadr[s] + 3, quat_read);
+      int b = c->m->sys_bodyadr[s];
+      for (int k = 0; !st && k < nxf; k++)
+        if (ss_model_add_xforce(c->m, b, xf[k].force, xf[k].torque,
+                                xf[k].start, xf[k].end, &c->e) < 0) {
+          c->e.line = 0;
+          st = fix_error(c, xf[k].line, NULL);
+        }
+    }
+  }
+  free(xf);
+  el_free(&e);
+  return st;
+}
+
+/* ---------------------------------------------------------------------- */
+/* height maps                                                             */
+
+static ssStatus read_terrain_props(readCtx *c, xmlNodePtr n, const char *label,
+                                   ssTerrainProps *p)
+{
+  static const char *const allowed[] = {
+    "x_size", "y_size", "x_samples", "y_samples", "x_sample", "y_sample",
+    "frequency", "z_scale", "fractal_octaves", "fractal_lacunarity",
+    "fractal_gain", "seed", "height_offset", "step_size", NULL};
+  xEl e;
+  *p = ss_terrain_props_default();
+  ssStatus st = open_leaf(c, n, label, allowed, &e);
+  if (!st) st = get_num(c, &e, "x_size", 1, &p->x_size);
+  if (!st) st = get_num(c, &e, "y_size", 1, &p->y_size);
+  for (int k = 0; k < 2 && !st; k++) {
+    const char *used = NULL;
+    const char *v = get_alias(c, &e, k ? "y_samples" : "x_samples",
+                              k ? "y_sample" : "x_sample", &used, &st);
+    if (st) break;
+    if (!v) {
+      st = missing(c, &e, k ? "y_samples" : "x_samples");
+      break;
+    }
+    long x = 0;
+    st = get_long(c, &e, used, 1, 2, INT_MAX, &x);
+    if (!st) *(k ? &p->y_samples : &p->x_samples) = (int)x;
+  }
+  if (!st) st = get_num(c, &e, "frequency", 0, &p->frequency);
+  if (!st) st = get_num(c, &e, "z_scale", 0, &p->z_scale);
+  if (!st) st = get_int(c, &e, "fractal_octaves", 0, 0, 16, &p->fractal_octaves);
+  if (!st) st = get_num(c, &e, "fractal_lacunarity", 0, &p->fractal_lacunarity);
+  if (!st) st = get_num(c, &e, "fractal_gain", 0, &p->fractal_gain);
+  long seed = 0;
+  if (!st) st = get_long(c, &e, "seed", 0, 0, 4294967295L, &seed);
+  p->seed = (uint32_t)seed;
+  if (!st) st = get_num(c, &e, "height_offset", 0, &p->height_offset);
+  if (!st) st = get_num(c, &e, "step_size", 0, &p->step_size);
+  if (!st) {
+    const char *bad = NULL;
+    double v = 0;
+    if (!(p->x_size > 0)) bad = "x_size", v = p->x_size;
+    else if (!(p->y_size > 0)) bad = "y_size", v = p->y_size;
+    else if (!(p->frequency >= 0)) bad = "frequency", v = p->frequency;
+    else if (!(p->fractal_lacunarity > 0))
+      bad = "fractal_lacunarity", v = p->fractal_lacunarity;
+    else if (!(p->fractal_gain >= 0)) bad = "fractal_gain", v = p->fractal_gain;
+    else if (!(p->step_size >= 0)) bad = "step_size", v = p->step_size;
+    if (bad)
+      st = fail(c, SS_ERR_VALUE, e.line,
+                "%s: %s = %g is invalid: must be %s", e.label, bad, v,
+                !strcmp(bad, "x_size") || !strcmp(bad, "y_size") ||
+                        !strcmp(bad, "fractal_lacunarity")
+                    ? "> 0"
+                    : ">= 0");
+  }
+  if (!st && (long)p->x_samples * (long)p->y_samples > MAX_VERTICES)
+    st = fail(c, SS_ERR_VALUE, e.line,
+              "%s: %d x %d samples exceed the limit of %ld vertices", e.label,
+              p->x_samples, p->y_samples, MAX_VERTICES);
+  el_free(&e);
+  return st;
+}
+
+/* <soil>: material (validated here, at its line) and optional state. */
+static ssStatus read_soil(readCtx *c, xmlNodePtr n, const char *label, int nx,
+                          int ny, ssSoilMaterial *mat, pendingSoil *ps)
+{
+  static const char *const fields[] = {
+    "bekker_kc", "bekker_kphi", "sinkage_exponent", "elastic_stiffness",
+    "damping", "cohesion", "friction_coefficient", "shear_displacement", NULL};
+  static const char *const allowed[] = {
+    "bekker_kc", "bekker_kphi", "sinkage_exponent", "elastic_stiffness",
+    "damping", "cohesion", "friction_coefficient", "shear_displacement",
+    "sinkage", "plastic_sinkage", "shear", NULL};
+  xEl e;
+  *mat = ss_soil_material_default();
+  double *dst[] = {&mat->bekker_kc, &mat->bekker_kphi, &mat->sinkage_exponent,
+                   &mat->elastic_stiffness, &mat->damping, &mat->cohesion,
+                   &mat->friction_coefficient, &mat->shear_displacement};
+  ssStatus st = open_leaf(c, n, label, allowed, &e);
+  for (int k = 0; !st && fields[k]; k++) st = get_num(c, &e, fields[k], 0, dst[k]);
+  if (!st) {
+    ssError e2;
+    if (ss_soil_material_validate(mat, &e2) != SS_OK)
+      st = fail(c, SS_ERR_VALUE, e.line, "%s: %s", label, e2.message);
+  }
+  char what[96];
+  long nv = (long)nx * ny;
+  snprintf(what, sizeof what, "nx*ny = %d*%d", nx, ny);
+  ps->line = e.line;
+  if (!st) st = get_array(c, &e, "sinkage", nv, what, 0, &ps->sinkage);
+  if (!st) st = get_array(c, &e, "plastic_sinkage", nv, what, 0, &ps->plastic);
+  if (!st) st = get_array(c, &e, "shear", nv, what, 0, &ps->shear);
+  el_free(&e);
+  return st;
+}
+
+static void pending_free(pendingSoil *p)
+{
+  free(p->sinkage);
+  free(p->plastic);
+  free(p->shear);
+  p->sinkage = p->plastic = p->shear = NULL;
+}
+
+enum { HF_EXPLICIT, HF_PNG, HF_TEXT, HF_GENERATED };
+
+static ssStatus read_heightmap(readCtx *c, xmlNodePtr n)
+{
+  static const char *const common[] = {"name", "center_x", "center_y",
+                                       "material", "pos", "quat", NULL};
+  static const char *const a_explicit[] = {
+    "name", "x_size", "y_size", "x_sample", "y_sample", "x_samples",
+    "y_samples", "center_x", "center_y", "height", "material", "pos", "quat",
+    NULL};
+  static const char *const a_png[] = {
+    "name", "png", "x_size", "y_size", "center_x", "center_y", "z_scale",
+    "z_offset", "material", "pos", "quat", NULL};
+  static const char *const a_text[] = {"name", "text", "x_size", "y_size",
+                                       "center_x", "center_y", "material",
+                                       "pos", "quat", NULL};
+  static const char *const kids_plain[] = {"soil", NULL};
+  static const char *const kids_gen[] = {"soil", "terrain_properties", NULL};
+
+  ssHfieldDef def = ss_hfield_def_default();
+  pendingSoil ps;
+  memset(&ps, 0, sizeof ps);
+  double *height = NULL;
+  xEl e;
+  ssStatus st = el_open(c, n, NULL, &e);
+  const char *name = NULL;
+
+  /* which form: exactly one of height, png, text, <terrain_properties> */
+  xmlNodePtr tp = NULL;
+  int ntp = 0;
+  for (xmlNodePtr k = n->children; k; k = k->next)
+    if (k->type == XML_ELEMENT_NODE) {
+      char kn[NAME_CAP];
+      norm_name((const char *)k->name, kn);
+      if (!strcmp(kn, "terrain_properties")) {
+        if (!tp) tp = k;
+        ntp++;
+      }
+    }
+  if (!st) {
+    /* the name first, so that later messages can use it */
+    const char *v = el_find(&e, "name");
+    if (v) snprintf(e.label, sizeof e.label, "heightmap '%s'", v);
+  }
+  int form = HF_EXPLICIT;
+  if (!st) {
+    const char *given[4];
+    int ng = 0;
+    if (el_find(&e, "height")) given[ng++] = "height";
+    if (el_find(&e, "png")) given[ng++] = "png", form = HF_PNG;
+    if (el_find(&e, "text")) given[ng++] = "text", form = HF_TEXT;
+    if (tp) given[ng++] = "<terrain_properties>", form = HF_GENERATED;
+    if (ng > 1)
+      st = fail(c, SS_ERR_PARSE, e.line,
+                "%s: give exactly one of height, png, text or "
+                "<terrain_properties> (found %s and %s)", e.label, given[0],
+                given[1]);
+  }
+  if (!st)
+    st = el_allow(c, &e, form == HF_EXPLICIT ? a_explicit
+                         : form == HF_PNG    ? a_png
+                         : form == HF_TEXT   ? a_text
+                                             : common);
+  if (!st) st = get_str(c, &e, "name", 1, &name);
+  def.name = name;
+  def.line = e.line;
+  if (!st) st = get_num(c, &e, "center_x", 0, &def.center_x);
+  if (!st) st = get_num(c, &e, "center_y", 0, &def.center_y);
+  if (!st) st = get_str(c, &e, "material", 0, &def.material);
+  if (!st) st = get_vec(c, &e, "pos", 3, 0, def.pos);
+  if (!st) st = get_vec(c, &e, "quat", 4, 0, def.quat);
+  if (!st && quat_is_zero(def.quat))
+    st = fail(c, SS_ERR_VALUE, e.line,
+              "%s: quat = %g %g %g %g has zero length (quaternions are w x y z)",
+              e.label, def.quat[0], def.quat[1], def.quat[2], def.quat[3]);
+  double quat_read[4];
+  memcpy(quat_read, def.quat, sizeof quat_read);
+  if (!st && form != HF_GENERATED) {
+    st = get_num(c, &e, "x_size", 1, &def.x_size);
+    if (!st) st = get_num(c, &e, "y_size", 1, &def.y_size);
+    if (!st && !(def.x_size > 0))
+      st = fail(c, SS_ERR_VALUE, e.line, "%s: x_size = %g is invalid: must be > 0",
+                e.label, def.x_size);
+    if (!st && !(def.y_size > 0))
+      st = fail(c, SS_ERR_VALUE, e.line, "%s: y_size = %g is invalid: must be > 0",
+                e.label, def.y_size);
+  }
+  if (!st && form == HF_EXPLICIT) {
+    def.source = SS_HFIELD_EXPLICIT;
+    long cnt[2] = {0, 0};
+    for (int k = 0; k < 2 && !st; k++) {
+      const char *used = NULL;
+      const char *v = get_alias(c, &e, k ? "y_sample" : "x_sample",
+                                k ? "y_samples" : "x_samples", &used, &st);
+      if (st) break;
+      if (!v) {
+        st = missing(c, &e, k ? "y_sample" : "x_sample");
+        break;
+      }
+      st = get_long(c, &e, used, 1, LONG_MIN, LONG_MAX, &cnt[k]);
+      if (!st && cnt[k] < 2)
+        st = fail(c, SS_ERR_VALUE, e.line,
+                  "%s: %s = %ld is invalid: need at least 2 samples along %c",
+                  e.label, used, cnt[k], k ? 'y' : 'x');
+      if (!st && cnt[k] > MAX_VERTICES / 2)
+        st = fail(c, SS_ERR_VALUE, e.line, "%s: %s = %ld is too large",
+                  e.label, used, cnt[k]);
+    }
+    if (!st && cnt[0] * cnt[1] > MAX_VERTICES)
+      st = fail(c, SS_ERR_VALUE, e.line,
+                "%s: %ld x %ld samples exceed the limit of %ld vertices",
+                e.label, cnt[0], cnt[1], MAX_VERTICES);
+    if (!st) {
+      def.nx = (int)cnt[0];
+      def.ny = (int)cnt[1];
+      st = get_array(c, &e, "height", cnt[0] * cnt[1], "x_sample*y_sample", 1,
+                     &height);
+    }
+  } else if (!st && (form == HF_PNG || form == HF_TEXT)) {
+    const char *attr = form == HF_PNG ? "png" : "text";
+    char path[1200];
+    double z_scale = 1, z_offset = 0;
+    if (form == HF_PNG) {
+      st = get_num(c, &e, "z_scale", 0, &z_scale);
+      if (!st) st = get_num(c, &e, "z_offset", 0, &z_offset);
+    }
+    if (!st) st = resolve_path(c, &e, attr, el_find(&e, attr), path, sizeof path);
+    if (!st) {
+      ssError e2;
+      memset(&e2, 0, sizeof e2);
+      ssStatus r = form == HF_PNG
+                       ? ss_hfield_read_png(path, z_scale, z_offset, &def.nx,
+                                            &def.ny, &height, &e2)
+                       : ss_hfield_read_text(path, &def.nx, &def.ny, &height,
+                                             &e2);
+      if (r != SS_OK) {
+        if (e2.line > 0)
+          st = fail(c, r, e.line, "%s: %s file '%s' line %d: %s", e.label,
+                    attr, path, e2.line, e2.message);
+        else
+          st = fail(c, r, e.line, "%s: cannot use %s file '%s': %s", e.label,
+                    attr, path, e2.message);
+      }
+      def.source = form == HF_PNG ? SS_HFIELD_PNG : SS_HFIELD_TEXT;
+    }
+  } else if (!st && form == HF_GENERATED) {
+    ssTerrainProps p;
+    if (ntp > 1) {
+      xEl tmp;
+      tmp.line = line_of(tp);
+      strcpy(tmp.name, "terrain_properties");
+      int seen = 0;
+      once(c, &seen, &tmp);
+      for (xmlNodePtr k = tp->next; k; k = k->next)
+        if (k->type == XML_ELEMENT_NODE) {
+          char kn[NAME_CAP];
+          norm_name((const char *)k->name, kn);
+          if (!strcmp(kn, "terrain_properties")) {
+            tmp.line = line_of(k);
+            st = once(c, &seen, &tmp);
+            break;
+          }
+        }
+    }
+    if (!st) st = read_terrain_props(c, tp, e.label, &p);
+    if (!st) {
+      def.nx = p.x_samples;
+      def.ny = p.y_samples;
+      def.x_size = p.x_size;
+      def.y_size = p.y_size;
+      def.source = SS_HFIELD_GENERATED;
+      height = malloc((size_t)def.nx * (size_t)def.ny * sizeof *height);
+      if (!height)
+        st = fail(c, SS_ERR_NOMEM, e.line, "%s: out of memory", e.label);
+      else
+        ss_terrain_generate(&p, height);
+    }
+  }
+  /* children: <soil>, and <terrain_properties> (read above) */
+  int seen_soil = 0;
+  for (xmlNodePtr k = n->children; !st && k; k = k->next) {
+    if (k->type != XML_ELEMENT_NODE) {
+      st = check_other_node(c, k, &e);
+      continue;
+    }
+    char kn[NAME_CAP];
+    norm_name((const char *)k->name, kn);
+    if (!strcmp(kn, "soil")) {
+      xEl tmp;
+      tmp.line = line_of(k);
+      strcpy(tmp.name, "soil");
+      st = once(c, &seen_soil, &tmp);
+      if (!st) st = read_soil(c, k, e.label, def.nx, def.ny, &def.soilmat, &ps);
+      def.soil = 1;
+    } else if (!(form == HF_GENERATED && !strcmp(kn, "terrain_properties"))) {
+      st = unknown_child(c, k, &e, form == HF_GENERATED ? kids_gen : kids_plain);
+    }
+  }
+  if (!st) {
+    def.height = height;
+    int h = ss_model_add_hfield(c->m, &def, &c->e);
+    if (h < 0) {
+      st = fix_error(c, e.line, NULL);
+    } else {
+      keep_unit_quat(c->m->hfield_quat0 + 4 * h, quat_read);
+      if (ps.sinkage || ps.plastic || ps.shear) {
+        pendingSoil *p = realloc(c->pend, (size_t)(c->npend + 1) * sizeof *p);
+        if (!p) {
+          st = fail(c, SS_ERR_NOMEM, e.line, "out of memory");
+        } else {
+          c->pend = p;
+          ps.hfield = h;
+          c->pend[c->npend++] = ps;
+          memset(&ps, 0, sizeof ps);
+        }
+      }
+    }
+  }
+  pending_free(&ps);
+  free(height);
+  el_free(&e);
+  return st;
+}
+
+static ssStatus read_objects(readCtx *c, xmlNodePtr n)
+{
+  static const char *const kids[] = {"ground", "box", "sphere", "cylinder",
+                                     "capsule", "heightmap", NULL};
+  static const char *const none[] = {NULL};
+  xEl e;
+  ssStatus st = el_open(c, n, NULL, &e);
+  if (!st) st = el_allow(c, &e, none);
+  for (xmlNodePtr k = n->children; !st && k; k = k->next) {
+    if (k->type != XML_ELEMENT_NODE) {
+      st = check_other_node(c, k, &e);
+      continue;
+    }
+    char kn[NAME_CAP];
+    norm_name((const char *)k->name, kn);
+    if (!strcmp(kn, "ground")) st = read_ground(c, k);
+    else if (!strcmp(kn, "box")) st = read_body(c, k, SS_GEOM_BOX);
+    else if (!strcmp(kn, "sphere")) st = read_body(c, k, SS_GEOM_SPHERE);
+    else if (!strcmp(kn, "cylinder")) st = read_body(c, k, SS_GEOM_CYLINDER);
+    else if (!strcmp(kn, "capsule")) st = read_body(c, k, SS_GEOM_CAPSULE);
+    else if (!strcmp(kn, "heightmap")) st = read_heightmap(c, k);
+    else if (!strcmp(kn, "articulated_system") || !strcmp(kn, "mesh")) {
+      xmlChar *nm = xmlGetProp(k, BAD_CAST "name");
+      st = fail(c, SS_ERR_UNSUPPORTED, line_of(k),
+                "<%s>%s%s%s is not supported yet (supported objects: ground, "
+                "box, sphere, cylinder, capsule, heightmap)", kn,
+                nm ? " '" : "", nm ? (const char *)nm : "", nm ? "'" : "");
+      if (nm) xmlFree(nm);
+    } else
+      st = unknown_child(c, k, &e, kids);
+  }
+  el_free(&e);
+  return st;
+}
+
+/* ---------------------------------------------------------------------- */
+/* materials, options, camera, clock                                       */
+
+static ssStatus read_material(readCtx *c, xmlNodePtr n)
+{
+  static const char *const kids[] = {"default", "pair_prop", NULL};
+  static const char *const a_def[] = {"friction", "restitution",
+                                      "restitution_threshold", NULL};
+  static const char *const a_pair[] = {"name1", "name2", "friction",
+                                       "restitution", "restitution_threshold",
+                                       NULL};
+  static const char *const none[] = {NULL};
+  xEl e;
+  int seen_default = 0;
+  ssStatus st = el_open(c, n, NULL, &e);
+  if (!st) st = el_allow(c, &e, none);
+  for (xmlNodePtr k = n->children; !st && k; k = k->next) {
+    if (k->type != XML_ELEMENT_NODE) {
+      st = check_other_node(c, k, &e);
+      continue;
+    }
+    char kn[NAME_CAP];
+    norm_name((const char *)k->name, kn);
+    xEl x;
+    if (!strcmp(kn, "default")) {
+      ssMaterialPair p = c->m->material_default;
+      st = open_leaf(c, k, "<material>", a_def, &x);
+      if (!st) st = once(c, &seen_default, &x);
+      if (!st) st = get_num(c, &x, "friction", 0, &p.friction);
+      if (!st) st = get_num(c, &x, "restitution", 0, &p.restitution);
+      if (!st)
+        st = get_num(c, &x, "restitution_threshold", 0, &p.restitution_threshold);
+      if (!st && ss_model_set_pair(c->m, NULL, NULL, p.friction, p.restitution,
+                                   p.restitution_threshold, &c->e) != SS_OK) {
+        c->e.line = 0;
+        st = fix_error(c, x.line, x.label);
+      }
+      el_free(&x);
+    } else if (!strcmp(kn, "pair_prop")) {
+      const char *n1 = NULL, *n2 = NULL;
+      double f = 0, r = 0, t = 0;
+      st = open_leaf(c, k, "<material>", a_pair, &x);
+      if (!st) st = get_str(c, &x, "name1", 1, &n1);
+      if (!st) st = get_str(c, &x, "name2", 1, &n2);
+      if (!st && (!*n1 || !*n2))
+        st = fail(c, SS_ERR_VALUE, x.line,
+                  "%s: name1 and name2 must be non-empty material names",
+                  x.label);
+      if (!st) st = get_num(c, &x, "friction", 1, &f);
+      if (!st) st = get_num(c, &x, "restitution", 0, &r);
+      if (!st) st = get_num(c, &x, "restitution_threshold", 0, &t);
+      if (!st && ss_model_set_pair(c->m, n1, n2, f, r, t, &c->e) != SS_OK) {
+        c->e.line = 0;
+        st = fix_error(c, x.line, x.label);
+      }
+      el_free(&x);
+    } else {
+      st = unknown_child(c, k, &e, kids);
+    }
+  }
+  el_free(&e);
+  return st;
+}
+
+static ssStatus read_time_step(readCtx *c, xEl *e)
+{
+  static const char *const allowed[] = {"value", NULL};
+  ssStatus st = el_allow(c, e, allowed);
+  if (!st) st = check_leaf(c, e);
+  double dt = 0;
+  if (!st) st = get_num(c, e, "value", 1, &dt);
+  if (!st && !(dt > 0 && dt <= 1))
+    st = fail(c, SS_ERR_VALUE, e->line,
+              "<time_step>: value = %g is invalid: must be in (0, 1] s", dt);
+  if (!st) c->m->opt.timestep = dt;
+  return st;
+}
+
+static ssStatus read_gravity(readCtx *c, xEl *e)
+{
+  static const char *const allowed[] = {"value", NULL};
+  ssStatus st = el_allow(c, e, allowed);
+  if (!st) st = check_leaf(c, e);
+  if (!st) st = get_vec(c, e, "value", 3, 1, c->m->opt.gravity);
+  return st;
+}
+
+static ssStatus read_contact_solver(readCtx *c, xEl *e)
+{
+  static const char *const allowed[] = {
+    "max_sweeps", "tolerance", "scalar_tolerance", "terrain_warm_start",
+    "contact_margin", "rigid_erp", NULL};
+  ssOption *o = &c->m->opt;
+  ssStatus st = el_allow(c, e, allowed);
+  if (!st) st = check_leaf(c, e);
+  if (!st) st = get_int(c, e, "max_sweeps", 0, 1, 1000000, &o->solver_max_sweeps);
+  if (!st) st = get_num(c, e, "tolerance", 0, &o->solver_tolerance);
+  if (!st) st = get_num(c, e, "scalar_tolerance", 0, &o->scalar_tolerance);
+  if (!st) st = get_bool(c, e, "terrain_warm_start", &o->terrain_warm_start);
+  if (!st) st = get_num(c, e, "contact_margin", 0, &o->contact_margin);
+  if (!st) st = get_num(c, e, "rigid_erp", 0, &o->rigid_erp);
+  if (!st) {
+    const char *bad = NULL, *rule = NULL;
+    double v = 0;
+    if (!(o->solver_tolerance > 0 && o->solver_tolerance < 1))
+      bad = "tolerance", v = o->solver_tolerance, rule = "in (0, 1)";
+    else if (!(o->scalar_tolerance > 0 && o->scalar_tolerance < 1))
+      bad = "scalar_tolerance", v = o->scalar_tolerance, rule = "in (0, 1)";
+    else if (!(o->contact_margin >= 0))
+      bad = "contact_margin", v = o->contact_margin, rule = ">= 0 m";
+    else if (!(o->rigid_erp >= 0 && o->rigid_erp <= 1))
+      bad = "rigid_erp", v = o->rigid_erp, rule = "in [0, 1]";
+    if (bad)
+      st = fail(c, SS_ERR_VALUE, e->line, "<contact_solver>: %s = %g is "
+                "invalid: must be %s", bad, v, rule);
+  }
+  return st;
+}
+
+static ssStatus read_clock(readCtx *c, xEl *e)
+{
+  static const char *const allowed[] = {"time", "step", NULL};
+  ssStatus st = el_allow(c, e, allowed);
+  if (!st) st = check_leaf(c, e);
+  if (!st) st = get_num(c, e, "time", 0, &c->clock_time);
+  if (!st) st = get_long(c, e, "step", 0, 0, LONG_MAX, &c->clock_step);
+  if (!st && !(c->clock_time >= 0))
+    st = fail(c, SS_ERR_VALUE, e->line,
+              "<clock>: time = %g is invalid: must be >= 0 s", c->clock_time);
+  c->clock_given = 1;
+  return st;
+}
+
+static ssStatus read_camera(readCtx *c, xEl *e)
+{
+  static const char *const allowed[] = {"pos", "look_at", "fov_deg", "follow",
+                                        NULL};
+  ssModel *m = c->m;
+  const char *follow = NULL;
+  ssStatus st = el_allow(c, e, allowed);
+  if (!st) st = check_leaf(c, e);
+  if (!st) st = get_vec(c, e, "pos", 3, 1, m->camera_pos);
+  if (!st) st = get_vec(c, e, "look_at", 3, 1, m->camera_look_at);
+  if (!st) st = get_num(c, e, "fov_deg", 0, &m->camera_fov_deg);
+  if (!st && !(m->camera_fov_deg > 0 && m->camera_fov_deg < 180))
+    st = fail(c, SS_ERR_VALUE, e->line,
+              "<camera>: fov_deg = %g is invalid: must be in (0, 180)",
+              m->camera_fov_deg);
+  if (!st) st = get_str(c, e, "follow", 0, &follow);
+  if (!st && follow) {
+    if (strlen(follow) >= sizeof m->camera_follow)
+      st = fail(c, SS_ERR_VALUE, e->line, "<camera>: follow name is too long");
+    else
+      snprintf(m->camera_follow, sizeof m->camera_follow, "%s", follow);
+  }
+  m->camera_given = 1;
+  c->camera_line = e->line;
+  return st;
+}
+
+static ssStatus read_root(readCtx *c, xmlNodePtr root)
+{
+  static const char *const kids[] = {"time_step", "gravity", "contact_solver",
+                                     "clock", "camera", "objects", "material",
+                                     NULL};
+  static const char *const allowed[] = {"version", NULL};
+  xEl e;
+  ssStatus st = el_open(c, root, NULL, &e);
+  if (!st && strcmp(e.name, "raisim"))
+    st = fail(c, SS_ERR_PARSE, e.line,
+              "root element is <%s>, expected <raisim>", e.raw);
+  if (!st) st = el_allow(c, &e, allowed);
+  int seen[7] = {0};
+  for (xmlNodePtr k = root->children; !st && k; k = k->next) {
+    if (k->type != XML_ELEMENT_NODE) {
+      st = check_other_node(c, k, &e);
+      continue;
+    }
+    char kn[NAME_CAP];
+    norm_name((const char *)k->name, kn);
+    int which = -1;
+    for (int i = 0; kids[i]; i++)
+      if (!strcmp(kn, kids[i])) which = i;
+    if (which < 0) {
+      st = unknown_child(c, k, &e, kids);
+      break;
+    }
+    xEl x;
+    st = el_open(c, k, NULL, &x);
+    if (!st) st = once(c, &seen[which], &x);
+    if (!st) {
+      switch (which) {
+      case 0: st = read_time_step(c, &x); break;
+      case 1: st = read_gravity(c, &x); break;
+      case 2: st = read_contact_solver(c, &x); break;
+      case 3: st = read_clock(c, &x); break;
+      case 4: st = read_camera(c, &x); break;
+      case 5: st = read_objects(c, k); break;
+      case 6: st = read_material(c, k); break;
+      }
+    }
+    el_free(&x);
+  }
+  /* the camera may follow a body defined anywhere in the file */
+  if (!st && c->m->camera_given && c->m->camera_follow[0] &&
+      ss_model_find_sys(c->m, c->m->camera_follow) < 0)
+    st = fail(c, SS_ERR_NOTFOUND, c->camera_line,
+              "<camera>: follow = '%s' names no body in the scene",
+              c->m->camera_follow);
+  el_free(&e);
+  return st;
+}
+
+/* ---------------------------------------------------------------------- */
+/* libxml2: safe parsing                                                   */
+
+typedef struct xmlGuard {
+  startElementNsSAX2Func start; /* libxml2's tree builder */
+  int doctype_line;  /* > 0: a DOCTYPE was met (parsing stopped there) */
+  int entity_refused;
+  int have_error;
+  int error_line;
+  char error_msg[400];
+} xmlGuard;
+
+static xmlGuard *guard_of(void *ctx)
+{
+  xmlParserCtxtPtr p = (xmlParserCtxtPtr)ctx;
+  return p ? (xmlGuard *)p->_private : NULL;
+}
+
+/* Structured error handler: keep the first error, print nothing. */
+static void on_xml_error(void *data, xmlErrorPtr err)
+{
+  xmlGuard *g = (xmlGuard *)data;
+  if (!g || !err || err->level < XML_ERR_ERROR || g->have_error) return;
+  g->have_error = 1;
+  g->error_line = err->line;
+  snprintf(g->error_msg, sizeof g->error_msg, "%s",
+           err->message ? err->message : "malformed XML");
+  size_t n = strlen(g->error_msg);
+  while (n > 0 && (g->error_msg[n - 1] == '\n' || g->error_msg[n - 1] == ' '))
+    g->error_msg[--n] = 0;
+}
+
+static void on_generic_error(void *data, const char *msg, ...)
+{
+  (void)data;
+  (void)msg;
+}
+
+/* Any DOCTYPE stops the parser before its internal subset is read. */
+static void on_internal_subset(void *ctx, const xmlChar *name,
+                               const xmlChar *external_id,
+                               const xmlChar *system_id)
+{
+  (void)name;
+  (void)external_id;
+  (void)system_id;
+  xmlParserCtxtPtr p = (xmlParserCtxtPtr)ctx;
+  xmlGuard *g = guard_of(ctx);
+  if (g && !g->doctype_line)
+    g->doctype_line = p && p->input && p->input->line > 0 ? p->input->line : 1;
+  xmlStopParser(p);
+}
+
+/* Build the element as usual, then record the line of its '<' in the
+ * node's application pointer.  The parser is at the end of the start tag;
+ * a start tag holds no other '<' (attribute values cannot), so the tag
+ * begins at the last '<' before the current position. */
+static void on_start_element(void *ctx, const xmlChar *localname,
+                             const xmlChar *prefix, const xmlChar *uri,
+                             int nb_namespaces, const xmlChar **namespaces,
+                             int nb_attributes, int nb_defaulted,
+                             const xmlChar **attributes)
+{
+  xmlParserCtxtPtr p = (xmlParserCtxtPtr)ctx;
+  xmlGuard *g = guard_of(ctx);
+  if (!g || !g->start) return;
+  g->start(ctx, localname, prefix, uri, nb_namespaces, namespaces,
+           nb_attributes, nb_defaulted, attributes);
+  xmlNodePtr node = p->node;
+  xmlParserInputPtr in = p->input;
+  if (!node || !in || !in->cur || !in->base || in->line <= 0) return;
+  const xmlChar *q = in->cur;
+  int nl = 0;
+  while (q > in->base && q[-1] != '<') {
+    q--;
+    if (*q == '\n') nl++;
+  }
+  int line = q > in->base && in->line - nl > 0 ? in->line - nl : in->line;
+  node->_private = (void *)(intptr_t)line;
+}
+
+/* Deny-by-default external entity loader: nothing is ever fetched. */
+static xmlParserInputPtr deny_entity_loader(const char *url, const char *id,
+                                            xmlParserCtxtPtr ctxt)
+{
+  (void)url;
+  (void)id;
+  xmlGuard *g = guard_of(ctxt);
+  if (g) g->entity_refused = 1;
+  return NULL;
+}
+
+static ssStatus parse_xml(readCtx *c, const char *buf, size_t len,
+                          xmlDocPtr *out)
+{
+  *out = NULL;
+  if (len == 0)
+    return fail(c, SS_ERR_PARSE, 1, "empty scene: expected a <raisim> element");
+  if (len > (size_t)SS_SCENE_MAX_BYTES)
+    return fail(c, SS_ERR_IO, 0, "scene is %zu bytes, larger than the limit "
+                "of %ld", len, (long)SS_SCENE_MAX_BYTES);
+  xmlInitParser();
+  xmlGuard g;
+  memset(&g, 0, sizeof g);
+
+  /* libxml2's handlers are global: install ours for this parse only */
+  xmlStructuredErrorFunc old_serror = xmlStructuredError;
+  void *old_sctx = xmlStructuredErrorContext;
+  xmlGenericErrorFunc old_gerror = xmlGenericError;
+  void *old_gctx = xmlGenericErrorContext;
+  xmlExternalEntityLoader old_loader = xmlGetExternalEntityLoader();
+  xmlSetStructuredErrorFunc(&g, on_xml_error);
+  xmlSetGenericErrorFunc(NULL, on_generic_error);
+  xmlSetExternalEntityLoader(deny_entity_loader);
+
+  ssStatus st = SS_OK;
+  xmlParserCtxtPtr p = xmlCreateMemoryParserCtxt(buf, (int)len);
+  if (!p) {
+    st = fail(c, SS_ERR_NOMEM, 0, "out of memory starting the XML parser");
+  } else {
+    p->_private = &g;
+    if (p->sax) {
+      p->sax->internalSubset = on_internal_subset;
+      g.start = p->sax->startElementNs;
+      if (g.start) p->sax->startElementNs = on_start_element;
+    }
+    /* never XML_PARSE_NOENT, XML_PARSE_DTDLOAD, XML_PARSE_DTDATTR or
+     * XML_PARSE_XINCLUDE; HUGE: see scene.h */
+    xmlCtxtUseOptions(p, XML_PARSE_NONET | XML_PARSE_HUGE |
+                             XML_PARSE_BIG_LINES);
+    xmlParseDocument(p);
+    xmlDocPtr doc = p->myDoc;
+    p->myDoc = NULL;
+    if (g.doctype_line) {
+      st = fail(c, SS_ERR_PARSE, g.doctype_line,
+                "DOCTYPE declarations are not allowed in scene files (no DTDs, "
+                "no entities)");
+    } else if (!p->wellFormed || !doc) {
+      if (g.have_error) {
+        st = fail(c, SS_ERR_PARSE, g.error_line, "XML syntax error: %s",
+                  g.error_msg);
+      } else {
+        xmlErrorPtr le = xmlCtxtGetLastError(p);
+        st = fail(c, SS_ERR_PARSE, le ? le->line : 0, "XML syntax error: %s",
+                  le && le->message ? le->message : "malformed document");
+        size_t n = strlen(c->e.message);
+        while (n > 0 && c->e.message[n - 1] == '\n') c->e.message[--n] = 0;
+      }
+    } else if (doc->intSubset || doc->extSubset || g.entity_refused) {
+      st = fail(c, SS_ERR_PARSE, 1,
+                "DOCTYPE declarations are not allowed in scene files (no DTDs, "
+                "no entities)");
+    } else if (!xmlDocGetRootElement(doc)) {
+      st = fail(c, SS_ERR_PARSE, 1, "no root element: expected <raisim>");
+    }
+    if (st != SS_OK) {
+      if (doc) xmlFreeDoc(doc);
+    } else {
+      *out = doc;
+    }
+    xmlFreeParserCtxt(p);
+  }
+
+  xmlSetExternalEntityLoader(old_loader);
+  xmlSetGenericErrorFunc(old_gctx, old_gerror);
+  xmlSetStructuredErrorFunc(old_sctx, old_serror);
+  return st;
+}
+
+/* ---------------------------------------------------------------------- */
+/* entry points                                                            */
+
+static void this_dir(const char *path, char *dir, size_t cap)
+{
+  const char *slash = path ? strrchr(path, '/') : NULL;
+  if (!slash)
+    snprintf(dir, cap, ".");
+  else if (slash == path)
+    snprintf(dir, cap, "/");
+  else
+    snprintf(dir, cap, "%.*s", (int)(slash - path), path);
+}
+
+static void ctx_free(readCtx *c)
+{
+  for (int i = 0; i < c->npend; i++) pending_free(&c->pend[i]);
+  free(c->pend);
+  c->pend = NULL;
+  c->npend = 0;
+}
+
+static ssStatus load(const char *buf, size_t len, const char *path,
+                     ssModel **mout, ssData **dout, ssError *err)
+{
+  readCtx c;
+  memset(&c, 0, sizeof c);
+  c.path = path;
+  this_dir(path, c.dir, sizeof c.dir);
+
+  ssCLocale loc;
+  if (ss_scene_c_locale_push(&loc) != 0) {
+    struct lconv *lc = localeconv();
+    if (!lc || !lc->decimal_point || strcmp(lc->decimal_point, "."))
+      return ss_error_set(err, SS_ERR_STATE, path, 0,
+                          "cannot switch to the C locale to read numbers");
+  }
+
+  ssData *d = NULL;
+  ssStatus st = parse_xml(&c, buf, len, &c.doc);
+  if (!st) {
+    c.m = ss_model_new();
+    if (!c.m) st = fail(&c, SS_ERR_NOMEM, 0, "out of memory");
+  }
+  if (!st) {
+    snprintf(c.m->source_path, sizeof c.m->source_path, "%s", path);
+    st = read_root(&c, xmlDocGetRootElement(c.doc));
+  }
+  if (!st && ss_model_validate(c.m, &c.e) != SS_OK) st = fix_error(&c, 0, NULL);
+  if (!st) {
+    d = ss_data_new(c.m);
+    if (!d) st = fail(&c, SS_ERR_NOMEM, 0, "out of memory");
+  }
+  for (int i = 0; !st && i < c.npend; i++) {
+    pendingSoil *p = &c.pend[i];
+    ssError e2;
+    if (ss_soil_set_state(c.m, d, p->hfield, p->sinkage, p->plastic, p->shear,
+                          &e2) != SS_OK)
+      st = fail(&c, e2.code, p->line, "heightmap '%s': %s",
+                c.m->hfield_name[p->hfield], e2.message);
+  }
+  if (!st && c.clock_given) {
+    d->time = c.clock_time;
+    d->step = c.clock_step;
+  }
+  if (c.doc) xmlFreeDoc(c.doc);
+  ctx_free(&c);
+  ss_scene_c_locale_pop(&loc);
+  if (st) {
+    ss_data_free(d);
+    ss_model_free(c.m);
+    if (err) *err = c.e;
+    return st;
+  }
+  *mout = c.m;
+  *dout = d;
+  return SS_OK;
+}
+
+ssStatus ss_scene_load_buffer(const char *buf, size_t len,
+                              const char *base_path, ssModel **mout,
+                              ssData **dout, ssError *err)
+{
+  if (!mout || !dout)
+    return ss_error_set(err, SS_ERR_VALUE, base_path, 0,
+                        "ss_scene_load_buffer: NULL output argument");
+  *mout = NULL;
+  *dout = NULL;
+  if (!buf && len)
+    return ss_error_set(err, SS_ERR_VALUE, base_path, 0,
+                        "ss_scene_load_buffer: NULL buffer");
+  return load(buf ? buf : "", len, base_path ? base_path : "(buffer)", mout,
+              dout, err);
+}
+
+ssStatus ss_scene_load(const char *path, ssModel **mout, ssData **dout,
+                       ssError *err)
+{
+  if (!mout || !dout)
+    return ss_error_set(err, SS_ERR_VALUE, path, 0,
+                        "ss_scene_load: NULL output argument");
+  *mout = NULL;
+  *dout = NULL;
+  char *buf = NULL;
+  size_t len = 0;
+  ssStatus st = ss_read_file(path, SS_SCENE_MAX_BYTES, &buf, &len, err);
+  if (st != SS_OK) return st;
+  st = load(buf, len, path, mout, dout, err);
+  free(buf);
+  return st;
+}

@@ -1,0 +1,458 @@
+/* scene_write.c -- the whole world (model + current state) as world XML.
+ *
+ * The output is the snake_case form of the format in scene.h, with every
+ * height map in the explicit form and soil beds carrying their material and
+ * state arrays, so that loading an export restores the world exactly and
+ * exporting it again gives the same bytes.  Each double is written so that
+ * it reads back to the same double (see fmt_double: as exact as "%.17g",
+ * but 9.81 stays "9.81").  The text goes
+ * through one buffer straight to the file (no per-number library calls
+ * besides the formatting), and the file is replaced atomically. */
+#include "scene.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct wBuf {
+  FILE *fp;
+  int bad;
+  size_t n;
+  char b[1 << 16];
+} wBuf;
+
+static void w_flush(wBuf *w)
+{
+  if (w->n && !w->bad && fwrite(w->b, 1, w->n, w->fp) != w->n) w->bad = 1;
+  w->n = 0;
+}
+
+static void w_put(wBuf *w, const char *s, size_t n)
+{
+  if (n > sizeof w->b - w->n) {
+    w_flush(w);
+    if (n > sizeof w->b) {
+      if (!w->bad && fwrite(s, 1, n, w->fp) != n) w->bad = 1;
+      return;
+    }
+  }
+  memcpy(w->b + w->n, s, n);
+  w->n += n;
+}
+
+static void w_s(wBuf *w, const char *s) { w_put(w, s, strlen(s)); }
+
+/* Exact and short: "%.17g" always reads back to the same double; when that
+ * has 17 significant digits and the last two are within 12 of a multiple
+ * of 100 (every double that is the nearest one to a 15-digit decimal
+ * prints that way: half an ulp is at most 11.1 units of the 17th digit),
+ * "%.15g" and then "%.16g" are tried and kept if they read back exactly.
+ * So 9.81 is written "9.81", not "9.8100000000000005", while a typical
+ * simulated value costs one format.  The result depends on the value
+ * alone, so a loaded export writes the same bytes again.  Needs the C
+ * locale.  Returns the length. */
+static int fmt_double(char out[40], double v)
+{
+  if (v == 0) {
+    strcpy(out, signbit(v) ? "-0" : "0");
+    return signbit(v) ? 2 : 1;
+  }
+  int n = snprintf(out, 40, "%.17g", v);
+  /* significant digits 16 and 17 */
+  int nd = 0, tail = 0;
+  for (const char *p = out; *p && *p != 'e'; p++) {
+    if (*p < '0' || *p > '9') continue;
+    if (nd == 0 && *p == '0') continue;
+    nd++;
+    if (nd >= 16) tail = tail * 10 + (*p - '0');
+  }
+  if (nd < 17 || (tail > 12 && tail < 88)) return n;
+  char t[40];
+  for (int prec = 15; prec <= 16; prec++) {
+    int m = snprintf(t, sizeof t, "%.*g", prec, v);
+    if (strtod(t, NULL) == v) {
+      memcpy(out, t, (size_t)m + 1);
+      return m;
+    }
+  }
+  return n;
+}
+
+static void w_num(wBuf *w, double v)
+{
+  char t[40];
+  int n = fmt_double(t, v);
+  w_put(w, t, (size_t)n);
+}
+
+static void w_long(wBuf *w, long v)
+{
+  char t[32];
+  int n = snprintf(t, sizeof t, "%ld", v);
+  w_put(w, t, (size_t)n);
+}
+
+/* Attribute text: markup characters and the white space that attribute
+ * normalisation would change are escaped. */
+static void w_esc(wBuf *w, const char *s)
+{
+  for (; *s; s++) {
+    switch (*s) {
+    case '&': w_s(w, "&amp;"); break;
+    case '<': w_s(w, "&lt;"); break;
+    case '>': w_s(w, "&gt;"); break;
+    case '"': w_s(w, "&quot;"); break;
+    case '\t': w_s(w, "&#9;"); break;
+    case '\n': w_s(w, "&#10;"); break;
+    case '\r': w_s(w, "&#13;"); break;
+    default: w_put(w, s, 1);
+    }
+  }
+}
+
+/* XML 1.0 cannot carry other control characters, even escaped. */
+static int name_ok(const char *s)
+{
+  for (; *s; s++) {
+    unsigned char ch = (unsigned char)*s;
+    if (ch < 0x20 && ch != '\t' && ch != '\n' && ch != '\r') return 0;
+  }
+  return 1;
+}
+
+static void a_str(wBuf *w, const char *name, const char *v)
+{
+  w_s(w, " ");
+  w_s(w, name);
+  w_s(w, "=\"");
+  w_esc(w, v);
+  w_s(w, "\"");
+}
+
+static void a_vec(wBuf *w, const char *name, const double *v, int n)
+{
+  w_s(w, " ");
+  w_s(w, name);
+  w_s(w, "=\"");
+  for (int k = 0; k < n; k++) {
+    if (k) w_s(w, " ");
+    w_num(w, v[k]);
+  }
+  w_s(w, "\"");
+}
+
+static void a_num(wBuf *w, const char *name, double v) { a_vec(w, name, &v, 1); }
+
+static void a_long(wBuf *w, const char *name, long v)
+{
+  w_s(w, " ");
+  w_s(w, name);
+  w_s(w, "=\"");
+  w_long(w, v);
+  w_s(w, "\"");
+}
+
+/* A grid array: one row of nx values per line. */
+static void a_grid(wBuf *w, const char *indent, const char *name,
+                   const double *v, int nx, int ny)
+{
+  w_s(w, "\n");
+  w_s(w, indent);
+  w_s(w, name);
+  w_s(w, "=\"");
+  for (int j = 0; j < ny; j++) {
+    if (j) {
+      w_s(w, "\n");
+      w_s(w, indent);
+      w_s(w, "  ");
+    }
+    const double *row = v + (size_t)j * nx;
+    for (int i = 0; i < nx; i++) {
+      if (i) w_s(w, " ");
+      w_num(w, row[i]);
+    }
+  }
+  w_s(w, "\"");
+}
+
+static const char *mat_name(const ssModel *m, int k)
+{
+  return k >= 0 && k < m->nmaterial ? m->material_name[k] : "default";
+}
+
+static void write_body(wBuf *w, const ssModel *m, const ssData *d, int s,
+                       int g)
+{
+  static const char *const tag[] = {"box", "sphere", "cylinder", "capsule"};
+  int b = m->sys_bodyadr[s];
+  int is_static = m->sys_type[s] == SS_SYS_STATIC;
+  const char *t = tag[m->geom_type[g]];
+  const double *sz = m->geom_size + 3 * g;
+  const double *q = d->qpos + m->sys_qadr[s];
+
+  w_s(w, "    <");
+  w_s(w, t);
+  a_str(w, "name", m->sys_name[s]);
+  if (is_static)
+    a_str(w, "body_type", "static");
+  else
+    a_num(w, "mass", m->body_mass[b]);
+  a_str(w, "material", mat_name(m, m->geom_material[g]));
+  a_vec(w, "rgba", m->geom_rgba + 4 * g, 4);
+  w_s(w, ">\n      <dim");
+  switch (m->geom_type[g]) {
+  case SS_GEOM_BOX:
+    a_num(w, "x", sz[0]);
+    a_num(w, "y", sz[1]);
+    a_num(w, "z", sz[2]);
+    break;
+  case SS_GEOM_SPHERE:
+    a_num(w, "radius", sz[0]);
+    break;
+  default:
+    a_num(w, "radius", sz[0]);
+    a_num(w, "height", sz[1]);
+    break;
+  }
+  w_s(w, "/>\n      <state");
+  a_vec(w, "pos", q, 3);
+  a_vec(w, "quat", q + 3, 4);
+  if (!is_static) {
+    const double *v = d->qvel + m->sys_vadr[s];
+    a_vec(w, "lin_vel", v, 3);
+    a_vec(w, "ang_vel", v + 3, 3);
+  }
+  w_s(w, "/>\n");
+  if (m->body_inertia_given[b]) {
+    const double *I = m->body_inertia + 9 * b;
+    w_s(w, "      <inertia");
+    a_num(w, "xx", I[0]);
+    a_num(w, "xy", I[1]);
+    a_num(w, "xz", I[2]);
+    a_num(w, "yy", I[4]);
+    a_num(w, "yz", I[5]);
+    a_num(w, "zz", I[8]);
+    w_s(w, "/>\n");
+  }
+  for (int k = 0; k < m->nxforce; k++) {
+    if (m->xforce_body[k] != b) continue;
+    w_s(w, "      <external_force");
+    a_vec(w, "force", m->xforce_force + 3 * k, 3);
+    a_vec(w, "torque", m->xforce_torque + 3 * k, 3);
+    a_num(w, "start", m->xforce_time[2 * k]);
+    if (isfinite(m->xforce_time[2 * k + 1]))
+      a_num(w, "end", m->xforce_time[2 * k + 1]);
+    w_s(w, "/>\n");
+  }
+  w_s(w, "    </");
+  w_s(w, t);
+  w_s(w, ">\n");
+}
+
+static void write_hfield(wBuf *w, const ssModel *m, const ssData *d, int h)
+{
+  static const char ind[] = "               ";
+  int nx = m->hfield_nx[h], ny = m->hfield_ny[h], a = m->hfield_adr[h];
+  w_s(w, "    <heightmap");
+  a_str(w, "name", m->hfield_name[h]);
+  a_num(w, "x_size", m->hfield_size[2 * h]);
+  a_num(w, "y_size", m->hfield_size[2 * h + 1]);
+  a_long(w, "x_sample", nx);
+  a_long(w, "y_sample", ny);
+  a_num(w, "center_x", m->hfield_center[2 * h]);
+  a_num(w, "center_y", m->hfield_center[2 * h + 1]);
+  a_vec(w, "pos", d->hfield_pos + 3 * h, 3);
+  a_vec(w, "quat", d->hfield_quat + 4 * h, 4);
+  a_str(w, "material", mat_name(m, m->hfield_material[h]));
+  a_grid(w, ind, "height", m->hfield_data + a, nx, ny);
+  if (!m->hfield_soil[h]) {
+    w_s(w, "/>\n");
+    return;
+  }
+  const ssSoilMaterial *s = &m->hfield_soilmat[h];
+  static const char sind[] = "            ";
+  w_s(w, ">\n      <soil");
+  a_num(w, "bekker_kc", s->bekker_kc);
+  a_num(w, "bekker_kphi", s->bekker_kphi);
+  a_num(w, "sinkage_exponent", s->sinkage_exponent);
+  a_num(w, "elastic_stiffness", s->elastic_stiffness);
+  w_s(w, "\n");
+  w_s(w, sind);
+  a_num(w, "damping", s->damping);
+  a_num(w, "cohesion", s->cohesion);
+  a_num(w, "friction_coefficient", s->friction_coefficient);
+  a_num(w, "shear_displacement", s->shear_displacement);
+  a_grid(w, sind, "sinkage", d->soil_sinkage + a, nx, ny);
+  a_grid(w, sind, "plastic_sinkage", d->soil_plastic + a, nx, ny);
+  a_grid(w, sind, "shear", d->soil_shear + a, nx, ny);
+  w_s(w, "/>\n    </heightmap>\n");
+}
+
+static void write_world(wBuf *w, const ssModel *m, const ssData *d)
+{
+  const ssOption *o = &m->opt;
+  w_s(w, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+         "<!-- soilsim " SS_VERSION " world export -->\n"
+         "<raisim version=\"1.0\">\n");
+  w_s(w, "  <time_step");
+  a_num(w, "value", o->timestep);
+  w_s(w, "/>\n  <gravity");
+  a_vec(w, "value", o->gravity, 3);
+  w_s(w, "/>\n  <contact_solver");
+  a_long(w, "max_sweeps", o->solver_max_sweeps);
+  a_num(w, "tolerance", o->solver_tolerance);
+  a_num(w, "scalar_tolerance", o->scalar_tolerance);
+  a_str(w, "terrain_warm_start", o->terrain_warm_start ? "true" : "false");
+  a_num(w, "contact_margin", o->contact_margin);
+  a_num(w, "rigid_erp", o->rigid_erp);
+  w_s(w, "/>\n  <clock");
+  a_num(w, "time", d->time);
+  a_long(w, "step", d->step);
+  w_s(w, "/>\n");
+  if (m->camera_given) {
+    w_s(w, "  <camera");
+    a_vec(w, "pos", m->camera_pos, 3);
+    a_vec(w, "look_at", m->camera_look_at, 3);
+    a_num(w, "fov_deg", m->camera_fov_deg);
+    /* a removed body is not written, so the camera cannot follow it */
+    int f = m->camera_follow[0] ? ss_model_find_sys(m, m->camera_follow) : -1;
+    if (f >= 0 && d->sys_active[f]) a_str(w, "follow", m->camera_follow);
+    w_s(w, "/>\n");
+  }
+
+  w_s(w, "  <objects>\n");
+  for (int p = 0; p < m->nplane; p++) {
+    w_s(w, "    <ground");
+    a_str(w, "name", m->plane_name[p]);
+    a_num(w, "height", m->plane_height[p]);
+    a_str(w, "material", mat_name(m, m->plane_material[p]));
+    w_s(w, "/>\n");
+  }
+  for (int s = 0; s < m->nsys; s++) {
+    if (!d->sys_active[s]) continue;
+    int b = m->sys_bodyadr[s];
+    for (int g = 0; g < m->ngeom; g++)
+      if (m->geom_body[g] == b) {
+        write_body(w, m, d, s, g);
+        break;
+      }
+  }
+  for (int h = 0; h < m->nhfield; h++) write_hfield(w, m, d, h);
+  w_s(w, "  </objects>\n");
+
+  w_s(w, "  <material>\n    <default");
+  a_num(w, "friction", m->material_default.friction);
+  a_num(w, "restitution", m->material_default.restitution);
+  a_num(w, "restitution_threshold", m->material_default.restitution_threshold);
+  w_s(w, "/>\n");
+  for (int k = 0; k < m->npair; k++) {
+    const ssMaterialPair *p = &m->pair[k];
+    w_s(w, "    <pair_prop");
+    a_str(w, "name1", mat_name(m, p->mat1));
+    a_str(w, "name2", mat_name(m, p->mat2));
+    a_num(w, "friction", p->friction);
+    a_num(w, "restitution", p->restitution);
+    a_num(w, "restitution_threshold", p->restitution_threshold);
+    w_s(w, "/>\n");
+  }
+  w_s(w, "  </material>\n</raisim>\n");
+}
+
+/* What the format cannot (yet) express. */
+static ssStatus check_exportable(const ssModel *m, const ssData *d,
+                                 const char *path, ssError *err)
+{
+  if (d->in_step)
+    return ss_error_set(err, SS_ERR_STATE, path, 0,
+                        "cannot export in the middle of a step");
+  for (int s = 0; s < m->nsys; s++) {
+    if (!d->sys_active[s]) continue;
+    if (m->sys_type[s] == SS_SYS_ARTICULATED || m->sys_nbody[s] != 1)
+      return ss_error_set(err, SS_ERR_UNSUPPORTED, path, 0,
+                          "cannot export '%s': articulated systems are not "
+                          "supported yet", m->sys_name[s]);
+    int b = m->sys_bodyadr[s], ng = 0;
+    for (int g = 0; g < m->ngeom; g++)
+      if (m->geom_body[g] == b) {
+        ng++;
+        if (m->geom_type[g] < SS_GEOM_BOX || m->geom_type[g] > SS_GEOM_CAPSULE)
+          return ss_error_set(err, SS_ERR_UNSUPPORTED, path, 0,
+                              "cannot export '%s': mesh bodies are not "
+                              "supported yet", m->sys_name[s]);
+      }
+    if (ng != 1)
+      return ss_error_set(err, SS_ERR_UNSUPPORTED, path, 0,
+                          "cannot export '%s': a single body needs exactly one "
+                          "collider (it has %d)", m->sys_name[s], ng);
+    if (!name_ok(m->sys_name[s]))
+      return ss_error_set(err, SS_ERR_VALUE, path, 0,
+                          "cannot export body %d: its name has control "
+                          "characters", s);
+  }
+  for (int p = 0; p < m->nplane; p++)
+    if (!name_ok(m->plane_name[p]))
+      return ss_error_set(err, SS_ERR_VALUE, path, 0,
+                          "cannot export ground %d: its name has control "
+                          "characters", p);
+  for (int h = 0; h < m->nhfield; h++)
+    if (!name_ok(m->hfield_name[h]))
+      return ss_error_set(err, SS_ERR_VALUE, path, 0,
+                          "cannot export height map %d: its name has control "
+                          "characters", h);
+  for (int k = 0; k < m->nmaterial; k++)
+    if (!name_ok(m->material_name[k]))
+      return ss_error_set(err, SS_ERR_VALUE, path, 0,
+                          "cannot export material %d: its name has control "
+                          "characters", k);
+  if (m->camera_given && !name_ok(m->camera_follow))
+    return ss_error_set(err, SS_ERR_VALUE, path, 0,
+                        "cannot export the camera: its follow name has "
+                        "control characters");
+  return SS_OK;
+}
+
+ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
+                         ssError *err)
+{
+  if (!m || !d || !path)
+    return ss_error_set(err, SS_ERR_VALUE, path ? path : "", 0,
+                        "ss_scene_export: NULL argument");
+  if (d->model && d->model != m)
+    return ss_error_set(err, SS_ERR_VALUE, path, 0,
+                        "ss_scene_export: the data belongs to another model");
+  ssStatus st = check_exportable(m, d, path, err);
+  if (st != SS_OK) return st;
+
+  wBuf *w = malloc(sizeof *w);
+  if (!w) return ss_error_set(err, SS_ERR_NOMEM, path, 0, "out of memory");
+  ssAtomicFile f;
+  st = ss_atomic_open(&f, path, err);
+  if (st != SS_OK) {
+    free(w);
+    return st;
+  }
+  w->fp = (FILE *)f.fp;
+  w->bad = 0;
+  w->n = 0;
+
+  ssCLocale loc;
+  int have_loc = ss_scene_c_locale_push(&loc) == 0;
+  struct lconv *lc = have_loc ? NULL : localeconv();
+  if (!have_loc && (!lc || !lc->decimal_point || strcmp(lc->decimal_point, "."))) {
+    ss_atomic_abort(&f);
+    free(w);
+    return ss_error_set(err, SS_ERR_STATE, path, 0,
+                        "cannot switch to the C locale to write numbers");
+  }
+  write_world(w, m, d);
+  w_flush(w);
+  if (have_loc) ss_scene_c_locale_pop(&loc);
+  int bad = w->bad;
+  free(w);
+  if (bad) {
+    ss_atomic_abort(&f);
+    return ss_error_set(err, SS_ERR_IO, path, 0, "write failed");
+  }
+  return ss_atomic_commit(&f, err);
+}

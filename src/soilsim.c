@@ -1,0 +1,745 @@
+/* soilsim.c -- the command-line program (DESIGN 4.3).
+ *
+ * Reads a world XML scene, checks every argument and output before the
+ * first step, steps the world, and writes the requested outputs: an export
+ * of the final world, a per-step CSV, rendered frames and a rut map.  Each
+ * output file is replaced atomically, so a failed or interrupted run never
+ * leaves a half-written file behind.
+ *
+ * Exit status: 0 success; 1 bad input or a failed run (the message names
+ * the file and line); 2 bad usage.  Only this file prints or exits. */
+#include "soilsim.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+enum { EXIT_RUN_FAILED = 1, EXIT_USAGE = 2 };
+
+#define DEFAULT_STEPS 1000L
+#define DEFAULT_RENDER_EVERY 20L
+#define MAX_IMAGE_SIDE 16384L
+
+/* One --remove NAME@STEP request. */
+typedef struct Removal {
+  const char *arg; /* the argument as given, for messages */
+  char *name;      /* system name (owned) */
+  long step;       /* remove after this step has been recorded */
+} Removal;
+
+typedef struct Options {
+  const char *scene;
+  long steps;
+  const char *export_path;
+  const char *csv_path;
+  const char *render_dir;
+  long render_every;
+  int render_every_given;
+  int width, height; /* 0: the renderer's default */
+  const char *rut_map;
+  int quiet;
+  Removal *removal;
+  int nremoval;
+} Options;
+
+/* The progress line on stderr (only on a terminal, without --quiet and CI). */
+typedef struct Progress {
+  int on;
+  int drawn;       /* 1 while a line is on screen */
+  double start;    /* monotonic time of the first step (s) */
+  double last;     /* when the line was last drawn (s) */
+} Progress;
+
+static volatile sig_atomic_t g_signal;
+
+/* ---------------------------------------------------------------------- */
+/* messages                                                                */
+
+static void usage(FILE *out)
+{
+  fputs(
+"usage: soilsim SCENE.xml [options]\n"
+"Simulate rigid bodies on deformable soil beds described by a world XML scene.\n"
+"\n"
+"options:\n"
+"  --steps N            number of time steps to run (default 1000; 0 = none)\n"
+"  --export OUT.xml     write the final world (with soil state) as XML\n"
+"  --csv FILE           write one row of statistics and positions per step\n"
+"  --remove NAME@STEP   remove body or system NAME after step STEP (repeatable)\n"
+"  --render DIR         write frames DIR/frame_NNNNNN.png (created if needed)\n"
+"  --render-every K     render every K steps (default 20; needs --render)\n"
+"  --size WxH           image size for --render and --rut-map (e.g. 800x600)\n"
+"  --rut-map FILE.png   write a top-down map of the final plastic sinkage\n"
+"  --quiet              no progress line and no summary; errors only\n"
+"  --help               show this help and exit\n"
+"  --version            show the version and exit\n"
+"\n"
+"Options also accept the form --option=VALUE.  Exit status: 0 success,\n"
+"1 bad input or failed run, 2 bad usage.  See soilsim(1).\n",
+      out);
+}
+
+/* A usage error: what is wrong, then where to look; exit status 2. */
+static int usage_error(const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 1, 2)))
+#endif
+    ;
+
+static int usage_error(const char *fmt, ...)
+{
+  va_list ap;
+  va_start(ap, fmt);
+  fputs("soilsim: ", stderr);
+  vfprintf(stderr, fmt, ap);
+  fputs("\ntry 'soilsim --help'\n", stderr);
+  va_end(ap);
+  return EXIT_USAGE;
+}
+
+/* soilsim: FILE:LINE: error: MESSAGE (FILE and LINE left out when unknown). */
+static void report(const ssError *e)
+{
+  fputs("soilsim: ", stderr);
+  if (e->file[0]) {
+    if (e->line > 0)
+      fprintf(stderr, "%s:%d: ", e->file, e->line);
+    else
+      fprintf(stderr, "%s: ", e->file);
+  }
+  fprintf(stderr, "error: %s\n",
+          e->message[0] ? e->message : ss_status_name(e->code));
+}
+
+/* ---------------------------------------------------------------------- */
+/* argument parsing                                                        */
+
+/* Whole-string base-10 integer in [lo, hi]; no spaces, no trailing junk. */
+static int parse_long(const char *s, long lo, long hi, long *out)
+{
+  if (!s || !*s || !((*s >= '0' && *s <= '9') || *s == '+' || *s == '-'))
+    return 0;
+  char *end;
+  errno = 0;
+  long v = strtol(s, &end, 10);
+  if (errno || end == s || *end || v < lo || v > hi) return 0;
+  *out = v;
+  return 1;
+}
+
+/* WxH with both sides in [1, MAX_IMAGE_SIDE]. */
+static int parse_size(const char *s, int *w, int *h)
+{
+  const char *x = strpbrk(s, "xX");
+  if (!x || x == s) return 0;
+  char buf[32];
+  size_t n = (size_t)(x - s);
+  if (n >= sizeof buf) return 0;
+  memcpy(buf, s, n);
+  buf[n] = 0;
+  long lw, lh;
+  if (!parse_long(buf, 1, MAX_IMAGE_SIDE, &lw)) return 0;
+  if (!parse_long(x + 1, 1, MAX_IMAGE_SIDE, &lh)) return 0;
+  *w = (int)lw;
+  *h = (int)lh;
+  return 1;
+}
+
+enum {
+  OPT_STEPS, OPT_EXPORT, OPT_CSV, OPT_REMOVE, OPT_RENDER, OPT_RENDER_EVERY,
+  OPT_SIZE, OPT_RUT_MAP, OPT_QUIET, OPT_HELP, OPT_VERSION
+};
+
+static const struct OptionSpec {
+  const char *name; /* without the leading dashes */
+  int id;
+  int has_value;
+} option_specs[] = {
+  {"steps", OPT_STEPS, 1},
+  {"export", OPT_EXPORT, 1},
+  {"csv", OPT_CSV, 1},
+  {"remove", OPT_REMOVE, 1},
+  {"render", OPT_RENDER, 1},
+  {"render-every", OPT_RENDER_EVERY, 1},
+  {"size", OPT_SIZE, 1},
+  {"rut-map", OPT_RUT_MAP, 1},
+  {"quiet", OPT_QUIET, 0},
+  {"help", OPT_HELP, 0},
+  {"version", OPT_VERSION, 0},
+};
+
+static void options_free(Options *o)
+{
+  for (int i = 0; i < o->nremoval; i++) free(o->removal[i].name);
+  free(o->removal);
+  o->removal = NULL;
+  o->nremoval = 0;
+}
+
+static int add_removal(Options *o, const char *arg)
+{
+  const char *at = strrchr(arg, '@');
+  long step;
+  if (!at || at == arg || !parse_long(at + 1, 0, LONG_MAX, &step))
+    return usage_error("invalid --remove value '%s': expected NAME@STEP "
+                       "with STEP an integer >= 0", arg);
+  size_t n = (size_t)(at - arg);
+  for (int i = 0; i < o->nremoval; i++)
+    if (strlen(o->removal[i].name) == n && !memcmp(o->removal[i].name, arg, n))
+      return usage_error("--remove names '%.*s' twice ('%s' and '%s')", (int)n,
+                         arg, o->removal[i].arg, arg);
+  Removal *r = realloc(o->removal, (size_t)(o->nremoval + 1) * sizeof *r);
+  if (!r) {
+    fputs("soilsim: error: out of memory\n", stderr);
+    return EXIT_RUN_FAILED;
+  }
+  o->removal = r;
+  char *name = malloc(n + 1);
+  if (!name) {
+    fputs("soilsim: error: out of memory\n", stderr);
+    return EXIT_RUN_FAILED;
+  }
+  memcpy(name, arg, n);
+  name[n] = 0;
+  r[o->nremoval].arg = arg;
+  r[o->nremoval].name = name;
+  r[o->nremoval].step = step;
+  o->nremoval++;
+  return -1;
+}
+
+/* Returns -1 to go on running, or the exit status (0 after --help or
+ * --version, 2 on bad usage). */
+static int parse_args(int argc, char **argv, Options *o)
+{
+  int steps_given = 0, size_given = 0, only_files = 0;
+  memset(o, 0, sizeof *o);
+  o->steps = DEFAULT_STEPS;
+  o->render_every = DEFAULT_RENDER_EVERY;
+
+  for (int i = 1; i < argc; i++) {
+    const char *a = argv[i];
+    if (only_files || a[0] != '-' || a[1] == 0) {
+      if (o->scene)
+        return usage_error("more than one scene given ('%s' and '%s')",
+                           o->scene, a);
+      o->scene = a;
+      continue;
+    }
+    if (!strcmp(a, "--")) {
+      only_files = 1;
+      continue;
+    }
+
+    /* find the option: --name, --name=value, or the short -h / -q / -V */
+    const struct OptionSpec *spec = NULL;
+    const char *value = NULL;
+    size_t namelen = 0;
+    if (a[1] == '-') {
+      const char *name = a + 2;
+      const char *eq = strchr(name, '=');
+      namelen = eq ? (size_t)(eq - name) : strlen(name);
+      for (size_t k = 0; k < sizeof option_specs / sizeof option_specs[0]; k++)
+        if (strlen(option_specs[k].name) == namelen &&
+            !strncmp(option_specs[k].name, name, namelen))
+          spec = &option_specs[k];
+      if (!spec)
+        return usage_error("unknown option '--%.*s'", (int)namelen, name);
+      if (eq) {
+        if (!spec->has_value)
+          return usage_error("option '--%s' takes no value", spec->name);
+        value = eq + 1;
+      }
+    } else if (!strcmp(a, "-h")) {
+      spec = &option_specs[OPT_HELP];
+    } else if (!strcmp(a, "-q")) {
+      spec = &option_specs[OPT_QUIET];
+    } else if (!strcmp(a, "-V")) {
+      spec = &option_specs[OPT_VERSION];
+    } else {
+      return usage_error("unknown option '%s'", a);
+    }
+
+    /* a separate value must not look like the next option */
+    if (spec->has_value && !value) {
+      if (i + 1 >= argc || !strncmp(argv[i + 1], "--", 2))
+        return usage_error("option '--%s' needs a value", spec->name);
+      value = argv[++i];
+    }
+    if (spec->has_value && !*value)
+      return usage_error("option '--%s' needs a value", spec->name);
+
+    switch (spec->id) {
+    case OPT_STEPS:
+      if (!parse_long(value, 0, LONG_MAX, &o->steps))
+        return usage_error("invalid --steps value '%s': expected an integer "
+                           ">= 0", value);
+      steps_given = 1;
+      break;
+    case OPT_EXPORT: o->export_path = value; break;
+    case OPT_CSV: o->csv_path = value; break;
+    case OPT_REMOVE: {
+      int rc = add_removal(o, value);
+      if (rc >= 0) return rc;
+      break;
+    }
+    case OPT_RENDER: o->render_dir = value; break;
+    case OPT_RENDER_EVERY:
+      if (!parse_long(value, 1, LONG_MAX, &o->render_every))
+        return usage_error("invalid --render-every value '%s': expected an "
+                           "integer >= 1", value);
+      o->render_every_given = 1;
+      break;
+    case OPT_SIZE:
+      if (!parse_size(value, &o->width, &o->height))
+        return usage_error("invalid --size value '%s': expected WxH with W "
+                           "and H integers from 1 to %ld", value,
+                           MAX_IMAGE_SIDE);
+      size_given = 1;
+      break;
+    case OPT_RUT_MAP: o->rut_map = value; break;
+    case OPT_QUIET: o->quiet = 1; break;
+    case OPT_HELP:
+      usage(stdout);
+      return 0;
+    case OPT_VERSION:
+      printf("soilsim %s\n", SS_VERSION);
+      return 0;
+    }
+  }
+
+  if (!o->scene) return usage_error("no scene file given");
+  if (o->render_every_given && !o->render_dir)
+    return usage_error("--render-every needs --render DIR");
+  if (size_given && !o->render_dir && !o->rut_map)
+    return usage_error("--size needs --render or --rut-map");
+  for (int i = 0; i < o->nremoval; i++)
+    if (o->removal[i].step > o->steps)
+      return usage_error("--remove %s: step %ld is after the last step "
+                         "(--steps %ld%s)", o->removal[i].arg,
+                         o->removal[i].step, o->steps,
+                         steps_given ? "" : ", the default");
+
+  /* two outputs on one path would overwrite each other */
+  const char *out[3] = {o->export_path, o->csv_path, o->rut_map};
+  const char *flag[3] = {"--export", "--csv", "--rut-map"};
+  for (int i = 0; i < 3; i++)
+    for (int j = i + 1; j < 3; j++)
+      if (out[i] && out[j] && !strcmp(out[i], out[j]))
+        return usage_error("%s and %s both write '%s'", flag[i], flag[j],
+                           out[i]);
+  return -1;
+}
+
+/* ---------------------------------------------------------------------- */
+/* checks made before the first step                                       */
+
+/* An output file must be replaceable: not a folder, and its folder must
+ * take a new file (the atomic writer creates its temporary file there). */
+static ssStatus check_output(const char *path, const char *flag, ssError *err)
+{
+  struct stat st;
+  if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+    return ss_error_set(err, SS_ERR_IO, path, 0,
+                        "%s: cannot write: is a directory", flag);
+  ssAtomicFile f;
+  ssError e;
+  ss_error_clear(&e);
+  if (ss_atomic_open(&f, path, &e) != SS_OK)
+    return ss_error_set(err, SS_ERR_IO, path, 0, "%s: %s", flag, e.message);
+  ss_atomic_abort(&f);
+  return SS_OK;
+}
+
+/* mkdir -p: create dir and its missing parents. */
+static ssStatus make_dirs(const char *dir, ssError *err)
+{
+  char path[1024];
+  size_t n = strlen(dir);
+  if (n >= sizeof path)
+    return ss_error_set(err, SS_ERR_IO, dir, 0, "--render: path too long");
+  memcpy(path, dir, n + 1);
+  for (size_t k = 1; k <= n; k++) {
+    if (path[k] != '/' && path[k] != 0) continue;
+    char c = path[k];
+    path[k] = 0;
+    if (mkdir(path, 0777) != 0 && errno != EEXIST) {
+      int e = errno;
+      return ss_error_set(err, SS_ERR_IO, path, 0,
+                          "--render: cannot create directory: %s",
+                          strerror(e));
+    }
+    path[k] = c;
+  }
+  struct stat st;
+  if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
+    return ss_error_set(err, SS_ERR_IO, dir, 0,
+                        "--render: not a directory");
+  return SS_OK;
+}
+
+/* The systems the scene has, for a message: "a, b, c" (truncated). */
+static void list_systems(const ssModel *m, char *buf, size_t size)
+{
+  size_t used = 0;
+  buf[0] = 0;
+  for (int s = 0; s < m->nsys; s++) {
+    int n = snprintf(buf + used, size - used, "%s'%s'", s ? ", " : "",
+                     m->sys_name[s]);
+    if (n < 0 || (size_t)n >= size - used) {
+      if (size > 4) strcpy(buf + size - 5, " ...");
+      return;
+    }
+    used += (size_t)n;
+  }
+}
+
+static ssStatus check_removals(const Options *o, const ssModel *m,
+                               ssError *err)
+{
+  for (int i = 0; i < o->nremoval; i++) {
+    if (ss_model_find_sys(m, o->removal[i].name) >= 0) continue;
+    if (m->nsys == 0)
+      return ss_error_set(err, SS_ERR_NOTFOUND, o->scene, 0,
+                          "--remove %s: no body or articulated system named "
+                          "'%s'; the scene has none", o->removal[i].arg,
+                          o->removal[i].name);
+    char names[600];
+    list_systems(m, names, sizeof names);
+    return ss_error_set(err, SS_ERR_NOTFOUND, o->scene, 0,
+                        "--remove %s: no body or articulated system named "
+                        "'%s'; the scene has %s", o->removal[i].arg,
+                        o->removal[i].name, names);
+  }
+  return SS_OK;
+}
+
+static int first_soil_bed(const ssModel *m)
+{
+  for (int h = 0; h < m->nhfield; h++)
+    if (m->hfield_soil[h]) return h;
+  return -1;
+}
+
+/* ---------------------------------------------------------------------- */
+/* CSV                                                                     */
+
+/* A header field, quoted when the name would break the CSV. */
+static void csv_name(FILE *fp, const char *name, const char *suffix)
+{
+  if (!strpbrk(name, ",\"\r\n")) {
+    fprintf(fp, ",%s%s", name, suffix);
+    return;
+  }
+  fputs(",\"", fp);
+  for (const char *c = name; *c; c++) {
+    if (*c == '"') fputc('"', fp);
+    fputc(*c, fp);
+  }
+  fprintf(fp, "%s\"", suffix);
+}
+
+static void csv_header(FILE *fp, const ssModel *m)
+{
+  fputs("step,time,soil_contacts,soil_contact_area,soil_normal_force,sweeps",
+        fp);
+  for (int s = 0; s < m->nsys; s++) {
+    csv_name(fp, m->sys_name[s], ".x");
+    csv_name(fp, m->sys_name[s], ".y");
+    csv_name(fp, m->sys_name[s], ".z");
+  }
+  fputc('\n', fp);
+}
+
+/* Numbers with round-trip precision; a removed system's fields stay empty. */
+static void csv_row(FILE *fp, const ssModel *m, const ssData *d, long k)
+{
+  const ssStepStats *st = &d->stats;
+  fprintf(fp, "%ld,%.17g,%d,%.17g,%.17g,%d", k, d->time,
+          st->soil_contacts, st->soil_contact_area, st->soil_normal_force,
+          st->sweeps);
+  for (int s = 0; s < m->nsys; s++) {
+    if (!d->sys_active[s] || m->sys_nbody[s] < 1) {
+      fputs(",,,", fp);
+      continue;
+    }
+    const double *p = d->body_xpos + 3 * m->sys_bodyadr[s];
+    fprintf(fp, ",%.17g,%.17g,%.17g", p[0], p[1], p[2]);
+  }
+  fputc('\n', fp);
+}
+
+/* ---------------------------------------------------------------------- */
+/* progress line                                                           */
+
+static double now_seconds(void)
+{
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void format_duration(char *buf, size_t size, double sec)
+{
+  if (!(sec >= 0) || sec > 359999) {
+    snprintf(buf, size, "--:--");
+    return;
+  }
+  long t = (long)(sec + 0.5);
+  if (t >= 3600)
+    snprintf(buf, size, "%ld:%02ld:%02ld", t / 3600, t / 60 % 60, t % 60);
+  else
+    snprintf(buf, size, "%ld:%02ld", t / 60, t % 60);
+}
+
+static void progress_draw(Progress *p, long k, long n, double now)
+{
+  enum { BAR = 30 };
+  double frac = n > 0 ? (double)k / (double)n : 1.0;
+  double elapsed = now - p->start;
+  char bar[BAR + 1], eta[32], rate[32];
+  int fill = (int)(frac * BAR);
+  for (int i = 0; i < BAR; i++) bar[i] = i < fill ? '#' : '.';
+  bar[BAR] = 0;
+  if (k > 0 && elapsed > 0) {
+    double r = (double)k / elapsed;
+    snprintf(rate, sizeof rate, "%.0f steps/s", r);
+    format_duration(eta, sizeof eta, (double)(n - k) / r);
+  } else {
+    snprintf(rate, sizeof rate, "-- steps/s");
+    snprintf(eta, sizeof eta, "--:--");
+  }
+  fprintf(stderr, "\r[%s] %3d%%  step %ld/%ld  %s  ETA %s\033[K", bar,
+          (int)(frac * 100), k, n, rate, eta);
+  fflush(stderr);
+  p->drawn = 1;
+  p->last = now;
+}
+
+static void progress_clear(Progress *p)
+{
+  if (!p->drawn) return;
+  fputs("\r\033[K", stderr);
+  fflush(stderr);
+  p->drawn = 0;
+}
+
+/* ---------------------------------------------------------------------- */
+/* the run                                                                 */
+
+static void on_signal(int sig) { g_signal = sig; }
+
+static void catch_signals(void)
+{
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+  sigaction(SIGHUP, &sa, NULL);
+}
+
+static ssStatus render_step(ssRenderer *r, const Options *o, const ssModel *m,
+                            const ssData *d, long k, long *nframes,
+                            ssError *err)
+{
+  char path[2048];
+  int n = snprintf(path, sizeof path, "%s/frame_%06ld.png", o->render_dir, k);
+  if (n < 0 || (size_t)n >= sizeof path)
+    return ss_error_set(err, SS_ERR_IO, o->render_dir, 0,
+                        "--render: path too long");
+  ssStatus st = ss_render_frame(r, m, d, path, err);
+  if (st == SS_OK) (*nframes)++;
+  return st;
+}
+
+/* Removals scheduled for step k. */
+static ssStatus apply_removals(const Options *o, const ssModel *m, ssData *d,
+                               long k, ssError *err)
+{
+  for (int i = 0; i < o->nremoval; i++)
+    if (o->removal[i].step == k &&
+        ss_remove(m, d, o->removal[i].name, err) != SS_OK) {
+      if (!err->file[0])
+        snprintf(err->file, sizeof err->file, "%s", o->scene);
+      return err->code;
+    }
+  return SS_OK;
+}
+
+static void print_summary(const Options *o, const ssModel *m, const ssData *d,
+                          long steps, double wall, long nframes,
+                          long unconverged)
+{
+  double sim = (double)steps * m->opt.timestep;
+  printf("scene       %s\n", o->scene);
+  printf("steps       %ld (dt %g s)\n", steps, m->opt.timestep);
+  double gap = d->time - sim;
+  if (gap > 0.5 * m->opt.timestep || gap < -0.5 * m->opt.timestep)
+    printf("simulated   %.6g s (scene time now %.6g s)\n", sim, d->time);
+  else
+    printf("simulated   %.6g s\n", sim);
+  if (wall > 0 && steps > 0)
+    printf("wall time   %.3f s (real-time factor %.3g)\n", wall, sim / wall);
+  else
+    printf("wall time   %.3f s\n", wall);
+  if (steps > 0) {
+    printf("sweeps      %d (last step)", d->stats.sweeps);
+    if (unconverged)
+      printf("; %ld step%s stopped at the sweep cap", unconverged,
+             unconverged == 1 ? "" : "s");
+    printf("\n");
+  }
+  if (o->export_path) printf("export      %s\n", o->export_path);
+  if (o->csv_path) printf("csv         %s\n", o->csv_path);
+  if (o->render_dir)
+    printf("frames      %s/frame_*.png (%ld)\n", o->render_dir, nframes);
+  if (o->rut_map) printf("rut map     %s\n", o->rut_map);
+}
+
+static int run(const Options *o)
+{
+  ssError err;
+  ssModel *m = NULL;
+  ssData *d = NULL;
+  ssRenderer *r = NULL;
+  ssAtomicFile csv;
+  int csv_open = 0, status = EXIT_RUN_FAILED;
+  long nframes = 0, unconverged = 0;
+  Progress prog;
+  memset(&prog, 0, sizeof prog);
+  memset(&csv, 0, sizeof csv);
+  ss_error_clear(&err);
+
+  /* load and validate everything before the first step */
+  if (ss_scene_load(o->scene, &m, &d, &err) != SS_OK) {
+    if (!err.file[0]) snprintf(err.file, sizeof err.file, "%s", o->scene);
+    goto fail;
+  }
+  if (check_removals(o, m, &err) != SS_OK) goto fail;
+  if (o->rut_map && first_soil_bed(m) < 0) {
+    ss_error_set(&err, SS_ERR_VALUE, o->scene, 0,
+                 "--rut-map: the scene has no soil bed");
+    goto fail;
+  }
+  if (o->export_path && check_output(o->export_path, "--export", &err))
+    goto fail;
+  if (o->rut_map && check_output(o->rut_map, "--rut-map", &err)) goto fail;
+
+  ssRenderOptions ropt = ss_render_options_default();
+  if (o->width > 0) {
+    ropt.width = o->width;
+    ropt.height = o->height;
+  }
+  if (o->render_dir) {
+    char probe[2048];
+    snprintf(probe, sizeof probe, "%s/frame_probe.png", o->render_dir);
+    if (make_dirs(o->render_dir, &err) != SS_OK ||
+        check_output(probe, "--render", &err) != SS_OK)
+      goto fail;
+    r = ss_render_new(m, &ropt, &err);
+    if (!r) {
+      if (err.code == SS_OK)
+        ss_error_set(&err, SS_ERR_UNSUPPORTED, "", 0,
+                     "--render: the renderer could not start");
+      goto fail;
+    }
+  }
+  if (o->csv_path) {
+    if (ss_atomic_open(&csv, o->csv_path, &err) != SS_OK) goto fail;
+    csv_open = 1;
+    csv_header((FILE *)csv.fp, m);
+  }
+
+  prog.on = !o->quiet && isatty(STDERR_FILENO) &&
+            !(getenv("CI") && *getenv("CI"));
+  catch_signals();
+  ss_forward(m, d);
+  double t0 = now_seconds();
+  prog.start = prog.last = t0;
+
+  /* step k's outputs are recorded, then the removals scheduled for k apply;
+   * k counts this run's steps (a scene may start at a later time) */
+  long done = 0;
+  for (long k = 0; k <= o->steps; k++) {
+    if (g_signal) break;
+    if (k > 0) {
+      if (ss_step(m, d, &err) != SS_OK) {
+        if (!err.file[0])
+          snprintf(err.file, sizeof err.file, "%s", o->scene);
+        goto fail;
+      }
+      ss_forward(m, d);
+      done = k;
+      if (!d->stats.converged) unconverged++;
+      if (csv_open) csv_row((FILE *)csv.fp, m, d, k);
+    }
+    if (r && (k % o->render_every == 0 || k == o->steps) &&
+        render_step(r, o, m, d, k, &nframes, &err) != SS_OK)
+      goto fail;
+    if (apply_removals(o, m, d, k, &err) != SS_OK) goto fail;
+    if (prog.on) {
+      double now = now_seconds();
+      if (now - prog.last >= 0.1 || k == o->steps)
+        progress_draw(&prog, k, o->steps, now);
+    }
+  }
+  double wall = now_seconds() - t0;
+  if (g_signal) {
+    progress_clear(&prog);
+    fprintf(stderr, "soilsim: interrupted after step %ld; no output files "
+            "written\n", done);
+    goto cleanup;
+  }
+  progress_clear(&prog);
+
+  /* outputs of the final state; the CSV appears last, once all else worked */
+  if (o->rut_map &&
+      ss_render_rut_map(m, d, -1, 1, o->width > 0 ? o->width : ropt.width,
+                        o->height > 0 ? o->height : ropt.height, o->rut_map,
+                        &err) != SS_OK)
+    goto fail;
+  if (o->export_path && ss_scene_export(m, d, o->export_path, &err) != SS_OK)
+    goto fail;
+  if (csv_open) {
+    csv_open = 0;
+    if (ss_atomic_commit(&csv, &err) != SS_OK) goto fail;
+  }
+  if (!o->quiet) print_summary(o, m, d, done, wall, nframes, unconverged);
+  status = 0;
+  goto cleanup;
+
+fail:
+  progress_clear(&prog);
+  report(&err);
+  status = EXIT_RUN_FAILED;
+cleanup:
+  if (csv_open) ss_atomic_abort(&csv);
+  ss_render_free(r);
+  ss_data_free(d);
+  ss_model_free(m);
+  return status;
+}
+
+int main(int argc, char **argv)
+{
+  Options o;
+  int status = parse_args(argc, argv, &o);
+  if (status < 0) status = run(&o);
+  options_free(&o);
+  if (g_signal) {
+    /* let the caller see how we ended (a shell loop stops on Ctrl-C) */
+    int sig = g_signal;
+    signal(sig, SIG_DFL);
+    raise(sig);
+  }
+  return status;
+}

@@ -1,0 +1,489 @@
+/* soilsim.h -- the public interface of the soilsim library.
+ *
+ * soilsim simulates rigid bodies and articulated systems on deformable soil
+ * beds (Bekker pressure-sinkage, elastic unloading, permanent ruts, loading
+ * viscosity, Mohr-Coulomb / Janosi-Hanamoto shear).  The library follows a
+ * model/data split: an ssModel is the immutable description of a world (what
+ * it is), an ssData holds everything that changes as it is stepped (where it
+ * is now).  ss_step(m, d) advances d by one time step.
+ *
+ * Conventions: SI units everywhere (m, s, kg, N, Pa).  World frame Z up.
+ * Quaternions are stored w, x, y, z.  Arrays are documented with their shape
+ * as (rows x cols).  Library functions never print and never exit: fallible
+ * functions return an ssStatus and fill a caller-owned ssError.
+ */
+#ifndef SOILSIM_H
+#define SOILSIM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SS_VERSION "0.1.0"
+
+/* ---------------------------------------------------------------------- */
+/* errors                                                                  */
+
+typedef enum ssStatus {
+  SS_OK = 0,
+  SS_ERR_NOMEM,       /* allocation failed */
+  SS_ERR_IO,          /* a file could not be read or written */
+  SS_ERR_PARSE,       /* malformed input (XML syntax, numbers, ...) */
+  SS_ERR_VALUE,       /* a value out of its allowed range */
+  SS_ERR_UNSUPPORTED, /* a valid request this build does not support */
+  SS_ERR_STATE,       /* the call is not allowed in the current state */
+  SS_ERR_NUMERIC,     /* the simulation produced a non-finite state */
+  SS_ERR_NOTFOUND     /* a named object does not exist */
+} ssStatus;
+
+/* A structured error, filled by the library and reported by the caller.
+ * file and line name the input location when the error comes from a file
+ * (line 0 when unknown).  message is one sentence without a trailing period
+ * that says what is wrong and, where it helps, what is allowed. */
+typedef struct ssError {
+  ssStatus code;
+  char file[512];
+  int line;
+  char message[1024];
+} ssError;
+
+/* Fill err (may be NULL) and return code.  printf-style message. */
+ssStatus ss_error_set(ssError *err, ssStatus code, const char *file, int line,
+                      const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 5, 6)))
+#endif
+    ;
+void ss_error_clear(ssError *err);
+const char *ss_status_name(ssStatus code);
+
+/* ---------------------------------------------------------------------- */
+/* soil material and constitutive law (DESIGN 2.3-2.5); pure functions     */
+
+typedef struct ssSoilMaterial {
+  double bekker_kc;            /* cohesive modulus k_c (Pa m^(1-n)) */
+  double bekker_kphi;          /* frictional modulus k_phi (Pa / m^n) */
+  double sinkage_exponent;     /* n (-) */
+  double elastic_stiffness;    /* K_e, un/reloading stiffness (Pa / m) */
+  double damping;              /* D, loading-only viscosity (Pa s / m) */
+  double cohesion;             /* c (Pa) */
+  double friction_coefficient; /* mu = tan(phi) (-) */
+  double shear_displacement;   /* K_j, Janosi-Hanamoto modulus (m); 0 = full */
+} ssSoilMaterial;
+
+/* The documented defaults (illustrative, not a calibrated soil). */
+ssSoilMaterial ss_soil_material_default(void);
+/* SS_OK, or SS_ERR_VALUE with a message naming the field and its value. */
+ssStatus ss_soil_material_validate(const ssSoilMaterial *mat, ssError *err);
+
+/* Bekker envelope p_y = (k_c/b + k_phi) s^n for sinkage s >= 0 (Pa). */
+double ss_soil_envelope(const ssSoilMaterial *mat, double b, double s);
+/* d p_y / d s (Pa/m); finite for s > 0. */
+double ss_soil_envelope_slope(const ssSoilMaterial *mat, double b, double s);
+/* Elastic branch p_e = K_e (s - s_p) (Pa); may be negative for s < s_p. */
+double ss_soil_elastic(const ssSoilMaterial *mat, double s, double s_p);
+/* Static pressure p = min(p_e, p_y) if s > s_p, else 0 (Pa). */
+double ss_soil_pressure(const ssSoilMaterial *mat, double b, double s,
+                        double s_p);
+/* Permanent sinkage after reaching s: max(s_p, s - p/K_e) (m). */
+double ss_soil_plastic_update(const ssSoilMaterial *mat, double b, double s,
+                              double s_p);
+/* Loading viscosity p_v = D max(sdot, 0) (Pa); sdot > 0 pushes down. */
+double ss_soil_viscous(const ssSoilMaterial *mat, double sdot);
+/* Mohr-Coulomb strength tau_f = c + mu p_n (Pa), p_n >= 0. */
+double ss_soil_shear_strength(const ssSoilMaterial *mat, double p_n);
+/* Janosi-Hanamoto limit tau_max = tau_f (1 - exp(-j/K_j)) (Pa). */
+double ss_soil_shear_limit(const ssSoilMaterial *mat, double p_n, double j);
+/* d tau_max / d j (1/m * Pa). */
+double ss_soil_shear_limit_slope(const ssSoilMaterial *mat, double p_n,
+                                 double j);
+
+/* ---------------------------------------------------------------------- */
+/* model: what the world is                                                */
+
+typedef enum ssGeomType {
+  SS_GEOM_BOX = 0,  /* size = full edge lengths x, y, z */
+  SS_GEOM_SPHERE,   /* size[0] = radius */
+  SS_GEOM_CYLINDER, /* size[0] = radius, size[1] = length along local z */
+  SS_GEOM_CAPSULE,  /* size[0] = radius, size[1] = distance between centres */
+  SS_GEOM_MESH      /* triangle mesh (articulated links; later issue) */
+} ssGeomType;
+
+typedef enum ssSysType {
+  SS_SYS_FREE = 0,   /* single rigid body, 6 DOF: nq = 7, nv = 6 */
+  SS_SYS_STATIC,     /* single fixed body: nq = 7 (pose), nv = 0 */
+  SS_SYS_ARTICULATED /* tree of links with loop closures (later issue) */
+} ssSysType;
+
+/* Solver and integration options: part of the world, saved in exports. */
+typedef struct ssOption {
+  double timestep;           /* dt (s) */
+  double gravity[3];         /* (m/s^2) */
+  int solver_max_sweeps;     /* Gauss-Seidel sweep cap */
+  double solver_tolerance;   /* relative impulse change that ends the sweeps */
+  double scalar_tolerance;   /* residual tolerance of the per-point solves */
+  int terrain_warm_start;    /* 1: start from the cached tractions */
+  double contact_margin;     /* (m) points closer than this become contacts */
+  double rigid_erp;          /* fraction of rigid penetration removed per step */
+} ssOption;
+
+ssOption ss_option_default(void);
+
+/* Coulomb contact properties between two rigid materials. */
+typedef struct ssMaterialPair {
+  int mat1, mat2;               /* material indices (mat1 <= mat2) */
+  double friction;              /* Coulomb coefficient (-) */
+  double restitution;           /* (-) */
+  double restitution_threshold; /* approach speed below which e = 0 (m/s) */
+} ssMaterialPair;
+
+/* How a height map's heights were given in the scene (export writes them
+ * back explicitly whatever the source). */
+typedef enum ssHfieldSource {
+  SS_HFIELD_EXPLICIT = 0,
+  SS_HFIELD_PNG,
+  SS_HFIELD_TEXT,
+  SS_HFIELD_GENERATED
+} ssHfieldSource;
+
+typedef struct ssModel {
+  ssOption opt;
+
+  /* systems: independent dynamic units (a single body or an articulated
+   * system); what --remove and the CSV columns name */
+  int nsys;
+  char **sys_name;      /* (nsys) */
+  int *sys_type;        /* (nsys) ssSysType */
+  int *sys_qadr;        /* (nsys) first index into qpos */
+  int *sys_nq;          /* (nsys) */
+  int *sys_vadr;        /* (nsys) first index into qvel */
+  int *sys_nv;          /* (nsys) */
+  int *sys_bodyadr;     /* (nsys) first body */
+  int *sys_nbody;       /* (nsys) */
+  int *sys_line;        /* (nsys) line in the scene file (0 if built in code) */
+
+  int nq, nv;           /* generalized coordinate / velocity counts */
+  double *qpos0;        /* (nq) initial positions (pos, quat for free bodies) */
+  double *qvel0;        /* (nv) initial velocities (lin_vel, ang_vel world) */
+
+  /* bodies: rigid links (a single rigid body is one body) */
+  int nbody;
+  char **body_name;     /* (nbody) */
+  int *body_sys;        /* (nbody) owning system */
+  double *body_mass;    /* (nbody) (kg) */
+  double *body_inertia; /* (nbody x 9) about the centre of mass, body frame */
+  int *body_inertia_given; /* (nbody) 1 if the scene overrode it */
+
+  /* geoms: colliders and visuals attached to bodies */
+  int ngeom;
+  int *geom_type;       /* (ngeom) ssGeomType */
+  int *geom_body;       /* (ngeom) */
+  double *geom_size;    /* (ngeom x 3) see ssGeomType */
+  double *geom_pos;     /* (ngeom x 3) in the body frame */
+  double *geom_quat;    /* (ngeom x 4) in the body frame */
+  int *geom_material;   /* (ngeom) rigid material index */
+  double *geom_rgba;    /* (ngeom x 4) display colour */
+
+  /* rigid ground planes z = height */
+  int nplane;
+  char **plane_name;    /* (nplane) */
+  double *plane_height; /* (nplane) (m) */
+  int *plane_material;  /* (nplane) */
+
+  /* height maps: rigid, or soil beds when hfield_soil is set (DESIGN 2.1) */
+  int nhfield;
+  char **hfield_name;     /* (nhfield) */
+  int *hfield_nx;         /* (nhfield) vertices along local x, >= 2 */
+  int *hfield_ny;         /* (nhfield) vertices along local y, >= 2 */
+  double *hfield_size;    /* (nhfield x 2) x_size, y_size (m) */
+  double *hfield_center;  /* (nhfield x 2) center_x, center_y, local frame (m) */
+  double *hfield_pos0;    /* (nhfield x 3) initial pose: position */
+  double *hfield_quat0;   /* (nhfield x 4) initial pose: orientation */
+  int *hfield_adr;        /* (nhfield) first vertex in hfield_data / soil */
+  int *hfield_material;   /* (nhfield) rigid material (rigid maps) */
+  int *hfield_source;     /* (nhfield) ssHfieldSource */
+  int *hfield_soil;       /* (nhfield) 1: soil bed, 0: rigid height map */
+  ssSoilMaterial *hfield_soilmat; /* (nhfield) soil material (soil beds) */
+  double *hfield_zrange;  /* (nhfield x 2) min, max undeformed height */
+  int nhfielddata;        /* total vertices of all height maps */
+  double *hfield_data;    /* (nhfielddata) undeformed heights, j*nx + i */
+
+  /* materials: names; pair table with a default */
+  int nmaterial;
+  char **material_name;   /* (nmaterial); index 0 is "default" */
+  ssMaterialPair material_default;
+  int npair;
+  ssMaterialPair *pair;   /* (npair) */
+
+  /* external forces: constant loads on a body over [start, end) */
+  int nxforce;
+  int *xforce_body;       /* (nxforce) */
+  double *xforce_force;   /* (nxforce x 3) world frame (N) at the COM */
+  double *xforce_torque;  /* (nxforce x 3) world frame (N m) */
+  double *xforce_time;    /* (nxforce x 2) start, end (s) */
+
+  /* default camera for rendering (DESIGN 4.1) */
+  int camera_given;
+  double camera_pos[3];
+  double camera_look_at[3];
+  double camera_fov_deg;
+  char camera_follow[128];
+
+  /* where the model came from (for messages and [THIS_DIR]) */
+  char source_path[512];
+
+  /* builder capacities (internal) */
+  int cap_sys, cap_body, cap_geom, cap_plane, cap_hfield, cap_hfielddata,
+      cap_material, cap_pair, cap_xforce, cap_q, cap_v;
+} ssModel;
+
+/* ---------------------------------------------------------------------- */
+/* model builder                                                           */
+
+/* Definition of a single rigid body (Box2D-style def with defaults). */
+typedef struct ssBodyDef {
+  const char *name;
+  ssGeomType shape;
+  double size[3];        /* see ssGeomType */
+  double mass;           /* (kg) > 0 for dynamic bodies */
+  int inertia_given;     /* 1: use inertia[] instead of the uniform solid */
+  double inertia[6];     /* xx xy xz yy yz zz about the COM, body frame */
+  int is_static;         /* 1: fixed in place */
+  const char *material;  /* rigid material name (NULL = "default") */
+  double pos[3];         /* COM position, world (m) */
+  double quat[4];        /* orientation w x y z (normalized on add) */
+  double lin_vel[3];     /* world (m/s) */
+  double ang_vel[3];     /* world (rad/s) */
+  double rgba[4];        /* display colour; alpha 0 = pick a default */
+  int line;              /* scene line for messages (0 if none) */
+} ssBodyDef;
+
+ssBodyDef ss_body_def_default(void);
+
+typedef struct ssHfieldDef {
+  const char *name;
+  int nx, ny;            /* vertex counts >= 2 */
+  double x_size, y_size; /* (m) > 0 */
+  double center_x, center_y;
+  const double *height;  /* (nx*ny) undeformed heights, j*nx + i */
+  double pos[3];         /* bed pose in the world */
+  double quat[4];
+  const char *material;  /* rigid material name (NULL = "default") */
+  int source;            /* ssHfieldSource */
+  int soil;              /* 1: soil bed */
+  ssSoilMaterial soilmat;
+  int line;
+} ssHfieldDef;
+
+ssHfieldDef ss_hfield_def_default(void);
+
+ssModel *ss_model_new(void);
+void ss_model_free(ssModel *m); /* accepts NULL */
+
+/* Each add returns the new object's index (>= 0) or -1 with err filled.
+ * Names must be unique among systems, planes and height maps. */
+int ss_model_add_body(ssModel *m, const ssBodyDef *def, ssError *err);
+int ss_model_add_plane(ssModel *m, const char *name, double height,
+                       const char *material, int line, ssError *err);
+int ss_model_add_hfield(ssModel *m, const ssHfieldDef *def, ssError *err);
+/* Find or add a rigid material by name. */
+int ss_model_material(ssModel *m, const char *name);
+/* Set the friction/restitution of a material pair (or of the default when
+ * both names are NULL). */
+ssStatus ss_model_set_pair(ssModel *m, const char *name1, const char *name2,
+                           double friction, double restitution,
+                           double restitution_threshold, ssError *err);
+const ssMaterialPair *ss_model_pair(const ssModel *m, int mat1, int mat2);
+int ss_model_add_xforce(ssModel *m, int body, const double force[3],
+                        const double torque[3], double start, double end,
+                        ssError *err);
+/* Look-ups by name; -1 when absent. */
+int ss_model_find_sys(const ssModel *m, const char *name);
+int ss_model_find_hfield(const ssModel *m, const char *name);
+/* Checks the whole model (options, materials, sizes); call once built. */
+ssStatus ss_model_validate(const ssModel *m, ssError *err);
+/* Effective width b of a geom on a bed whose normal is n_bed (DESIGN 2.4),
+ * given the geom's world rotation (row-major 3x3). */
+double ss_geom_width(const ssModel *m, int geom, const double xmat[9],
+                     const double n_bed[3]);
+
+/* ---------------------------------------------------------------------- */
+/* data: where the world is now                                            */
+
+/* Statistics of the last step (DESIGN 2.6). */
+typedef struct ssStepStats {
+  int soil_contacts;        /* quadrature points near bodies */
+  int soil_loaded;          /* of those, loaded ones */
+  double soil_contact_area; /* area of the loaded points (m^2) */
+  double soil_normal_force; /* total normal force of the loaded points (N) */
+  int rigid_contacts;       /* rigid (Coulomb) contacts */
+  int sweeps;               /* Gauss-Seidel sweeps used */
+  double residual;          /* final relative impulse change */
+  int converged;            /* 1 if the tolerance was met */
+  /* wall time of each stage of the last step (s): forward kinematics, free
+   * velocity, contact generation, solve, soil update, integration */
+  double time_stage[6];
+} ssStepStats;
+
+typedef struct ssContact ssContact; /* solver contact (internal layout) */
+typedef struct ssWarmEntry ssWarmEntry;
+
+typedef struct ssData {
+  const ssModel *model;   /* the model this data was made for */
+  double time;            /* simulated time (s) */
+  long step;              /* completed steps */
+  int in_step;            /* 1 while ss_step runs: state setters refuse */
+
+  double *qpos;           /* (nq) free body: COM position (3), quat (4) */
+  double *qvel;           /* (nv) free body: lin vel (3), ang vel (3), world */
+  unsigned char *sys_active; /* (nsys) 0 once removed from the world */
+
+  /* derived kinematics (ss_forward) */
+  double *body_xpos;      /* (nbody x 3) COM position, world */
+  double *body_xquat;     /* (nbody x 4) */
+  double *body_xmat;      /* (nbody x 9) rotation, row-major */
+  double *geom_xpos;      /* (ngeom x 3) */
+  double *geom_xmat;      /* (ngeom x 9) */
+  double *body_iinv;      /* (nbody x 9) inverse inertia, world frame */
+
+  /* height map poses (settable between steps) */
+  double *hfield_pos;     /* (nhfield x 3) */
+  double *hfield_quat;    /* (nhfield x 4) */
+
+  /* soil state, one value per vertex of every soil bed (zero elsewhere) */
+  double *soil_sinkage;   /* (nhfielddata) total sinkage s >= 0 (m) */
+  double *soil_plastic;   /* (nhfielddata) permanent sinkage s_p (m) */
+  double *soil_shear;     /* (nhfielddata) accumulated shear j (m) */
+  int nsoil_loaded, cap_soil_loaded;
+  int *soil_loaded;       /* (nsoil_loaded) vertices with s > s_p or j > 0:
+                             the ones that recover when their load goes */
+
+  /* solver */
+  int ncontact, cap_contact;
+  ssContact *contact;     /* (ncontact) contacts of the last step */
+  double *jac;            /* contact Jacobians and responses (internal) */
+  size_t cap_jac;
+  double *qvel_free;      /* (nv) velocity before contact impulses */
+  int nwarm, cap_warm;
+  ssWarmEntry *warm;      /* (nwarm) warm-start cache */
+  ssStepStats stats;
+} ssData;
+
+ssData *ss_data_new(const ssModel *m);
+void ss_data_free(ssData *d); /* accepts NULL */
+/* Back to the model's initial state, soil state zero, time 0. */
+void ss_data_reset(const ssModel *m, ssData *d);
+/* Recompute derived kinematics (body and geom poses) from qpos. */
+void ss_forward(const ssModel *m, ssData *d);
+
+/* One time step.  SS_ERR_NUMERIC (naming the step and body) if the state
+ * became non-finite; d is then not advanced. */
+ssStatus ss_step(const ssModel *m, ssData *d, ssError *err);
+
+/* Remove a system from the world (from the next step on). */
+ssStatus ss_remove(const ssModel *m, ssData *d, const char *name, ssError *err);
+
+/* soil state API (valid only between steps; DESIGN 2.2) */
+ssStatus ss_soil_get_state(const ssModel *m, const ssData *d, int hfield,
+                           double *sinkage, double *plastic, double *shear,
+                           ssError *err);
+ssStatus ss_soil_set_state(const ssModel *m, ssData *d, int hfield,
+                           const double *sinkage, const double *plastic,
+                           const double *shear, ssError *err);
+ssStatus ss_soil_reset(const ssModel *m, ssData *d, int hfield, ssError *err);
+/* Undeformed heights (nx*ny), valid for rigid maps too. */
+const double *ss_hfield_heights(const ssModel *m, int hfield);
+/* Height edits: allowed on rigid maps, SS_ERR_STATE on soil beds. */
+ssStatus ss_hfield_set_heights(ssModel *m, int hfield, const double *h,
+                               ssError *err);
+/* Recompute hfield_zrange after the heights changed (builders call it). */
+void ss_hfield_update_range(ssModel *m, int hfield);
+ssStatus ss_hfield_set_pose(const ssModel *m, ssData *d, int hfield,
+                            const double pos[3], const double quat[4],
+                            ssError *err);
+/* Current surface height of vertex (i, j) in the bed frame (m). */
+double ss_hfield_surface(const ssModel *m, const ssData *d, int hfield, int i,
+                         int j);
+
+/* ---------------------------------------------------------------------- */
+/* scenes (world XML, DESIGN 4.1)                                          */
+
+/* Read a world XML scene; on success *mout and *dout own the world.
+ * Errors carry the file and line. */
+ssStatus ss_scene_load(const char *path, ssModel **mout, ssData **dout,
+                       ssError *err);
+/* Same, from a memory buffer; base_path names the file for messages and
+ * [THIS_DIR]. */
+ssStatus ss_scene_load_buffer(const char *buf, size_t len,
+                              const char *base_path, ssModel **mout,
+                              ssData **dout, ssError *err);
+/* Write the whole world (model + current state + soil arrays) as XML,
+ * atomically (temporary file, then rename). */
+ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
+                         ssError *err);
+
+/* ---------------------------------------------------------------------- */
+/* off-screen rendering (DESIGN 6)                                         */
+
+typedef enum ssColorMode {
+  SS_COLOR_SINKAGE = 0, /* bed coloured by total sinkage, with a colour bar */
+  SS_COLOR_PLASTIC,     /* bed coloured by permanent sinkage (ruts) */
+  SS_COLOR_SOIL         /* plain soil colour */
+} ssColorMode;
+
+typedef struct ssRenderOptions {
+  int width, height;        /* image size in pixels */
+  int color_mode;           /* ssColorMode */
+  double sinkage_max;       /* colour-bar full scale (m); <= 0: automatic */
+  int camera_given;         /* 1: use the camera below, else the model's
+                               <camera>, else an automatic overview */
+  double camera_pos[3];
+  double camera_look_at[3];
+  double camera_fov_deg;
+  char camera_follow[128];  /* system name the camera follows ("" = none) */
+} ssRenderOptions;
+
+ssRenderOptions ss_render_options_default(void);
+
+typedef struct ssRenderer ssRenderer;
+
+/* Create the off-screen context (OSMesa, or EGL surfaceless) and load the
+ * model's meshes.  Fails early (bad size, no GL) with a clear message. */
+ssRenderer *ss_render_new(const ssModel *m, const ssRenderOptions *opt,
+                          ssError *err);
+void ss_render_free(ssRenderer *r); /* accepts NULL */
+/* Draw the current state into rgba (width*height*4, row 0 at the top). */
+ssStatus ss_render_pixels(ssRenderer *r, const ssModel *m, const ssData *d,
+                          unsigned char *rgba, ssError *err);
+/* Draw the current state and write it as a PNG, atomically. */
+ssStatus ss_render_frame(ssRenderer *r, const ssModel *m, const ssData *d,
+                         const char *png_path, ssError *err);
+/* Top-down rut map of the first soil bed (or hfield >= 0): sinkage or
+ * plastic sinkage as colour, colour bar labelled in millimetres, metre
+ * scale.  Does not need a GL context. */
+ssStatus ss_render_rut_map(const ssModel *m, const ssData *d, int hfield,
+                           int plastic, int width, int height,
+                           const char *png_path, ssError *err);
+
+/* ---------------------------------------------------------------------- */
+/* atomic output files (temporary file in the same folder, then rename)    */
+
+typedef struct ssAtomicFile {
+  void *fp;            /* FILE*, open for writing while active */
+  char path[1024];
+  char tmp_path[1040];
+} ssAtomicFile;
+
+ssStatus ss_atomic_open(ssAtomicFile *f, const char *path, ssError *err);
+/* Flush, sync, close and rename over path; on failure the old file stays. */
+ssStatus ss_atomic_commit(ssAtomicFile *f, ssError *err);
+/* Close and delete the temporary file (safe to call after commit). */
+void ss_atomic_abort(ssAtomicFile *f);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SOILSIM_H */

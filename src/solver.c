@@ -1,0 +1,404 @@
+/* solver.c -- per-contact Gauss-Seidel on the impulse-response blocks.
+ *
+ * Each sweep visits every contact once.  For contact i the others are held:
+ * its velocity without its own impulse is v0 = J u - G lambda_i, and its new
+ * impulse solves the contact law at the end-of-step velocity
+ * v = v0 + G lambda_i.  Soil points solve the implicit soil law of
+ * DESIGN 3.1 (scalar, safeguarded root finding -- never a penalty spring);
+ * rigid points a Coulomb cone.  The system velocity u is updated after each
+ * contact by W (lambda_new - lambda_old). */
+#include "solver.h"
+#include "ss_math.h"
+
+#include <float.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---------------------------------------------------------------------- */
+/* the soil point                                                          */
+
+/* Normal pressure at end-of-step normal velocity vn (DESIGN 3.1) and its
+ * derivative dP/dvn (<= 0). */
+static double soil_pressure(const ssSoilMaterial *mat, const ssContact *c,
+                            double dt, double vn, double *dP)
+{
+  double delta = -(c->g0 + dt * vn);
+  if (!(delta > 0)) {
+    *dP = 0;
+    return 0;
+  }
+  double s = c->sp + delta;
+  double pe = mat->elastic_stiffness * delta;
+  double py = ss_soil_envelope(mat, c->width, s);
+  double p, slope;
+  if (pe <= py) {
+    p = pe;
+    slope = mat->elastic_stiffness;
+  } else {
+    p = py;
+    slope = ss_soil_envelope_slope(mat, c->width, s);
+  }
+  double dpdv = -dt * slope;
+  if (vn < 0) {
+    p -= mat->damping * vn;
+    dpdv -= mat->damping;
+  }
+  *dP = dpdv;
+  return p;
+}
+
+/* lambda_n = A dt P(a + g lambda_n): one root, f increasing (g >= 0,
+ * P non-increasing).  Bracket [0, A dt P(a)]; Newton with bisection. */
+static double solve_normal(const ssSoilMaterial *mat, const ssContact *c,
+                           double dt, double a, double g, double guess,
+                           double tol, int *iters)
+{
+  double scale = c->area * dt, dP;
+  double hi = scale * soil_pressure(mat, c, dt, a, &dP);
+  if (!(hi > 0)) return 0;
+  if (!(g > 0)) return hi;
+  double lo = 0, x = guess;
+  if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
+  double ftol = tol * hi;
+  for (int it = 0; it < 100; it++) {
+    (*iters)++;
+    double P = soil_pressure(mat, c, dt, a + g * x, &dP);
+    double f = x - scale * P;
+    if (fabs(f) <= ftol) return x;
+    if (f > 0) hi = x;
+    else lo = x;
+    double fp = 1 - scale * dP * g;
+    double xn = x - f / fp;
+    if (!(xn > lo && xn < hi)) xn = 0.5 * (lo + hi);
+    if (fabs(xn - x) <= tol * x || hi - lo <= tol * hi) return xn;
+    x = xn;
+  }
+  return x;
+}
+
+/* 2x2 helpers on the tangential block */
+static void inv2(const double A[4], double R[4])
+{
+  double det = A[0] * A[3] - A[1] * A[2];
+  R[0] = A[3] / det;
+  R[1] = -A[1] / det;
+  R[2] = -A[2] / det;
+  R[3] = A[0] / det;
+}
+
+/* The tangential impulse bound of one contact as a function of its slip
+ * speed: A dt tau_max(p_n, j + dt sigma) on soil (Janosi buildup), or a
+ * constant mu lambda_n for a rigid Coulomb contact (mat == NULL). */
+typedef struct ShearBound {
+  const ssSoilMaterial *mat;
+  double scale, pn, j, dt;
+  double constant;
+} ShearBound;
+
+/* the bound at slip speed sigma and its derivative in sigma */
+static double shear_bound(const ShearBound *b, double sigma, double *slope)
+{
+  if (!b->mat) {
+    *slope = 0;
+    return b->constant;
+  }
+  double tf = b->scale * ss_soil_shear_strength(b->mat, b->pn);
+  double K = b->mat->shear_displacement, j = b->j + b->dt * sigma;
+  if (!(K > 0)) {
+    *slope = 0;
+    return tf;
+  }
+  double e = exp(-(j > 0 ? j : 0) / K);
+  *slope = tf * e / K * b->dt;
+  return tf * (1 - e);
+}
+
+/* h(sigma) = |M^-1 ct| - 1 with M = sigma I + T(sigma) G: zero at the slip
+ * speed sigma.  Returns h, its derivative *dh, and in lt the impulse
+ * -T M^-1 ct at that speed. */
+static double slip_residual(const ShearBound *b, const double G[4],
+                            const double ct[2], double sigma, double lt[2],
+                            double *dh)
+{
+  double dT;
+  double T = shear_bound(b, sigma, &dT);
+  double M[4] = {sigma + T * G[0], T * G[1], T * G[2], sigma + T * G[3]};
+  double det = M[0] * M[3] - M[1] * M[2];
+  if (!(det > 0)) {
+    lt[0] = lt[1] = 0;
+    *dh = 0;
+    return INFINITY;
+  }
+  double w0 = (M[3] * ct[0] - M[1] * ct[1]) / det;
+  double w1 = (-M[2] * ct[0] + M[0] * ct[1]) / det;
+  double wn = sqrt(w0 * w0 + w1 * w1);
+  lt[0] = -T * w0;
+  lt[1] = -T * w1;
+  /* d(M^-1 c)/dsigma = -M^-1 (I + T' G) M^-1 c */
+  double q0 = w0 + dT * (G[0] * w0 + G[1] * w1);
+  double q1 = w1 + dT * (G[2] * w0 + G[3] * w1);
+  double d0 = -(M[3] * q0 - M[1] * q1) / det;
+  double d1 = -(-M[2] * q0 + M[0] * q1) / det;
+  *dh = wn > 0 ? (w0 * d0 + w1 * d1) / wn : 0;
+  return wn - 1;
+}
+
+/* Tangential impulse of one contact for a fixed normal impulse: stick if
+ * the impulse that stops slip lies inside the bound, else the slip speed
+ * sigma in (0, |ct|] solving |w(sigma)| = sigma along the 2x2 block
+ * (maximum dissipation: the impulse opposes the resulting slip), by Newton
+ * on h(sigma) kept inside the bracket (bisection when a step leaves it). */
+static void solve_tangent(const ShearBound *b, const double ct[2],
+                          const double G[4], double tol, double lt[2],
+                          int *iters)
+{
+  double slope;
+  double speed = sqrt(ct[0] * ct[0] + ct[1] * ct[1]);
+  lt[0] = lt[1] = 0;
+  if (speed == 0) return;
+  double gmax = fabs(G[0]) + fabs(G[3]);
+  if (!(gmax > 0)) {
+    /* no response (static body): the slip is what it is */
+    double T = shear_bound(b, speed, &slope);
+    lt[0] = -T * ct[0] / speed;
+    lt[1] = -T * ct[1] / speed;
+    return;
+  }
+  double Gi[4];
+  inv2(G, Gi);
+  double ls0 = -(Gi[0] * ct[0] + Gi[1] * ct[1]);
+  double ls1 = -(Gi[2] * ct[0] + Gi[3] * ct[1]);
+  double T0 = shear_bound(b, 0, &slope);
+  if (sqrt(ls0 * ls0 + ls1 * ls1) <= T0) {
+    lt[0] = ls0;
+    lt[1] = ls1;
+    return;
+  }
+  double lo = 0, hi = speed, x = speed, tmp[2], dh;
+  for (int it = 0; it < 100; it++) {
+    (*iters)++;
+    double h = slip_residual(b, G, ct, x, tmp, &dh);
+    if (h > 0) {
+      lo = x;
+    } else {
+      hi = x;
+      lt[0] = tmp[0];
+      lt[1] = tmp[1];
+    }
+    if (fabs(h) <= tol) {
+      lt[0] = tmp[0];
+      lt[1] = tmp[1];
+      return;
+    }
+    double xn = dh < 0 ? x - h / dh : 0.5 * (lo + hi);
+    if (!(xn > lo && xn < hi)) xn = 0.5 * (lo + hi);
+    if (fabs(xn - x) <= tol * speed) {
+      slip_residual(b, G, ct, xn, lt, &dh);
+      return;
+    }
+    x = xn;
+  }
+}
+
+int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
+                         const double v0[3], double tol)
+{
+  const double *G = c->G;
+  double Gtt[4] = {G[4], G[5], G[7], G[8]};
+  int iters = 0;
+  double ln = c->lambda[0], lt[2] = {c->lambda[1], c->lambda[2]};
+  int coupled = G[1] != 0 || G[2] != 0;
+  for (int outer = 0; outer < 50; outer++) {
+    double a = v0[0] + G[1] * lt[0] + G[2] * lt[1];
+    double ln_new = solve_normal(mat, c, dt, a, G[0], ln, tol, &iters);
+    double ct[2] = {v0[1] + G[3] * ln_new, v0[2] + G[6] * ln_new};
+    double lt_new[2] = {0, 0};
+    if (ln_new > 0) {
+      ShearBound b = {mat, c->area * dt, ln_new / (c->area * dt), c->j, dt, 0};
+      solve_tangent(&b, ct, Gtt, tol, lt_new, &iters);
+    }
+    double change = fabs(ln_new - ln) + fabs(lt_new[0] - lt[0]) + fabs(lt_new[1] - lt[1]);
+    double size = fabs(ln_new) + fabs(lt_new[0]) + fabs(lt_new[1]);
+    ln = ln_new;
+    lt[0] = lt_new[0];
+    lt[1] = lt_new[1];
+    if (!coupled || change <= 1e3 * tol * size || size == 0) break;
+  }
+  c->lambda[0] = ln;
+  c->lambda[1] = lt[0];
+  c->lambda[2] = lt[1];
+  return iters;
+}
+
+/* ---------------------------------------------------------------------- */
+/* the rigid point: Coulomb cone with a normal velocity target            */
+
+static void rigid_point(ssContact *c, const double v0[3], double tol)
+{
+  const double *G = c->G;
+  if (!(G[0] > 0)) return;
+  double Gtt[4] = {G[4], G[5], G[7], G[8]};
+  double ln = c->lambda[0], lt[2] = {c->lambda[1], c->lambda[2]};
+  int iters = 0, coupled = G[1] != 0 || G[2] != 0;
+  for (int it = 0; it < 50; it++) {
+    double vn = v0[0] + G[1] * lt[0] + G[2] * lt[1];
+    double ln_new = (c->vn_target - vn) / G[0];
+    if (ln_new < 0) ln_new = 0;
+    double ct[2] = {v0[1] + G[3] * ln_new, v0[2] + G[6] * ln_new};
+    double lt_new[2] = {0, 0};
+    if (ln_new > 0) {
+      ShearBound b = {NULL, 0, 0, 0, 0, c->mu * ln_new};
+      solve_tangent(&b, ct, Gtt, tol, lt_new, &iters);
+    }
+    double change = fabs(ln_new - ln) + fabs(lt_new[0] - lt[0]) + fabs(lt_new[1] - lt[1]);
+    double size = fabs(ln_new) + fabs(lt_new[0]) + fabs(lt_new[1]);
+    ln = ln_new;
+    lt[0] = lt_new[0];
+    lt[1] = lt_new[1];
+    if (!coupled || change <= 1e3 * tol * size || size == 0) break;
+  }
+  c->lambda[0] = ln;
+  c->lambda[1] = lt[0];
+  c->lambda[2] = lt[1];
+}
+
+/* ---------------------------------------------------------------------- */
+/* sweeps                                                                  */
+
+static void contact_velocity(const ssData *d, const ssContact *c, double v[3])
+{
+  const double *J = d->jac + c->jadr, *u = d->qvel + c->vadr;
+  int nv = c->nv;
+  for (int k = 0; k < 3; k++) {
+    double s = 0;
+    for (int i = 0; i < nv; i++) s += J[k * nv + i] * u[i];
+    v[k] = s;
+  }
+}
+
+static void apply_impulse(ssData *d, const ssContact *c, const double dl[3])
+{
+  const double *W = d->jac + c->jadr + 3 * c->nv;
+  double *u = d->qvel + c->vadr;
+  for (int i = 0; i < c->nv; i++)
+    u[i] += W[3 * i] * dl[0] + W[3 * i + 1] * dl[1] + W[3 * i + 2] * dl[2];
+}
+
+static int cmp_warm(const void *a, const void *b)
+{
+  const ssWarmEntry *x = a, *y = b;
+  if (x->vertex != y->vertex) return (x->vertex > y->vertex) - (x->vertex < y->vertex);
+  return (x->geom > y->geom) - (x->geom < y->geom);
+}
+
+/* Initial impulses from last step's tractions, scaled by the current area
+ * and time step and projected into the current bounds. */
+static void warm_start(const ssModel *m, ssData *d)
+{
+  const double dt = m->opt.timestep;
+  for (int i = 0; i < d->ncontact; i++) {
+    ssContact *c = d->contact + i;
+    c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
+    if (!m->opt.terrain_warm_start || c->type != SS_CONTACT_SOIL || !d->nwarm)
+      continue;
+    ssWarmEntry key = {c->vertex, c->geom, {0, 0, 0}};
+    const ssWarmEntry *e = bsearch(&key, d->warm, (size_t)d->nwarm, sizeof key, cmp_warm);
+    if (!e) continue;
+    double scale = c->area * dt;
+    double ln = e->traction[0] > 0 ? e->traction[0] * scale : 0;
+    double lt0 = e->traction[1] * scale, lt1 = e->traction[2] * scale;
+    double lim = scale * ss_soil_shear_strength(&m->hfield_soilmat[c->hfield], ln / scale);
+    double mag = sqrt(lt0 * lt0 + lt1 * lt1);
+    if (mag > lim) {
+      lt0 *= lim / mag;
+      lt1 *= lim / mag;
+    }
+    c->lambda[0] = ln;
+    c->lambda[1] = lt0;
+    c->lambda[2] = lt1;
+    if (c->nv) apply_impulse(d, c, c->lambda);
+  }
+}
+
+/* keep this step's converged tractions for the next one */
+static ssStatus store_warm(const ssModel *m, ssData *d, ssError *err)
+{
+  const double dt = m->opt.timestep;
+  int n = 0;
+  for (int i = 0; i < d->ncontact; i++)
+    if (d->contact[i].type == SS_CONTACT_SOIL && d->contact[i].lambda[0] > 0) n++;
+  if (n > d->cap_warm) {
+    ssWarmEntry *p = realloc(d->warm, (size_t)n * sizeof *p);
+    if (!p) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
+    d->warm = p;
+    d->cap_warm = n;
+  }
+  n = 0;
+  for (int i = 0; i < d->ncontact; i++) {
+    const ssContact *c = d->contact + i;
+    if (c->type != SS_CONTACT_SOIL || !(c->lambda[0] > 0)) continue;
+    ssWarmEntry *e = d->warm + n++;
+    double inv = 1.0 / (c->area * dt);
+    e->vertex = c->vertex;
+    e->geom = c->geom;
+    e->traction[0] = c->lambda[0] * inv;
+    e->traction[1] = c->lambda[1] * inv;
+    e->traction[2] = c->lambda[2] * inv;
+  }
+  qsort(d->warm, (size_t)n, sizeof *d->warm, cmp_warm);
+  d->nwarm = n;
+  return SS_OK;
+}
+
+ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
+{
+  const double dt = m->opt.timestep, tol = m->opt.solver_tolerance;
+  const double stol = m->opt.scalar_tolerance;
+  ssStepStats *st = &d->stats;
+  st->sweeps = 0;
+  st->residual = 0;
+  st->converged = 1;
+  warm_start(m, d);
+
+  int sweeps = d->ncontact ? m->opt.solver_max_sweeps : 0;
+  for (int sweep = 0; sweep < sweeps; sweep++) {
+    double dmax = 0, lmax = 0;
+    for (int i = 0; i < d->ncontact; i++) {
+      ssContact *c = d->contact + i;
+      double v[3] = {0, 0, 0}, v0[3], old[3];
+      if (c->nv) contact_velocity(d, c, v);
+      memcpy(old, c->lambda, sizeof old);
+      ss_m3_mulv(v0, c->G, old);
+      ss_v3_sub(v0, v, v0);
+      if (c->type == SS_CONTACT_SOIL)
+        ss_solver_soil_point(&m->hfield_soilmat[c->hfield], dt, c, v0, stol);
+      else
+        rigid_point(c, v0, stol);
+      double dl[3];
+      ss_v3_sub(dl, c->lambda, old);
+      if (c->nv) apply_impulse(d, c, dl);
+      double dn = fabs(dl[0]) + fabs(dl[1]) + fabs(dl[2]);
+      double ln = fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]);
+      if (dn > dmax) dmax = dn;
+      if (ln > lmax) lmax = ln;
+    }
+    st->sweeps = sweep + 1;
+    st->residual = lmax > 0 ? dmax / lmax : 0;
+    /* a contact without a dynamic body is solved exactly in one visit */
+    if (st->residual <= tol) break;
+  }
+  st->converged = st->residual <= tol;
+
+  /* end-of-step contact velocities for the soil update */
+  for (int i = 0; i < d->ncontact; i++) {
+    ssContact *c = d->contact + i;
+    double v[3] = {0, 0, 0};
+    if (c->nv) contact_velocity(d, c, v);
+    memcpy(c->v, v, sizeof v);
+    c->loaded = c->type == SS_CONTACT_SOIL && c->lambda[0] > 0 &&
+                -(c->g0 + dt * v[0]) > 0;
+    if (c->type == SS_CONTACT_SOIL && !c->loaded)
+      c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
+  }
+  return store_warm(m, d, err);
+}

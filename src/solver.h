@@ -1,0 +1,59 @@
+/* solver.h -- per-contact Gauss-Seidel on the impulse-response blocks.
+ *
+ * Every contact couples one dynamic system (or none, for static bodies) to
+ * a static support (a soil bed, a rigid height map, a ground plane).  A
+ * contact carries its Jacobian J (3 x nv of its system, rows = contact
+ * frame n, t1, t2) and W = M^-1 J^T (nv x 3), so the velocity response to
+ * an impulse is J W.  Articulated systems plug in through the same J/W
+ * (with loop closures eliminated in W); single rigid bodies have nv = 6. */
+#ifndef SS_SOLVER_H
+#define SS_SOLVER_H
+
+#include "soilsim.h"
+
+typedef enum ssContactType {
+  SS_CONTACT_SOIL = 0, /* one soil quadrature point (DESIGN 3.1) */
+  SS_CONTACT_RIGID     /* Coulomb cone with restitution */
+} ssContactType;
+
+struct ssContact {
+  int type;          /* ssContactType */
+  int sys;           /* dynamic system, -1 if the body is static */
+  int geom;          /* collider */
+  int hfield;        /* bed or rigid height map; -1 for a ground plane */
+  int vertex;        /* soil: absolute index into the soil arrays */
+  int vadr, nv;      /* the system's velocity block */
+  long jadr;         /* offset of J (3 nv) then W (nv x 3) in ssData.jac */
+  double pos[3];     /* contact point, world */
+  double frame[9];   /* rows n, t1, t2 (world); n = bed +z / surface normal */
+  double area;       /* soil: quadrature weight A (m^2) */
+  double width;      /* soil: effective width b (m) */
+  double g0;         /* separation along n at the step start (m, > 0 above) */
+  double sp, j;      /* soil: plastic sinkage and shear before the step */
+  double G[9];       /* impulse response J W (3 x 3) */
+  double lambda[3];  /* impulse in the contact frame (N s) */
+  double mu;         /* rigid: friction coefficient */
+  double vn_target;  /* rigid: lowest allowed normal velocity (m/s) */
+  double v[3];       /* contact-frame velocity at the end of the solve */
+  int loaded;        /* soil: 1 if the point carries load at the end */
+};
+
+/* A cached traction from the previous step (warm start). */
+struct ssWarmEntry {
+  int vertex;        /* absolute soil vertex */
+  int geom;
+  double traction[3];/* impulse / (area dt), contact frame (Pa) */
+};
+
+/* Solve all contacts in d->contact; d->qvel holds the free velocity on entry
+ * and the end-of-step velocity on return.  Fills d->stats. */
+ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err);
+
+/* The per-point soil solve (exposed for tests and benchmarks): given the
+ * contact's state and the velocity v0 it would have with lambda = 0 from
+ * this contact (others held), find lambda.  Returns the number of inner
+ * iterations. */
+int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
+                         const double v0[3], double tol);
+
+#endif

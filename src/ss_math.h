@@ -1,0 +1,124 @@
+/* ss_math.h -- small inline vector, quaternion and 3x3 matrix algebra.
+ * Matrices are row-major double[9]; quaternions w, x, y, z. */
+#ifndef SS_MATH_H
+#define SS_MATH_H
+
+#include <math.h>
+#include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+static inline void ss_v3_set(double r[3], double x, double y, double z) { r[0] = x; r[1] = y; r[2] = z; }
+static inline void ss_v3_copy(double r[3], const double a[3]) { r[0] = a[0]; r[1] = a[1]; r[2] = a[2]; }
+static inline void ss_v3_add(double r[3], const double a[3], const double b[3]) { r[0] = a[0] + b[0]; r[1] = a[1] + b[1]; r[2] = a[2] + b[2]; }
+static inline void ss_v3_sub(double r[3], const double a[3], const double b[3]) { r[0] = a[0] - b[0]; r[1] = a[1] - b[1]; r[2] = a[2] - b[2]; }
+static inline void ss_v3_scale(double r[3], const double a[3], double s) { r[0] = a[0] * s; r[1] = a[1] * s; r[2] = a[2] * s; }
+/* r += a * s */
+static inline void ss_v3_addscl(double r[3], const double a[3], double s) { r[0] += a[0] * s; r[1] += a[1] * s; r[2] += a[2] * s; }
+static inline double ss_v3_dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static inline double ss_v3_norm(const double a[3]) { return sqrt(ss_v3_dot(a, a)); }
+static inline void ss_v3_cross(double r[3], const double a[3], const double b[3])
+{
+  double t0 = a[1] * b[2] - a[2] * b[1];
+  double t1 = a[2] * b[0] - a[0] * b[2];
+  double t2 = a[0] * b[1] - a[1] * b[0];
+  r[0] = t0; r[1] = t1; r[2] = t2;
+}
+static inline double ss_v3_normalize(double a[3])
+{
+  double n = ss_v3_norm(a);
+  if (n > 0) { a[0] /= n; a[1] /= n; a[2] /= n; }
+  return n;
+}
+
+/* r = M a */
+static inline void ss_m3_mulv(double r[3], const double M[9], const double a[3])
+{
+  double t0 = M[0] * a[0] + M[1] * a[1] + M[2] * a[2];
+  double t1 = M[3] * a[0] + M[4] * a[1] + M[5] * a[2];
+  double t2 = M[6] * a[0] + M[7] * a[1] + M[8] * a[2];
+  r[0] = t0; r[1] = t1; r[2] = t2;
+}
+/* r = M^T a */
+static inline void ss_m3_mulvT(double r[3], const double M[9], const double a[3])
+{
+  double t0 = M[0] * a[0] + M[3] * a[1] + M[6] * a[2];
+  double t1 = M[1] * a[0] + M[4] * a[1] + M[7] * a[2];
+  double t2 = M[2] * a[0] + M[5] * a[1] + M[8] * a[2];
+  r[0] = t0; r[1] = t1; r[2] = t2;
+}
+/* R = A B */
+static inline void ss_m3_mul(double R[9], const double A[9], const double B[9])
+{
+  double t[9];
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      t[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
+  memcpy(R, t, sizeof t);
+}
+static inline void ss_m3_transpose(double R[9], const double A[9])
+{
+  double t[9] = {A[0], A[3], A[6], A[1], A[4], A[7], A[2], A[5], A[8]};
+  memcpy(R, t, sizeof t);
+}
+/* Inverse of a general 3x3; returns the determinant (0: R untouched). */
+static inline double ss_m3_inv(double R[9], const double A[9])
+{
+  double c0 = A[4] * A[8] - A[5] * A[7];
+  double c1 = A[5] * A[6] - A[3] * A[8];
+  double c2 = A[3] * A[7] - A[4] * A[6];
+  double det = A[0] * c0 + A[1] * c1 + A[2] * c2;
+  if (det == 0) return 0;
+  double id = 1.0 / det;
+  double t[9] = {
+    c0 * id, (A[2] * A[7] - A[1] * A[8]) * id, (A[1] * A[5] - A[2] * A[4]) * id,
+    c1 * id, (A[0] * A[8] - A[2] * A[6]) * id, (A[2] * A[3] - A[0] * A[5]) * id,
+    c2 * id, (A[1] * A[6] - A[0] * A[7]) * id, (A[0] * A[4] - A[1] * A[3]) * id};
+  memcpy(R, t, sizeof t);
+  return det;
+}
+
+static inline void ss_quat_identity(double q[4]) { q[0] = 1; q[1] = q[2] = q[3] = 0; }
+static inline double ss_quat_normalize(double q[4])
+{
+  double n = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (n > 0) { q[0] /= n; q[1] /= n; q[2] /= n; q[3] /= n; }
+  else ss_quat_identity(q);
+  return n;
+}
+/* r = a * b (Hamilton product) */
+static inline void ss_quat_mul(double r[4], const double a[4], const double b[4])
+{
+  double t[4] = {
+    a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+    a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+    a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+    a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]};
+  memcpy(r, t, sizeof t);
+}
+/* Row-major rotation matrix of a unit quaternion. */
+static inline void ss_quat_to_mat(double R[9], const double q[4])
+{
+  double w = q[0], x = q[1], y = q[2], z = q[3];
+  R[0] = 1 - 2 * (y * y + z * z); R[1] = 2 * (x * y - w * z);     R[2] = 2 * (x * z + w * y);
+  R[3] = 2 * (x * y + w * z);     R[4] = 1 - 2 * (x * x + z * z); R[5] = 2 * (y * z - w * x);
+  R[6] = 2 * (x * z - w * y);     R[7] = 2 * (y * z + w * x);     R[8] = 1 - 2 * (x * x + y * y);
+}
+/* Quaternion of a rotation by angle |v| about v (exact exponential map). */
+static inline void ss_quat_from_rotvec(double q[4], const double v[3])
+{
+  double a = ss_v3_norm(v);
+  if (a < 1e-12) { q[0] = 1; q[1] = 0.5 * v[0]; q[2] = 0.5 * v[1]; q[3] = 0.5 * v[2]; ss_quat_normalize(q); return; }
+  double s = sin(0.5 * a) / a;
+  q[0] = cos(0.5 * a); q[1] = v[0] * s; q[2] = v[1] * s; q[3] = v[2] * s;
+}
+/* Quaternion of a rotation by angle about a unit axis. */
+static inline void ss_quat_from_axis_angle(double q[4], const double axis[3], double angle)
+{
+  double s = sin(0.5 * angle);
+  q[0] = cos(0.5 * angle); q[1] = axis[0] * s; q[2] = axis[1] * s; q[3] = axis[2] * s;
+}
+
+#endif /* SS_MATH_H */

@@ -1,0 +1,84 @@
+/* step.c -- one time step, stage by stage, each timed. */
+#include "soilsim.h"
+#include "dynamics.h"
+#include "solver.h"
+#include "terrain.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double now(void)
+{
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
+{
+  if (d->in_step)
+    return ss_error_set(err, SS_ERR_STATE, NULL, 0, "ss_step called re-entrantly");
+  /* keep the velocities so a failed step leaves d where it was */
+  double stack[64], *saved = m->nv <= 64 ? stack : malloc((size_t)m->nv * sizeof(double));
+  if (!saved) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
+  if (m->nv) memcpy(saved, d->qvel, (size_t)m->nv * sizeof(double));
+  d->in_step = 1;
+  double *t = d->stats.time_stage, t0 = now(), t1;
+  ssStatus st = SS_OK;
+
+  /* poses of bodies and colliders from qpos */
+  ss_forward(m, d);
+  t1 = now(); t[0] = t1 - t0; t0 = t1;
+
+  /* velocities under gravity, external loads and gyroscopic torques */
+  ss_dyn_free_velocity(m, d);
+  t1 = now(); t[1] = t1 - t0; t0 = t1;
+
+  /* soil quadrature points and rigid contacts, with their responses */
+  if ((st = ss_terrain_contacts(m, d, err))) goto fail;
+  t1 = now(); t[2] = t1 - t0; t0 = t1;
+
+  /* implicit contact impulses at the end-of-step velocity */
+  if ((st = ss_solver_solve(m, d, err))) goto fail;
+  t1 = now(); t[3] = t1 - t0; t0 = t1;
+
+  int bad = ss_dyn_check_finite(m, d);
+  if (bad >= 0) {
+    st = ss_error_set(err, SS_ERR_NUMERIC, NULL, 0,
+                      "step %ld (t = %.6g s): the velocity of '%s' became "
+                      "non-finite or absurd; the time step may be too large "
+                      "for the stiffness in the scene",
+                      d->step + 1, d->time + m->opt.timestep, m->sys_name[bad]);
+    goto fail;
+  }
+
+  /* soil sinkage, permanent ruts and shear history */
+  ss_terrain_update(m, d);
+  t1 = now(); t[4] = t1 - t0; t0 = t1;
+
+  /* positions from the new velocities */
+  ss_dyn_integrate(m, d);
+  ss_forward(m, d);
+  t1 = now(); t[5] = t1 - t0;
+
+  bad = ss_dyn_check_finite(m, d);
+  if (bad >= 0) {
+    st = ss_error_set(err, SS_ERR_NUMERIC, NULL, 0,
+                      "step %ld (t = %.6g s): the position of '%s' became "
+                      "non-finite", d->step + 1, d->time + m->opt.timestep,
+                      m->sys_name[bad]);
+    goto fail;
+  }
+  d->time += m->opt.timestep;
+  d->step++;
+  d->in_step = 0;
+  if (saved != stack) free(saved);
+  return SS_OK;
+
+fail:
+  if (m->nv) memcpy(d->qvel, saved, (size_t)m->nv * sizeof(double));
+  if (saved != stack) free(saved);
+  d->in_step = 0;
+  return st;
+}

@@ -1,0 +1,399 @@
+/* terrain.c -- contacts between colliders and the static supports (soil
+ * beds, rigid height maps, ground planes), and the soil state update.
+ *
+ * Soil quadrature (DESIGN 2.6): every bed vertex owns the cell dx x dy
+ * around it (halved on the bed's edges).  A vertex is a quadrature point of
+ * a collider when part of its cell lies inside the collider's footprint;
+ * its weight is exactly that part's area, so a plate's loaded area is its
+ * true area for any placement and heading.  The depth is measured on the
+ * vertical (bed z) line through the vertex when its cell is fully covered;
+ * for a partially covered cell it is measured through the centroid of the
+ * covered part, which lies inside the footprint (the vertex itself may lie
+ * on or beyond the footprint's edge, where the line meets a side face or
+ * misses the collider).  The soil state stays at the vertex.
+ * Only vertices inside the collider's bounding box are visited, so the cost
+ * follows the contacts, not the bed size. */
+#include "terrain.h"
+#include "collide.h"
+#include "dynamics.h"
+#include "solver.h"
+#include "ss_math.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+void ss_hfield_frame(const ssData *d, int h, double R[9], double p[3])
+{
+  ss_quat_to_mat(R, d->hfield_quat + 4 * h);
+  ss_v3_copy(p, d->hfield_pos + 3 * h);
+}
+
+/* room for one more contact and its Jacobian block; NULL when out of memory */
+static ssContact *new_contact(ssData *d, int nv)
+{
+  if (d->ncontact == d->cap_contact) {
+    int c = d->cap_contact ? 2 * d->cap_contact : 256;
+    ssContact *p = realloc(d->contact, (size_t)c * sizeof *p);
+    if (!p) return NULL;
+    d->contact = p;
+    d->cap_contact = c;
+  }
+  ssContact *c = d->contact + d->ncontact;
+  memset(c, 0, sizeof *c);
+  c->jadr = d->ncontact ? d->contact[d->ncontact - 1].jadr +
+                              6 * (long)d->contact[d->ncontact - 1].nv
+                        : 0;
+  size_t need = (size_t)c->jadr + 6 * (size_t)nv;
+  if (need > d->cap_jac) {
+    size_t cap = d->cap_jac ? 2 * d->cap_jac : 4096;
+    while (cap < need) cap *= 2;
+    double *q = realloc(d->jac, cap * sizeof(double));
+    if (!q) return NULL;
+    d->jac = q;
+    d->cap_jac = cap;
+  }
+  c->nv = nv;
+  d->ncontact++;
+  return c;
+}
+
+/* fill the system-dependent part of a contact: Jacobian, response, G */
+static void attach(const ssModel *m, ssData *d, ssContact *c, int sys)
+{
+  if (sys >= 0 && c->nv > 0) {
+    c->sys = sys;
+    c->vadr = m->sys_vadr[sys];
+    double *J = d->jac + c->jadr, *W = J + 3 * c->nv;
+    ss_dyn_contact_jacobian(m, d, sys, c->pos, c->frame, J, W, c->G);
+  } else {
+    c->sys = -1;
+    c->nv = 0;
+    memset(c->G, 0, sizeof c->G);
+  }
+}
+
+/* the collider of geom g expressed in a frame (R, p) */
+static void shape_in_frame(const ssModel *m, const ssData *d, int g,
+                           const double R[9], const double p[3], ssShape *s)
+{
+  double rel[3];
+  s->type = m->geom_type[g];
+  memcpy(s->size, m->geom_size + 3 * g, 3 * sizeof(double));
+  ss_v3_sub(rel, d->geom_xpos + 3 * g, p);
+  ss_m3_mulvT(s->pos, R, rel);
+  double Rt[9];
+  ss_m3_transpose(Rt, R);
+  ss_m3_mul(s->R, Rt, d->geom_xmat + 9 * g);
+}
+
+static double geom_radius(const ssModel *m, int g)
+{
+  const double *s = m->geom_size + 3 * g;
+  switch (m->geom_type[g]) {
+  case SS_GEOM_BOX: return 0.5 * sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+  case SS_GEOM_SPHERE: return s[0];
+  case SS_GEOM_CYLINDER: return sqrt(s[0] * s[0] + 0.25 * s[1] * s[1]);
+  case SS_GEOM_CAPSULE: return s[0] + 0.5 * s[1];
+  default: return s[0];
+  }
+}
+
+/* How far a collider can travel towards a support in one step plus the
+ * configured margin: points closer than this become contacts, so no
+ * contact is missed by the implicit end-of-step solve. */
+static double geom_margin(const ssModel *m, const ssData *d, int g, int sys)
+{
+  double reach = m->opt.contact_margin;
+  if (sys >= 0 && m->sys_nv[sys] > 0) {
+    const double *u = d->qvel + m->sys_vadr[sys];
+    double r[3];
+    ss_v3_sub(r, d->geom_xpos + 3 * g, d->body_xpos + 3 * m->geom_body[g]);
+    reach += m->opt.timestep *
+             (ss_v3_norm(u) + ss_v3_norm(u + 3) * (ss_v3_norm(r) + geom_radius(m, g)));
+  }
+  return reach;
+}
+
+static void frame_from_bed(const double R[9], double frame[9])
+{
+  /* rows n = bed z, t1 = bed x, t2 = bed y (columns of R) */
+  for (int k = 0; k < 3; k++) {
+    frame[k] = R[3 * k + 2];
+    frame[3 + k] = R[3 * k];
+    frame[6 + k] = R[3 * k + 1];
+  }
+}
+
+static void frame_from_normal(const double n[3], double frame[9])
+{
+  double t1[3], t2[3], a[3] = {1, 0, 0};
+  if (fabs(n[0]) > 0.8) ss_v3_set(a, 0, 1, 0);
+  ss_v3_cross(t1, a, n);
+  ss_v3_normalize(t1);
+  ss_v3_cross(t2, n, t1);
+  memcpy(frame, n, 3 * sizeof(double));
+  memcpy(frame + 3, t1, 3 * sizeof(double));
+  memcpy(frame + 6, t2, 3 * sizeof(double));
+}
+
+/* quadrature points of geom g on soil bed h */
+static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
+                              int sys, const double R[9], const double p[3],
+                              ssError *err)
+{
+  ssShape s;
+  shape_in_frame(m, d, g, R, p, &s);
+  double lo[3], hi[3];
+  ss_shape_aabb(&s, lo, hi);
+  double margin = geom_margin(m, d, g, sys);
+  if (lo[2] > m->hfield_zrange[2 * h + 1] + margin) return SS_OK;
+
+  int nx = m->hfield_nx[h], ny = m->hfield_ny[h], adr = m->hfield_adr[h];
+  double xs = m->hfield_size[2 * h], ys = m->hfield_size[2 * h + 1];
+  double dx = xs / (nx - 1), dy = ys / (ny - 1);
+  double x0 = m->hfield_center[2 * h] - 0.5 * xs;
+  double y0 = m->hfield_center[2 * h + 1] - 0.5 * ys;
+  /* vertices whose cells overlap the bounding box */
+  int i0 = (int)ceil((lo[0] - x0) / dx - 0.5), i1 = (int)floor((hi[0] - x0) / dx + 0.5);
+  int j0 = (int)ceil((lo[1] - y0) / dy - 0.5), j1 = (int)floor((hi[1] - y0) / dy + 0.5);
+  if (i1 < 0 || j1 < 0 || i0 > nx - 1 || j0 > ny - 1) return SS_OK;
+  if (i0 < 0) i0 = 0;
+  if (j0 < 0) j0 = 0;
+  if (i1 > nx - 1) i1 = nx - 1;
+  if (j1 > ny - 1) j1 = ny - 1;
+
+  ssPoly2 fp;
+  ss_shape_footprint(&s, &fp);
+  double up[3] = {0, 0, 1};
+  double width = ss_shape_width(&s, up);
+  double frame[9];
+  frame_from_bed(R, frame);
+  int nv = sys >= 0 ? m->sys_nv[sys] : 0;
+  const double *z0 = m->hfield_data + adr;
+  const double *sp = d->soil_plastic + adr, *jj = d->soil_shear + adr;
+  double tiny = 1e-12 * dx * dy;
+
+  for (int j = j0; j <= j1; j++) {
+    double y = y0 + j * dy;
+    double cy0 = j == 0 ? y : y - 0.5 * dy, cy1 = j == ny - 1 ? y : y + 0.5 * dy;
+    for (int i = i0; i <= i1; i++) {
+      double x = x0 + i * dx;
+      double cx0 = i == 0 ? x : x - 0.5 * dx, cx1 = i == nx - 1 ? x : x + 0.5 * dx;
+      double qx, qy;
+      double area = ss_poly_rect_area(&fp, cx0, cx1, cy0, cy1, &qx, &qy);
+      if (!(area > tiny)) continue;
+      /* the point represents the covered part of the cell: the vertex when
+       * the cell is fully covered, else the covered part's centroid (a
+       * vertex on or outside the footprint's edge would see a side face) */
+      double full = (cx1 - cx0) * (cy1 - cy0);
+      if (area >= full * (1 - 1e-9)) {
+        qx = x;
+        qy = y;
+      }
+      double zl;
+      if (!ss_shape_lowest_z(&s, qx, qy, &zl)) continue;
+      int k = j * nx + i;
+      double floor_z = z0[k] - sp[k];
+      double g0 = zl - floor_z;
+      if (g0 > margin) continue;
+      ssContact *c = new_contact(d, nv);
+      if (!c) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
+      c->type = SS_CONTACT_SOIL;
+      c->geom = g;
+      c->hfield = h;
+      c->vertex = adr + k;
+      double pl[3] = {qx, qy, zl};
+      ss_m3_mulv(c->pos, R, pl);
+      ss_v3_add(c->pos, c->pos, p);
+      memcpy(c->frame, frame, sizeof frame);
+      c->area = area;
+      c->width = width;
+      c->g0 = g0;
+      c->sp = sp[k];
+      c->j = jj[k];
+      attach(m, d, c, sys);
+    }
+  }
+  return SS_OK;
+}
+
+/* bilinear height and upward normal of rigid height map h at local (x, y);
+ * 0 outside the map */
+static int hfield_sample(const ssModel *m, int h, double x, double y,
+                         double *z, double n[3])
+{
+  int nx = m->hfield_nx[h], ny = m->hfield_ny[h];
+  double xs = m->hfield_size[2 * h], ys = m->hfield_size[2 * h + 1];
+  double dx = xs / (nx - 1), dy = ys / (ny - 1);
+  double u = (x - (m->hfield_center[2 * h] - 0.5 * xs)) / dx;
+  double v = (y - (m->hfield_center[2 * h + 1] - 0.5 * ys)) / dy;
+  if (!(u >= 0 && v >= 0 && u <= nx - 1 && v <= ny - 1)) return 0;
+  int i = (int)u, j = (int)v;
+  if (i > nx - 2) i = nx - 2;
+  if (j > ny - 2) j = ny - 2;
+  double fu = u - i, fv = v - j;
+  const double *zz = m->hfield_data + m->hfield_adr[h];
+  double z00 = zz[j * nx + i], z10 = zz[j * nx + i + 1];
+  double z01 = zz[(j + 1) * nx + i], z11 = zz[(j + 1) * nx + i + 1];
+  *z = (1 - fv) * ((1 - fu) * z00 + fu * z10) + fv * ((1 - fu) * z01 + fu * z11);
+  double gx = ((1 - fv) * (z10 - z00) + fv * (z11 - z01)) / dx;
+  double gy = ((1 - fu) * (z01 - z00) + fu * (z11 - z10)) / dy;
+  ss_v3_set(n, -gx, -gy, 1);
+  ss_v3_normalize(n);
+  return 1;
+}
+
+/* Coulomb contacts of geom g against a rigid surface: candidate points of
+ * the collider tested against the surface (plane when h < 0). */
+static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
+                               int g, int sys, ssError *err)
+{
+  double R[9], p[3];
+  if (h >= 0) {
+    ss_hfield_frame(d, h, R, p);
+  } else {
+    double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    memcpy(R, I, sizeof I);
+    ss_v3_set(p, 0, 0, m->plane_height[plane]);
+  }
+  ssShape s;
+  shape_in_frame(m, d, g, R, p, &s);
+  double lo[3], hi[3];
+  ss_shape_aabb(&s, lo, hi);
+  double margin = geom_margin(m, d, g, sys);
+  double top = h >= 0 ? m->hfield_zrange[2 * h + 1] : 0;
+  if (lo[2] > top + margin) return SS_OK;
+
+  double up[3] = {0, 0, 1}, pts[32][3];
+  int npt = ss_shape_candidates(&s, up, pts, 32);
+  int mat = h >= 0 ? m->hfield_material[h] : m->plane_material[plane];
+  const ssMaterialPair *pair = ss_model_pair(m, m->geom_material[g], mat);
+  int nv = sys >= 0 ? m->sys_nv[sys] : 0;
+  for (int k = 0; k < npt; k++) {
+    double zs = 0, nl[3] = {0, 0, 1};
+    if (h >= 0 && !hfield_sample(m, h, pts[k][0], pts[k][1], &zs, nl)) continue;
+    double gap = (pts[k][2] - zs) * nl[2];
+    if (gap > margin) continue;
+    ssContact *c = new_contact(d, nv);
+    if (!c) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
+    c->type = SS_CONTACT_RIGID;
+    c->geom = g;
+    c->hfield = h;
+    c->vertex = -1;
+    ss_m3_mulv(c->pos, R, pts[k]);
+    ss_v3_add(c->pos, c->pos, p);
+    double nw[3];
+    ss_m3_mulv(nw, R, nl);
+    frame_from_normal(nw, c->frame);
+    c->g0 = gap;
+    c->mu = pair->friction;
+    /* lowest allowed end-of-step normal velocity: close a gap, remove a
+     * fraction of a penetration, or bounce */
+    double dt = m->opt.timestep;
+    c->vn_target = gap >= 0 ? -gap / dt : -m->opt.rigid_erp * gap / dt;
+    if (sys >= 0 && nv > 0 && gap <= m->opt.contact_margin) {
+      double v[3];
+      ss_dyn_point_velocity(m, d, sys, c->pos, v);
+      double vn = ss_v3_dot(v, nw);
+      if (pair->restitution > 0 && vn < -pair->restitution_threshold &&
+          -pair->restitution * vn > c->vn_target)
+        c->vn_target = -pair->restitution * vn;
+    }
+    attach(m, d, c, sys);
+  }
+  return SS_OK;
+}
+
+ssStatus ss_terrain_contacts(const ssModel *m, ssData *d, ssError *err)
+{
+  d->ncontact = 0;
+  for (int g = 0; g < m->ngeom; g++) {
+    int sys = m->body_sys[m->geom_body[g]];
+    if (!d->sys_active[sys]) continue;
+    int dyn = m->sys_nv[sys] > 0;
+    ssStatus st;
+    for (int h = 0; h < m->nhfield; h++) {
+      if (m->hfield_soil[h]) {
+        double R[9], p[3];
+        ss_hfield_frame(d, h, R, p);
+        st = soil_contacts(m, d, h, g, dyn ? sys : -1, R, p, err);
+      } else {
+        /* a static body cannot push on a rigid support */
+        if (!dyn) continue;
+        st = rigid_contacts(m, d, h, -1, g, sys, err);
+      }
+      if (st) return st;
+    }
+    if (!dyn) continue;
+    for (int pl = 0; pl < m->nplane; pl++)
+      if ((st = rigid_contacts(m, d, -1, pl, g, sys, err))) return st;
+  }
+  return SS_OK;
+}
+
+static int cmp_int(const void *a, const void *b)
+{
+  int x = *(const int *)a, y = *(const int *)b;
+  return (x > y) - (x < y);
+}
+
+void ss_terrain_update(const ssModel *m, ssData *d)
+{
+  const double dt = m->opt.timestep;
+  ssStepStats *st = &d->stats;
+  st->soil_contacts = st->soil_loaded = 0;
+  st->soil_contact_area = st->soil_normal_force = 0;
+  st->rigid_contacts = 0;
+
+  /* unloaded vertices recover elastically to the rut floor at once */
+  for (int k = 0; k < d->nsoil_loaded; k++) {
+    int v = d->soil_loaded[k];
+    d->soil_sinkage[v] = d->soil_plastic[v];
+    d->soil_shear[v] = 0;
+  }
+  int nload = 0;
+  for (int i = 0; i < d->ncontact; i++) {
+    ssContact *c = d->contact + i;
+    if (c->type != SS_CONTACT_SOIL) {
+      st->rigid_contacts++;
+      continue;
+    }
+    st->soil_contacts++;
+    if (!c->loaded) continue;
+    const ssSoilMaterial *mat = &m->hfield_soilmat[c->hfield];
+    double delta = -(c->g0 + dt * c->v[0]);
+    double s = c->sp + delta;
+    double spn = ss_soil_plastic_update(mat, c->width, s, c->sp);
+    double jn = c->j + dt * sqrt(c->v[1] * c->v[1] + c->v[2] * c->v[2]);
+    int v = c->vertex;
+    /* two colliders on one vertex: the deeper imprint wins */
+    if (s > d->soil_sinkage[v]) d->soil_sinkage[v] = s;
+    if (spn > d->soil_plastic[v]) d->soil_plastic[v] = spn;
+    if (jn > d->soil_shear[v]) d->soil_shear[v] = jn;
+    st->soil_loaded++;
+    st->soil_contact_area += c->area;
+    st->soil_normal_force += c->lambda[0] / dt;
+    nload++;
+  }
+  /* the new list of loaded vertices (unique) */
+  if (nload > d->cap_soil_loaded) {
+    int *p = realloc(d->soil_loaded, (size_t)nload * sizeof(int));
+    if (!p) {
+      /* keep the old list: worst case some vertices recover a step late */
+      return;
+    }
+    d->soil_loaded = p;
+    d->cap_soil_loaded = nload;
+  }
+  int n = 0;
+  for (int i = 0; i < d->ncontact; i++) {
+    const ssContact *c = d->contact + i;
+    if (c->type == SS_CONTACT_SOIL && c->loaded) d->soil_loaded[n++] = c->vertex;
+  }
+  qsort(d->soil_loaded, (size_t)n, sizeof(int), cmp_int);
+  int u = 0;
+  for (int i = 0; i < n; i++)
+    if (u == 0 || d->soil_loaded[u - 1] != d->soil_loaded[i])
+      d->soil_loaded[u++] = d->soil_loaded[i];
+  d->nsoil_loaded = u;
+}

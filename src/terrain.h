@@ -1,0 +1,17 @@
+/* terrain.h -- contact generation on soil beds, rigid height maps and ground
+ * planes (quadrature of DESIGN 2.6), and the soil state update after the
+ * solve. */
+#ifndef SS_TERRAIN_H
+#define SS_TERRAIN_H
+
+#include "soilsim.h"
+
+/* Build d->contact for the current positions (d->ncontact). */
+ssStatus ss_terrain_contacts(const ssModel *m, ssData *d, ssError *err);
+/* After the solve: update sinkage, plastic sinkage and shear of every soil
+ * vertex touched (DESIGN 3.1, last paragraph), and step statistics. */
+void ss_terrain_update(const ssModel *m, ssData *d);
+/* Bed-frame <-> world transforms of height map h for the current pose. */
+void ss_hfield_frame(const ssData *d, int h, double R[9], double p[3]);
+
+#endif

@@ -1,0 +1,302 @@
+#!/bin/sh
+# test_cli.sh -- TAP tests of the soilsim command line (DESIGN 4.3).
+#
+# make check sets top_srcdir and top_builddir (absolute); by hand:
+#   top_srcdir=. top_builddir=build sh tests/test_cli.sh
+# Checks exit statuses (0 ok, 1 bad input or failed run, 2 bad usage), the
+# file:line of input errors, that failed runs leave no output and never
+# damage an existing one, determinism of exports, the export/reload round
+# trip, and the CSV layout.
+
+# The checks are shell expressions in single quotes, expanded by eval.
+# shellcheck disable=SC2016
+
+top_srcdir=${top_srcdir:-.}
+top_builddir=${top_builddir:-.}
+SOILSIM=$top_builddir/soilsim
+PLATE=$top_srcdir/scenes/plate.xml
+
+if [ ! -x "$SOILSIM" ]; then
+  echo "Bail out! $SOILSIM is not built"
+  exit 1
+fi
+
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/soilsim-cli.XXXXXX") || {
+  echo "Bail out! mktemp -d failed"
+  exit 1
+}
+trap 'rm -rf "$tmp"' EXIT
+trap 'exit 130' INT TERM HUP
+
+# Every run is bounded so that a hang fails instead of stalling make check.
+TIMEOUT=""
+if command -v timeout >/dev/null 2>&1; then TIMEOUT="timeout 120"; fi
+
+n=0
+nfail=0
+last_cmd=""
+rc=0
+
+# run ARGS...: soilsim with stdout/stderr in $tmp/out, $tmp/err; sets rc.
+# CI is cleared so that nothing depends on the caller's environment.
+run() {
+  last_cmd="soilsim $*"
+  # shellcheck disable=SC2086
+  CI='' $TIMEOUT "$SOILSIM" "$@" >"$tmp/out" 2>"$tmp/err"
+  rc=$?
+}
+
+# check DESC EXPR: one TAP line; EXPR is evaluated by the shell.
+check() {
+  n=$((n + 1))
+  desc=$(printf '%s' "$1" | sed 's/#/\\#/g')
+  if eval "$2"; then
+    echo "ok $n - $desc"
+  else
+    echo "not ok $n - $desc"
+    nfail=$((nfail + 1))
+    echo "#   last command: $last_cmd (exit $rc)"
+    sed -n '1,8s/^/#   stderr: /p' "$tmp/err"
+    sed -n '1,4s/^/#   stdout: /p' "$tmp/out"
+  fi
+}
+
+skip() {
+  n=$((n + 1))
+  echo "ok $n # SKIP $1"
+}
+
+rc_is() { [ "$rc" -eq "$1" ]; }
+err_has() { grep -qF -- "$1" "$tmp/err"; }
+out_has() { grep -qF -- "$1" "$tmp/out"; }
+no_file() { [ ! -e "$1" ]; }
+# no temporary files of the atomic writer left in a folder
+no_tmp() {
+  for f in "$1"/*.tmp[0-9]* "$1"/.*.tmp[0-9]*; do
+    [ -e "$f" ] && return 1
+  done
+  return 0
+}
+usage_error() { rc_is 2 && err_has "try 'soilsim --help'"; }
+
+# ---------------------------------------------------------------------
+# help, version, usage errors (exit 2), no scene needed
+
+run --help
+check "--help exits 0 and lists every option" \
+  'rc_is 0 && out_has "usage: soilsim" && out_has "--steps" && out_has "--export" &&
+   out_has "--csv" && out_has "--remove" && out_has "--render" &&
+   out_has "--render-every" && out_has "--size" && out_has "--rut-map" &&
+   out_has "--quiet" && out_has "--version"'
+run --version
+check "--version prints 'soilsim 0.1.0' and exits 0" \
+  'rc_is 0 && [ "$(cat "$tmp/out")" = "soilsim 0.1.0" ]'
+run
+check "no arguments: usage error (exit 2)" 'usage_error && err_has "no scene"'
+run "$PLATE" --bogus
+check "unknown option: exit 2 naming it" 'usage_error && err_has "--bogus"'
+run "$PLATE" --bogus=3
+check "unknown option in --opt=value form: exit 2" 'usage_error && err_has "--bogus"'
+run "$PLATE" -x
+check "unknown short option: exit 2" 'usage_error && err_has "-x"'
+run "$PLATE" --steps
+check "missing value at the end: exit 2" 'usage_error && err_has "--steps"'
+run "$PLATE" --export --csv "$tmp/a.csv"
+check "an option in place of a value: exit 2" \
+  'usage_error && err_has "--export" && no_file "$tmp/--csv"'
+run "$PLATE" --steps=
+check "empty --steps= value: exit 2" 'usage_error'
+for v in abc -1 10x 1e3 "" 99999999999999999999999; do
+  run "$PLATE" --steps "$v"
+  check "--steps '$v' is rejected (exit 2)" 'usage_error'
+done
+for v in 0x10 640 x480 640x 640x480x2 -640x480 20000x100 axb; do
+  run "$PLATE" --size "$v" --rut-map "$tmp/r.png"
+  check "--size '$v' is rejected (exit 2)" 'usage_error && err_has "--size"'
+done
+for v in plate @5 plate@ plate@x plate@-1 plate@1.5; do
+  run "$PLATE" --remove "$v"
+  check "--remove '$v' is rejected (exit 2)" 'usage_error && err_has "--remove"'
+done
+run "$PLATE" --remove plate@5 --remove plate@7
+check "--remove naming the same system twice: exit 2" 'usage_error'
+run "$PLATE" --steps 10 --remove plate@11
+check "--remove after the last step: exit 2" 'usage_error && err_has "plate@11"'
+run "$PLATE" --render-every 0 --render "$tmp/f0"
+check "--render-every 0 is rejected (exit 2)" 'usage_error && no_file "$tmp/f0"'
+run "$PLATE" --render-every 5
+check "--render-every without --render: exit 2" 'usage_error'
+run "$PLATE" "$PLATE"
+check "two scene files: exit 2" 'usage_error'
+run "$PLATE" --quiet=1
+check "a value given to a flag: exit 2" 'usage_error && err_has "--quiet"'
+run "$PLATE" --export "$tmp/same" --csv "$tmp/same"
+check "--export and --csv on one path: exit 2" 'usage_error'
+
+# ---------------------------------------------------------------------
+# bad input (exit 1): the message names the file and the line
+
+run "$tmp/no-such-scene.xml" --steps 1
+check "missing scene file: exit 1 naming the file" \
+  'rc_is 1 && err_has "no-such-scene.xml" && err_has "error:"'
+
+# Every file in tests/data/bad starts with <!-- expect: LINE: SUBSTRING -->.
+nbad=0
+for f in "$top_srcdir"/tests/data/bad/*.xml; do
+  [ -f "$f" ] || continue
+  nbad=$((nbad + 1))
+  b=$(basename "$f")
+  first=$(sed -n 1p "$f")
+  line=$(printf '%s\n' "$first" |
+    sed -n 's/^<!-- *expect: *\([0-9][0-9]*\): .*-->.*$/\1/p')
+  sub=$(printf '%s\n' "$first" |
+    sed -n 's/^<!-- *expect: *[0-9][0-9]*: *\(.*[^ ]\) *-->.*$/\1/p')
+  if [ -z "$line" ] || [ -z "$sub" ]; then
+    check "bad/$b has an expect line ('<!-- expect: LINE: SUBSTRING -->')" false
+    continue
+  fi
+  if [ "$line" -gt 0 ]; then where="$b:$line:"; else where="$b: "; fi
+  rm -f "$tmp/bad.xml" "$tmp/bad.csv"
+  run "$f" --steps 5 --export "$tmp/bad.xml" --csv "$tmp/bad.csv"
+  check "bad/$b: exit 1, '$where', '$sub', no output files" \
+    'rc_is 1 && err_has "$where" && err_has "$sub" && err_has "error:" &&
+     no_file "$tmp/bad.xml" && no_file "$tmp/bad.csv" && no_tmp "$tmp"'
+done
+[ "$nbad" -gt 0 ] || skip "no files in tests/data/bad"
+
+run "$PLATE" --steps 2000000000 --csv "$tmp/u.csv" --remove nosuchbody@0
+check "--remove of an unknown name: exit 1 before stepping, lists the systems" \
+  'rc_is 1 && err_has "nosuchbody" && err_has "plate" && no_file "$tmp/u.csv" &&
+   no_tmp "$tmp"'
+
+run "$PLATE" --steps 2000000000 --export /nonexistent/dir/x.xml
+check "unwritable --export path: exit 1 before stepping, names the path" \
+  'rc_is 1 && err_has "/nonexistent/dir/x.xml" && no_file /nonexistent/dir/x.xml'
+run "$PLATE" --steps 2000000000 --csv /nonexistent/dir/x.csv
+check "unwritable --csv path: exit 1 before stepping" \
+  'rc_is 1 && err_has "/nonexistent/dir/x.csv"'
+run "$PLATE" --steps 2000000000 --export "$tmp"
+check "--export naming a directory: exit 1 before stepping" \
+  'rc_is 1 && err_has "directory"'
+: >"$tmp/plainfile"
+run "$PLATE" --steps 2000000000 --render "$tmp/plainfile/frames"
+check "--render folder that cannot be created: exit 1 before stepping" \
+  'rc_is 1 && err_has "plainfile" && no_tmp "$tmp"'
+
+# A failed run never touches an existing output file.
+cat >"$tmp/broken.xml" <<'EOF'
+<raisim version="1.0">
+  <timeStep value="0.001"/>
+  <objects>
+    <box name="b" mass="1"> <dim x="1" y="1" z="1"/>
+</raisim>
+EOF
+echo "precious export" >"$tmp/keep.xml"
+echo "precious csv" >"$tmp/keep.csv"
+run "$tmp/broken.xml" --steps 5 --export "$tmp/keep.xml" --csv "$tmp/keep.csv"
+check "failed run: exit 1 and the existing --export/--csv files stay intact" \
+  'rc_is 1 && err_has "broken.xml" && [ "$(cat "$tmp/keep.xml")" = "precious export" ] &&
+   [ "$(cat "$tmp/keep.csv")" = "precious csv" ] && no_tmp "$tmp"'
+
+# A step that fails (the state becomes non-finite) ends the run: exit 1,
+# no outputs, existing files untouched.
+cat >"$tmp/blowup.xml" <<'EOF'
+<raisim version="1.0">
+  <timeStep value="0.001"/>
+  <gravity value="0 0 -1e306"/>
+  <objects>
+    <box name="b" mass="1"> <dim x="0.1" y="0.1" z="0.1"/>
+      <state pos="0 0 1" lin_vel="0 0 -1.7e308"/> </box>
+  </objects>
+</raisim>
+EOF
+rm -f "$tmp/blow.csv"
+run "$tmp/blowup.xml" --steps 10 --export "$tmp/keep.xml" --csv "$tmp/blow.csv"
+check "failed step: exit 1 naming the step, no CSV, existing export intact" \
+  'rc_is 1 && err_has "blowup.xml" && err_has "step" && no_file "$tmp/blow.csv" &&
+   [ "$(cat "$tmp/keep.xml")" = "precious export" ] && no_tmp "$tmp"'
+
+# ---------------------------------------------------------------------
+# successful runs
+
+N=300
+run "$PLATE" --steps $N --export "$tmp/a.xml" --csv "$tmp/a.csv"
+check "plate.xml, $N steps with --export and --csv: exit 0, quiet stderr" \
+  'rc_is 0 && [ -s "$tmp/a.xml" ] && [ -s "$tmp/a.csv" ] && [ ! -s "$tmp/err" ] &&
+   no_tmp "$tmp"'
+check "the summary names the outputs written" \
+  'out_has "$tmp/a.xml" && out_has "$tmp/a.csv" && out_has "steps"'
+run "$PLATE" --steps=$N --export="$tmp/b.xml" --quiet
+check "--opt=value forms and --quiet: exit 0, nothing on stdout or stderr" \
+  'rc_is 0 && [ ! -s "$tmp/out" ] && [ ! -s "$tmp/err" ]'
+check "two runs give byte-identical exports" 'cmp -s "$tmp/a.xml" "$tmp/b.xml"'
+
+run "$tmp/a.xml" --steps 0 --export "$tmp/c.xml" --quiet
+check "export, reload with --steps 0, export again: identical files" \
+  'rc_is 0 && cmp -s "$tmp/a.xml" "$tmp/c.xml"'
+
+head -n 1 "$tmp/a.csv" >"$tmp/header"
+check "CSV header: the statistics columns, then plate.x,plate.y,plate.z" \
+  '[ "$(cat "$tmp/header")" = "step,time,soil_contacts,soil_contact_area,soil_normal_force,sweeps,plate.x,plate.y,plate.z" ]'
+check "CSV has one row per step ($N rows)" \
+  '[ "$(sed 1d "$tmp/a.csv" | wc -l)" -eq $N ]'
+check "CSV rows are numbered 1..$N and have as many fields as the header" \
+  'awk -F, -v n=$N "NR == 1 { nf = NF; next }
+     NF != nf || \$1 != NR - 1 { bad = 1 }
+     END { exit bad || NR != n + 1 }" "$tmp/a.csv"'
+check "CSV: the plate has sunk into the soil (z below 0.025 at the end)" \
+  'tail -n 1 "$tmp/a.csv" | awk -F, "{ exit !(\$9 < 0.025 && \$9 > 0) }"'
+
+# A removed system keeps its columns, empty from the row after its step.
+run "$PLATE" --steps 20 --csv "$tmp/r.csv" --remove plate@10 --quiet
+check "--remove plate@10: exit 0; rows 1..10 have positions, 11..20 are empty" \
+  'rc_is 0 && awk -F, "NR == 1 { next }
+     NR <= 11 && \$7 == \"\" { bad = 1 }
+     NR > 11 && (\$7 != \"\" || \$8 != \"\" || \$9 != \"\") { bad = 1 }
+     END { exit bad || NR != 21 }" "$tmp/r.csv"'
+run "$PLATE" --steps 5 --csv "$tmp/r0.csv" --remove plate@0 --quiet
+check "--remove plate@0 applies before the first step" \
+  'rc_is 0 && awk -F, "NR > 1 && \$7 != \"\" { bad = 1 } END { exit bad }" "$tmp/r0.csv"'
+
+run "$PLATE" --steps 0 --export "$tmp/zero.xml" --csv "$tmp/zero.csv" --quiet
+check "--steps 0: exit 0, export written, CSV has only its header" \
+  'rc_is 0 && [ -s "$tmp/zero.xml" ] && [ "$(wc -l <"$tmp/zero.csv")" -eq 1 ]'
+
+# An existing output file is replaced whole.
+echo "old" >"$tmp/old.xml"
+run "$PLATE" --steps 10 --export "$tmp/old.xml" --quiet
+check "an existing --export file is replaced" \
+  'rc_is 0 && ! grep -q "^old$" "$tmp/old.xml" && grep -q "<raisim" "$tmp/old.xml"'
+
+# ---------------------------------------------------------------------
+# images: --render frames and --rut-map (PNG signature checked)
+
+is_png() { [ "$(head -c 4 "$1" 2>/dev/null | od -An -c | tr -d ' \n')" = "211PNG" ]; }
+
+run "$PLATE" --steps 10 --rut-map "$tmp/rut.png" --size 200x150 --quiet
+check "--rut-map writes a PNG" 'rc_is 0 && is_png "$tmp/rut.png"'
+run "$PLATE" --steps 10 --render "$tmp/frames/sub" --render-every 4 \
+  --size 160x120 --quiet
+check "--render creates the folder; frames 0, 4, 8 and the last step (10)" \
+  'rc_is 0 && is_png "$tmp/frames/sub/frame_000000.png" &&
+   is_png "$tmp/frames/sub/frame_000004.png" &&
+   is_png "$tmp/frames/sub/frame_000008.png" &&
+   is_png "$tmp/frames/sub/frame_000010.png" &&
+   [ "$(ls "$tmp/frames/sub" | wc -l)" -eq 4 ]'
+
+cat >"$tmp/nosoil.xml" <<'EOF'
+<raisim version="1.0">
+  <timeStep value="0.001"/>
+  <objects>
+    <ground name="ground" height="0"/>
+    <box name="b" mass="1"> <dim x="0.1" y="0.1" z="0.1"/>
+      <state pos="0 0 0.05"/> </box>
+  </objects>
+</raisim>
+EOF
+run "$tmp/nosoil.xml" --steps 2000000000 --rut-map "$tmp/none.png"
+check "--rut-map on a scene without a soil bed: exit 1 before stepping" \
+  'rc_is 1 && err_has "soil" && no_file "$tmp/none.png"'
+
+echo "1..$n"
+[ "$nfail" -eq 0 ]

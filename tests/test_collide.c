@@ -1,0 +1,722 @@
+/* test_collide.c -- footprints, cell quadrature weights, exact vertical ray
+ * casts, contact candidates, widths and bounds of the collider shapes
+ * (DESIGN 2.4, 2.6), checked against closed forms. */
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "collide.h"
+#include "ss_math.h"
+#include "tap.h"
+
+#define PI 3.14159265358979323846
+
+/* deterministic xorshift64* so every run sees the same scenes */
+static uint64_t rng_state = 0x9e3779b97f4a7c15ull;
+
+static double urand(double lo, double hi)
+{
+  rng_state ^= rng_state >> 12;
+  rng_state ^= rng_state << 25;
+  rng_state ^= rng_state >> 27;
+  uint64_t v = rng_state * 0x2545f4914f6cdd1dull;
+  return lo + (hi - lo) * ((double)(v >> 11) / 9007199254740992.0);
+}
+
+static void rot_z(double R[9], double a)
+{
+  double c = cos(a), s = sin(a);
+  double t[9] = {c, -s, 0, s, c, 0, 0, 0, 1};
+  memcpy(R, t, sizeof t);
+}
+
+static void rot_x(double R[9], double a)
+{
+  double c = cos(a), s = sin(a);
+  double t[9] = {1, 0, 0, 0, c, -s, 0, s, c};
+  memcpy(R, t, sizeof t);
+}
+
+static void rot_y(double R[9], double a)
+{
+  double c = cos(a), s = sin(a);
+  double t[9] = {c, 0, s, 0, 1, 0, -s, 0, c};
+  memcpy(R, t, sizeof t);
+}
+
+static void rot_random(double R[9])
+{
+  double q[4];
+  do {
+    for (int i = 0; i < 4; i++) q[i] = urand(-1, 1);
+  } while (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] > 1);
+  ss_quat_normalize(q);
+  ss_quat_to_mat(R, q);
+}
+
+/* a wheel: axis (local z) horizontal along heading psi, spun by phi */
+static void rot_wheel(double R[9], double psi, double phi)
+{
+  double A[9], B[9], C[9];
+  rot_z(A, phi);          /* spin about the axle */
+  rot_x(B, -0.5 * PI);    /* local z -> frame y */
+  ss_m3_mul(C, B, A);
+  rot_z(A, psi);          /* heading */
+  ss_m3_mul(R, A, C);
+}
+
+/* axis tilted by phi from vertical (towards frame x), then a yaw */
+static void rot_tilt(double R[9], double phi, double psi)
+{
+  double A[9], B[9];
+  rot_y(A, phi);
+  rot_z(B, psi);
+  ss_m3_mul(R, B, A);
+}
+
+static ssShape make_shape(int type, double s0, double s1, double s2,
+                          double x, double y, double z, const double R[9])
+{
+  ssShape s;
+  s.type = type;
+  s.size[0] = s0; s.size[1] = s1; s.size[2] = s2;
+  s.pos[0] = x; s.pos[1] = y; s.pos[2] = z;
+  memcpy(s.R, R, sizeof s.R);
+  return s;
+}
+
+/* the sum of cell weights over a vertex grid of spacing dx, dy whose
+ * origin is (gx, gy); also the area-weighted centroid */
+static double grid_sum(const ssPoly2 *p, double dx, double dy, double gx,
+                       double gy, double *mx, double *my)
+{
+  double xlo = p->x[0], xhi = p->x[0], ylo = p->y[0], yhi = p->y[0];
+  for (int i = 1; i < p->n; i++) {
+    xlo = fmin(xlo, p->x[i]); xhi = fmax(xhi, p->x[i]);
+    ylo = fmin(ylo, p->y[i]); yhi = fmax(yhi, p->y[i]);
+  }
+  int i0 = (int)floor((xlo - gx) / dx) - 1, i1 = (int)ceil((xhi - gx) / dx) + 1;
+  int j0 = (int)floor((ylo - gy) / dy) - 1, j1 = (int)ceil((yhi - gy) / dy) + 1;
+  double sum = 0, sx = 0, sy = 0;
+  for (int j = j0; j <= j1; j++)
+    for (int i = i0; i <= i1; i++) {
+      double x = gx + i * dx, y = gy + j * dy, cx = 0, cy = 0;
+      double a = ss_poly_rect_area(p, x - 0.5 * dx, x + 0.5 * dx, y - 0.5 * dy,
+                                   y + 0.5 * dy, &cx, &cy);
+      sum += a;
+      sx += a * cx;
+      sy += a * cy;
+    }
+  if (mx) *mx = sum > 0 ? sx / sum : 0;
+  if (my) *my = sum > 0 ? sy / sum : 0;
+  return sum;
+}
+
+/* 1 if the polygon is strictly convex and counter-clockwise */
+static int poly_ccw_convex(const ssPoly2 *p)
+{
+  if (p->n < 3) return 0;
+  for (int i = 0; i < p->n; i++) {
+    int j = (i + 1) % p->n, k = (i + 2) % p->n;
+    double cr = (p->x[j] - p->x[i]) * (p->y[k] - p->y[j]) -
+                (p->y[j] - p->y[i]) * (p->x[k] - p->x[j]);
+    if (!(cr > 0)) return 0;
+  }
+  return 1;
+}
+
+/* the extent of a polygon along the unit direction (ux, uy) */
+static double poly_extent(const ssPoly2 *p, double ux, double uy)
+{
+  double lo = INFINITY, hi = -INFINITY;
+  for (int i = 0; i < p->n; i++) {
+    double t = p->x[i] * ux + p->y[i] * uy;
+    lo = fmin(lo, t);
+    hi = fmax(hi, t);
+  }
+  return hi - lo;
+}
+
+static double rel(double got, double want)
+{
+  return fabs(got - want) / fabs(want);
+}
+
+/* a plate's loaded area is its true area for any placement and heading */
+static void test_plate_quadrature(void)
+{
+  double worst = 0, worst_c = 0;
+  int n4 = 1;
+  for (int trial = 0; trial < 40; trial++) {
+    double R[9];
+    rot_z(R, urand(-PI, PI));
+    double cx = urand(-3, 3), cy = urand(-3, 3);
+    ssShape s = make_shape(SS_GEOM_BOX, 0.4, 0.6, 0.05, cx, cy, urand(0, 1), R);
+    ssPoly2 p;
+    ss_shape_footprint(&s, &p);
+    if (p.n != 4) n4 = 0;
+    double dx = urand(0.01, 0.05), dy = urand(0.01, 0.05), mx, my;
+    double a = grid_sum(&p, dx, dy, urand(-1, 1), urand(-1, 1), &mx, &my);
+    worst = fmax(worst, rel(a, 0.24));
+    worst_c = fmax(worst_c, fmax(fabs(mx - cx), fabs(my - cy)));
+  }
+  ok(n4, "a flat plate at any heading has a 4-gon footprint");
+  ok(worst <= 1e-12, "plate 0.4x0.6, 40 random placements/headings/grids: "
+     "sum of cell weights = 0.24 (worst rel err %.3g)", worst);
+  ok(worst_c <= 1e-12, "the weighted centroid of the cells is the plate centre "
+     "(worst err %.3g m)", worst_c);
+
+  /* edges exactly on cell boundaries */
+  double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  ssShape s = make_shape(SS_GEOM_BOX, 0.4, 0.6, 0.05, 0.025, 0.025, 0.1, I);
+  ssPoly2 p;
+  ss_shape_footprint(&s, &p);
+  close_enough(grid_sum(&p, 0.05, 0.05, 0, 0, NULL, NULL), 0.24, 0.24e-13,
+               "plate with edges on cell boundaries (5 cm): area");
+  close_enough(grid_sum(&p, 0.01, 0.02, 0, 0.015, NULL, NULL), 0.24, 0.24e-13,
+               "plate with edges on cell boundaries (1x2 cm): area");
+}
+
+/* box footprints: exact hull of the 8 projected corners */
+static void test_box_footprint(void)
+{
+  double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, R[9];
+  ssPoly2 p;
+  ssShape s = make_shape(SS_GEOM_BOX, 0.3, 0.5, 0.2, 1, 2, 3, I);
+  ss_shape_footprint(&s, &p);
+  ok(p.n == 4 && poly_ccw_convex(&p), "axis-aligned box: CCW 4-gon (n = %d)", p.n);
+  close_enough(ss_poly_area(&p), 0.15, 1e-15, "axis-aligned box: footprint area");
+
+  /* tilted about x only: corners collapse pairwise onto the x = +-hx sides */
+  rot_x(R, 0.4);
+  R[1] = R[2] = R[3] = R[6] = 0;
+  s = make_shape(SS_GEOM_BOX, 0.3, 0.5, 0.2, 0, 0, 0, R);
+  ss_shape_footprint(&s, &p);
+  ok(p.n == 4 && poly_ccw_convex(&p), "box tilted about x: collinear corners removed (n = %d)", p.n);
+  close_enough(ss_poly_area(&p), 0.3 * (0.5 * cos(0.4) + 0.2 * sin(0.4)), 1e-15,
+               "box tilted about x: footprint area");
+
+  /* random orientation: projected area of a box = sum of face areas |n_z| */
+  double worst = 0;
+  int convex = 1, inside = 1;
+  for (int trial = 0; trial < 200; trial++) {
+    rot_random(R);
+    double sx = urand(0.05, 1), sy = urand(0.05, 1), sz = urand(0.05, 1);
+    s = make_shape(SS_GEOM_BOX, sx, sy, sz, urand(-5, 5), urand(-5, 5), 0, R);
+    ss_shape_footprint(&s, &p);
+    double want = sy * sz * fabs(R[6]) + sx * sz * fabs(R[7]) + sx * sy * fabs(R[8]);
+    worst = fmax(worst, rel(ss_poly_area(&p), want));
+    if (!poly_ccw_convex(&p) || p.n > 6) convex = 0;
+    for (int i = 0; i < 8; i++) {
+      double l[3] = {(i & 1) ? sx / 2 : -sx / 2, (i & 2) ? sy / 2 : -sy / 2,
+                     (i & 4) ? sz / 2 : -sz / 2}, w[3];
+      ss_m3_mulv(w, R, l);
+      if (!ss_poly_contains(&p, s.pos[0] + w[0], s.pos[1] + w[1])) inside = 0;
+    }
+  }
+  ok(worst <= 1e-13, "random boxes: footprint area = projected area (worst rel %.3g)", worst);
+  ok(convex, "random boxes: footprints are strictly convex CCW with <= 6 vertices");
+  ok(inside, "random boxes: every projected corner lies in the footprint");
+}
+
+/* round shapes: area-matched polygons, exact tread width */
+static void test_round_footprints(void)
+{
+  double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, R[9];
+  ssPoly2 p;
+  double r = 0.3, L = 0.25;
+
+  ssShape s = make_shape(SS_GEOM_SPHERE, r, 0, 0, 0.7, -0.2, 1, I);
+  ss_shape_footprint(&s, &p);
+  ok(p.n == SS_FOOTPRINT_SEGMENTS && poly_ccw_convex(&p),
+     "sphere footprint: CCW %d-gon (n = %d)", SS_FOOTPRINT_SEGMENTS, p.n);
+  ok(rel(ss_poly_area(&p), PI * r * r) <= 1e-14, "sphere footprint area = pi r^2 "
+     "(rel %.3g)", rel(ss_poly_area(&p), PI * r * r));
+  ok(rel(grid_sum(&p, 0.013, 0.021, 0.3, 0.1, NULL, NULL), PI * r * r) <= 1e-12,
+     "sphere: cell weights sum to pi r^2");
+  ok(ss_poly_contains(&p, 0.7, -0.2) && !ss_poly_contains(&p, 0.7 + 1.01 * r, -0.2),
+     "sphere footprint contains its centre, not a point at 1.01 r");
+
+  /* a lying wheel: a 2r x L rectangle whatever its heading and spin */
+  double worst = 0, worst_w = 0, a0 = -1, spin_var = 0;
+  int small = 1;
+  for (int trial = 0; trial < 50; trial++) {
+    double psi = urand(-PI, PI);
+    rot_wheel(R, psi, urand(-PI, PI));
+    s = make_shape(SS_GEOM_CYLINDER, r, L, 0, urand(-2, 2), urand(-2, 2), r, R);
+    ss_shape_footprint(&s, &p);
+    if (p.n != 4 || !poly_ccw_convex(&p)) small = 0;
+    double a = ss_poly_area(&p);
+    worst = fmax(worst, rel(a, 2 * r * L));
+    /* frame y of the wheel is the axle; across it the width is 2r */
+    worst_w = fmax(worst_w, rel(poly_extent(&p, cos(psi), sin(psi)), 2 * r));
+    worst_w = fmax(worst_w, rel(poly_extent(&p, -sin(psi), cos(psi)), L));
+    if (a0 < 0) a0 = a;
+    spin_var = fmax(spin_var, rel(a, a0));
+  }
+  ok(worst <= 1e-12, "lying wheel: footprint area = 2 r L (worst rel %.3g)", worst);
+  ok(worst_w <= 1e-12, "lying wheel: footprint is 2r across, L along the axle "
+     "(worst rel %.3g)", worst_w);
+  ok(spin_var <= 1e-13, "lying wheel: area does not change with heading or spin");
+  ok(small, "lying wheel: the footprint is a CCW 4-gon");
+
+  /* standing cylinder: a disc */
+  s = make_shape(SS_GEOM_CYLINDER, r, L, 0, 0, 0, 0, I);
+  ss_shape_footprint(&s, &p);
+  ok(rel(ss_poly_area(&p), PI * r * r) <= 1e-13 && p.n == SS_FOOTPRINT_SEGMENTS,
+     "standing cylinder: a disc of area pi r^2 (n = %d)", p.n);
+
+  /* tilted by phi: pi r^2 |cos phi| + 2 r L sin phi */
+  worst = 0;
+  small = 1;
+  for (int trial = 0; trial < 50; trial++) {
+    double phi = urand(0, PI), psi = urand(-PI, PI);
+    rot_tilt(R, phi, psi);
+    s = make_shape(SS_GEOM_CYLINDER, r, L, 0, urand(-2, 2), urand(-2, 2), 0, R);
+    ss_shape_footprint(&s, &p);
+    if (p.n > SS_POLY_MAX || !poly_ccw_convex(&p)) small = 0;
+    worst = fmax(worst, rel(ss_poly_area(&p),
+                            PI * r * r * fabs(cos(phi)) + 2 * r * L * sin(phi)));
+  }
+  ok(small, "tilted cylinders: convex CCW footprints, <= SS_POLY_MAX vertices");
+  ok(worst <= 1e-12, "tilted cylinders: area = pi r^2 |cos| + 2 r L sin (worst rel %.3g)", worst);
+
+  /* capsules */
+  rot_wheel(R, 0.3, 1.1);
+  s = make_shape(SS_GEOM_CAPSULE, r, L, 0, 0.2, 0.1, r, R);
+  ss_shape_footprint(&s, &p);
+  ok(rel(ss_poly_area(&p), PI * r * r + 2 * r * L) <= 1e-13,
+     "lying capsule: area = pi r^2 + 2 r L (rel %.3g)",
+     rel(ss_poly_area(&p), PI * r * r + 2 * r * L));
+  ok(rel(grid_sum(&p, 0.02, 0.03, 0.01, 0, NULL, NULL), PI * r * r + 2 * r * L) <= 1e-12,
+     "lying capsule: cell weights sum to its area");
+  s = make_shape(SS_GEOM_CAPSULE, r, L, 0, 0, 0, 0, I);
+  ss_shape_footprint(&s, &p);
+  ok(rel(ss_poly_area(&p), PI * r * r) <= 1e-13 && p.n == SS_FOOTPRINT_SEGMENTS,
+     "standing capsule: a disc (n = %d)", p.n);
+  worst = 0;
+  for (int trial = 0; trial < 50; trial++) {
+    double phi = urand(0, PI);
+    rot_tilt(R, phi, urand(-PI, PI));
+    s = make_shape(SS_GEOM_CAPSULE, r, L, 0, urand(-2, 2), urand(-2, 2), 0, R);
+    ss_shape_footprint(&s, &p);
+    worst = fmax(worst, rel(ss_poly_area(&p), PI * r * r + 2 * r * L * sin(phi)));
+  }
+  ok(worst <= 1e-12, "tilted capsules: area = pi r^2 + 2 r L sin (worst rel %.3g)", worst);
+}
+
+/* clipping against cells */
+static void test_poly_clip(void)
+{
+  ssPoly2 sq = {4, {0, 1, 1, 0}, {0, 0, 1, 1}};
+  ssPoly2 tri = {3, {0, 1, 0}, {0, 0, 1}};
+  ssPoly2 cw = {4, {0, 0, 1, 1}, {0, 1, 1, 0}};
+  double cx = -9, cy = -9, a;
+
+  close_enough(ss_poly_area(&sq), 1, 0, "CCW unit square: area +1");
+  close_enough(ss_poly_area(&cw), -1, 0, "CW unit square: area -1");
+
+  a = ss_poly_rect_area(&sq, 0.5, 1.5, 0.25, 0.75, &cx, &cy);
+  ok(a == 0.25 && cx == 0.75 && cy == 0.5, "square and an overlapping cell: 0.25 at "
+     "(0.75, 0.5) (got %.17g at %.17g, %.17g)", a, cx, cy);
+  a = ss_poly_rect_area(&tri, 0, 1, 0, 1, &cx, &cy);
+  ok(fabs(a - 0.5) <= 1e-16 && fabs(cx - 1.0 / 3) <= 1e-16 && fabs(cy - 1.0 / 3) <= 1e-16,
+     "triangle inside a cell: 0.5 at (1/3, 1/3)");
+  a = ss_poly_rect_area(&tri, 0.4, 0.7, 0.4, 0.7, &cx, &cy);
+  ok(fabs(a - 0.02) <= 1e-16 && fabs(cx - (0.4 + 0.2 / 3)) <= 1e-15 &&
+     fabs(cy - (0.4 + 0.2 / 3)) <= 1e-15,
+     "hypotenuse cutting a cell's corner: 0.02 at (0.4 + 0.2/3, same) (got %.17g)", a);
+  a = ss_poly_rect_area(&sq, 0.2, 0.3, 0.6, 0.9, &cx, &cy);
+  ok(fabs(a - 0.03) <= 1e-17 && fabs(cx - 0.25) <= 1e-16 && fabs(cy - 0.75) <= 1e-16,
+     "cell inside the polygon: full cell area at its centre");
+  ok(ss_poly_rect_area(&sq, 1.5, 2, 0, 1, NULL, NULL) == 0, "disjoint cell: 0");
+  ok(ss_poly_rect_area(&sq, 1, 2, 0, 1, NULL, NULL) == 0, "cell touching an edge: 0");
+  ok(ss_poly_rect_area(&sq, 0.5, 0.5, 0, 1, NULL, NULL) == 0, "empty cell: 0");
+  close_enough(ss_poly_rect_area(&cw, 0.5, 1.5, 0, 1, NULL, NULL), 0.5, 1e-16,
+               "a CW polygon still gives a positive area");
+
+  ok(ss_poly_contains(&sq, 0.5, 0.5), "contains: interior point");
+  ok(ss_poly_contains(&sq, 1, 0.5) && ss_poly_contains(&sq, 0, 0), "contains: edge and vertex");
+  ok(!ss_poly_contains(&sq, 1.001, 0.5) && !ss_poly_contains(&sq, -0.5, -0.5),
+     "contains: outside points");
+  ok(!ss_poly_contains(&tri, 0.6, 0.6), "contains: outside the hypotenuse");
+}
+
+/* vertical ray casts against closed forms */
+static void test_lowest_z(void)
+{
+  double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, R[9], z = 0, worst;
+  int miss;
+
+  /* box tilted about x by theta: its bottom face plane */
+  double th = 0.3, hx = 0.2, hy = 0.3, hz = 0.05, c[3] = {0.4, -0.3, 0.6};
+  rot_x(R, th);
+  ssShape s = make_shape(SS_GEOM_BOX, 2 * hx, 2 * hy, 2 * hz, c[0], c[1], c[2], R);
+  worst = 0;
+  miss = 0;
+  for (int i = 0; i < 500; i++) {
+    double u = urand(-hx, hx), v = urand(-hy, hy);
+    double x = c[0] + u, y = c[1] + v * cos(th) + hz * sin(th);
+    double want = c[2] + (sin(th) * (y - c[1]) - hz) / cos(th);
+    if (!ss_shape_lowest_z(&s, x, y, &z)) miss++;
+    else worst = fmax(worst, fabs(z - want));
+  }
+  ok(miss == 0 && worst <= 1e-14, "box tilted about x: bottom face plane "
+     "(%d misses, worst %.3g m)", miss, worst);
+  ok(!ss_shape_lowest_z(&s, c[0] + hx + 1e-9, c[1], &z) &&
+     !ss_shape_lowest_z(&s, c[0], c[1] + hy * cos(th) + hz * sin(th) + 1e-9, &z),
+     "box tilted about x: lines just outside miss");
+
+  /* axis-aligned box: rays parallel to every slab */
+  s = make_shape(SS_GEOM_BOX, 0.4, 0.6, 0.1, 1, 2, 3, I);
+  ok(ss_shape_lowest_z(&s, 1.1, 2.25, &z) && z == 2.95, "axis-aligned box: z = c - hz (%.17g)", z);
+  z = 42;
+  ok(!ss_shape_lowest_z(&s, 1.3, 2, &z) && z == 42, "axis-aligned box: miss returns 0, z untouched");
+
+  /* sphere */
+  double r = 0.25;
+  s = make_shape(SS_GEOM_SPHERE, r, 0, 0, -0.5, 0.5, 0.2, I);
+  worst = 0;
+  miss = 0;
+  for (int i = 0; i < 500; i++) {
+    double rho = r * sqrt(urand(0, 1)), al = urand(-PI, PI);
+    double x = -0.5 + rho * cos(al), y = 0.5 + rho * sin(al);
+    double want = 0.2 - sqrt(r * r - ((x + 0.5) * (x + 0.5) + (y - 0.5) * (y - 0.5)));
+    if (!ss_shape_lowest_z(&s, x, y, &z)) miss++;
+    else worst = fmax(worst, fabs(z - want));
+  }
+  ok(miss == 0 && worst <= 1e-15, "sphere: z = c - sqrt(r^2 - rho^2) (worst %.3g)", worst);
+  ok(!ss_shape_lowest_z(&s, -0.5 + 1.0001 * r, 0.5, &z), "sphere: miss outside r");
+
+  /* lying cylinder, random heading and spin: z = c - sqrt(r^2 - d^2) */
+  double L = 0.2;
+  worst = 0;
+  miss = 0;
+  int outside = 0;
+  for (int i = 0; i < 500; i++) {
+    double psi = urand(-PI, PI), cz = urand(0, 1);
+    rot_wheel(R, psi, urand(-PI, PI));
+    s = make_shape(SS_GEOM_CYLINDER, r, L, 0, 0.1, 0.2, cz, R);
+    /* frame y of the wheel (-sin psi, cos psi) is the axle */
+    double along = urand(-0.5, 0.5) * L * 0.999, d = urand(-1, 1) * r * 0.999;
+    double x = 0.1 - sin(psi) * along + cos(psi) * d;
+    double y = 0.2 + cos(psi) * along + sin(psi) * d;
+    if (!ss_shape_lowest_z(&s, x, y, &z)) miss++;
+    else worst = fmax(worst, fabs(z - (cz - sqrt(r * r - d * d))));
+    /* beyond the caps, beyond the tread */
+    double e = 0.5 * L * 1.001;
+    if (ss_shape_lowest_z(&s, 0.1 - sin(psi) * e, 0.2 + cos(psi) * e, &z)) outside++;
+    if (ss_shape_lowest_z(&s, 0.1 + cos(psi) * 1.001 * r, 0.2 + sin(psi) * 1.001 * r, &z))
+      outside++;
+  }
+  ok(miss == 0 && worst <= 1e-13, "lying cylinder: z = c - sqrt(r^2 - d^2) "
+     "(%d misses, worst %.3g m)", miss, worst);
+  ok(outside == 0, "lying cylinder: lines past the caps or tread miss (%d hits)", outside);
+
+  /* exact axis permutation: the ray is parallel to the cap planes */
+  double P[9] = {0, 0, 1, 1, 0, 0, 0, 1, 0};
+  s = make_shape(SS_GEOM_CYLINDER, r, L, 0, 0, 0, 1, P);
+  ok(ss_shape_lowest_z(&s, 0.05, 0.15, &z) && fabs(z - (1 - sqrt(r * r - 0.15 * 0.15))) <= 1e-15,
+     "cylinder with axis exactly along x: lateral surface");
+  ok(!ss_shape_lowest_z(&s, 0.11, 0.0, &z), "cylinder with axis exactly along x: miss past a cap");
+
+  /* standing cylinder: the ray is parallel to the lateral surface */
+  s = make_shape(SS_GEOM_CYLINDER, r, L, 0, 0, 0, 1, I);
+  ok(ss_shape_lowest_z(&s, 0.1, -0.2, &z) && z == 1 - 0.5 * L, "standing cylinder: bottom cap");
+  ok(!ss_shape_lowest_z(&s, 0.2, -0.2, &z), "standing cylinder: miss outside r");
+
+  /* capsule lying along frame x: cylinder part and end spheres */
+  s = make_shape(SS_GEOM_CAPSULE, r, L, 0, 0, 0, 1, P);
+  ok(ss_shape_lowest_z(&s, 0.05, 0.15, &z) && fabs(z - (1 - sqrt(r * r - 0.15 * 0.15))) <= 1e-15,
+     "lying capsule: cylinder part z = c - sqrt(r^2 - d^2)");
+  double ex = 0.5 * L + 0.1, dd = 0.1 * 0.1 + 0.12 * 0.12;
+  ok(ss_shape_lowest_z(&s, ex, 0.12, &z) && fabs(z - (1 - sqrt(r * r - dd))) <= 1e-15,
+     "lying capsule: end sphere z = c - sqrt(r^2 - rho^2)");
+  ok(!ss_shape_lowest_z(&s, 0.5 * L + r * 1.0001, 0, &z), "lying capsule: miss past an end");
+
+  /* standing capsule: the lower end sphere */
+  s = make_shape(SS_GEOM_CAPSULE, r, L, 0, 0, 0, 1, I);
+  ok(ss_shape_lowest_z(&s, 0.1, 0.1, &z) && fabs(z - (1 - 0.5 * L - sqrt(r * r - 0.02))) <= 1e-15,
+     "standing capsule: z = c - L/2 - sqrt(r^2 - rho^2)");
+
+  /* any orientation: a surface point whose outward normal points down is
+   * where the upward line through it enters */
+  const char *names[4] = {"box", "sphere", "cylinder", "capsule"};
+  for (int type = 0; type < 4; type++) {
+    worst = 0;
+    miss = 0;
+    int tested = 0;
+    for (int i = 0; i < 4000; i++) {
+      rot_random(R);
+      double sz[3] = {urand(0.05, 0.5), urand(0.05, 0.5), urand(0.05, 0.5)};
+      s = make_shape(type, sz[0], sz[1], sz[2], urand(-1, 1), urand(-1, 1), urand(-1, 1), R);
+      double lp[3], ln[3];
+      if (type == SS_GEOM_BOX) {
+        int f = (int)urand(0, 6);
+        for (int k = 0; k < 3; k++) lp[k] = urand(-0.5, 0.5) * sz[k];
+        ss_v3_set(ln, 0, 0, 0);
+        lp[f % 3] = (f < 3 ? 0.5 : -0.5) * sz[f % 3];
+        ln[f % 3] = f < 3 ? 1 : -1;
+      } else {
+        double al = urand(-PI, PI), hl = type == SS_GEOM_SPHERE ? 0 : 0.5 * sz[1];
+        int part = type == SS_GEOM_SPHERE ? 1 : (int)urand(0, 3);
+        if (part == 0) { /* lateral surface */
+          ss_v3_set(ln, cos(al), sin(al), 0);
+          ss_v3_set(lp, sz[0] * ln[0], sz[0] * ln[1], urand(-hl, hl));
+        } else if (type == SS_GEOM_CYLINDER) { /* a cap disc */
+          double e = part == 1 ? 1 : -1, rho = sz[0] * sqrt(urand(0, 1));
+          ss_v3_set(ln, 0, 0, e);
+          ss_v3_set(lp, rho * cos(al), rho * sin(al), e * hl);
+        } else { /* a sphere, or a capsule's end hemisphere */
+          double e = part == 1 ? 1 : -1, ct = urand(-1, 1), st = sqrt(1 - ct * ct);
+          ss_v3_set(ln, st * cos(al), st * sin(al), ct);
+          if (type == SS_GEOM_CAPSULE) ln[2] = e * fabs(ct);
+          ss_v3_set(lp, sz[0] * ln[0], sz[0] * ln[1], e * hl + sz[0] * ln[2]);
+        }
+      }
+      double wp[3], wn[3];
+      ss_m3_mulv(wp, R, lp);
+      ss_v3_add(wp, wp, s.pos);
+      ss_m3_mulv(wn, R, ln);
+      if (wn[2] > -0.05) continue;
+      tested++;
+      if (!ss_shape_lowest_z(&s, wp[0], wp[1], &z)) miss++;
+      else worst = fmax(worst, fabs(z - wp[2]));
+    }
+    ok(tested > 500 && miss == 0 && worst <= 1e-13, "%s, random orientations: lowest z = "
+       "downward-facing surface point (%d points, %d misses, worst %.3g m)",
+       names[type], tested, miss, worst);
+  }
+
+  /* lines outside the bounds always miss */
+  miss = 0;
+  for (int i = 0; i < 2000; i++) {
+    rot_random(R);
+    int type = i % 4;
+    s = make_shape(type, urand(0.05, 0.5), urand(0.05, 0.5), urand(0.05, 0.5), 0, 0, 0, R);
+    double lo[3], hi[3], al = urand(-PI, PI);
+    ss_shape_aabb(&s, lo, hi);
+    double rad = 1e-9 + sqrt(fmax(hi[0] * hi[0], lo[0] * lo[0]) + fmax(hi[1] * hi[1], lo[1] * lo[1]));
+    if (ss_shape_lowest_z(&s, rad * cos(al), rad * sin(al), &z)) miss++;
+  }
+  ok(miss == 0, "lines outside every shape's bounds miss (%d hits)", miss);
+}
+
+/* contact candidates */
+static void test_candidates(void)
+{
+  double R[9], pts[32][3], n[3] = {0, 0, 1};
+  rot_random(R);
+  ssShape s = make_shape(SS_GEOM_BOX, 0.3, 0.4, 0.5, 1, 2, 3, R);
+  int k = ss_shape_candidates(&s, n, pts, 32), found = 0;
+  for (int i = 0; i < 8; i++) {
+    double l[3] = {(i & 1) ? 0.15 : -0.15, (i & 2) ? 0.2 : -0.2, (i & 4) ? 0.25 : -0.25}, w[3];
+    ss_m3_mulv(w, R, l);
+    ss_v3_add(w, w, s.pos);
+    for (int j = 0; j < k; j++) {
+      double d[3];
+      ss_v3_sub(d, pts[j], w);
+      if (ss_v3_norm(d) <= 1e-15) { found++; break; }
+    }
+  }
+  ok(k == 8 && found == 8, "box candidates are its 8 corners (k = %d, matched %d)", k, found);
+  ok(ss_shape_candidates(&s, n, pts, 3) == 3, "candidates respect max");
+
+  /* a tilted surface normal */
+  double nt[3] = {0.3, -0.2, 1};
+  ss_v3_normalize(nt);
+  s = make_shape(SS_GEOM_SPHERE, 0.2, 0, 0, 1, 2, 3, R);
+  k = ss_shape_candidates(&s, nt, pts, 32);
+  ok(k == 1 && fabs(pts[0][0] - (1 - 0.2 * nt[0])) <= 1e-15 &&
+     fabs(pts[0][2] - (3 - 0.2 * nt[2])) <= 1e-15, "sphere candidate: c - r n");
+
+  s = make_shape(SS_GEOM_CAPSULE, 0.2, 0.6, 0, 1, 2, 3, R);
+  k = ss_shape_candidates(&s, nt, pts, 32);
+  double a[3] = {R[2], R[5], R[8]};
+  double lowest = fmin(ss_v3_dot(nt, pts[0]), ss_v3_dot(nt, pts[1]));
+  ok(k == 2 && fabs(lowest - (ss_v3_dot(nt, s.pos) - 0.3 * fabs(ss_v3_dot(nt, a)) - 0.2)) <= 1e-14,
+     "capsule candidates: two points, the lowest is the support along -n");
+
+  /* cylinder: lowest candidate is the true support; all lie on the rims */
+  double worst = 0, off = 0;
+  int count_ok = 1;
+  for (int t = 0; t < 100; t++) {
+    rot_random(R);
+    s = make_shape(SS_GEOM_CYLINDER, 0.3, 0.2, 0, urand(-1, 1), 0, 1, R);
+    k = ss_shape_candidates(&s, nt, pts, 32);
+    if (k != 18) count_ok = 0;
+    ss_v3_set(a, R[2], R[5], R[8]);
+    double na = ss_v3_dot(nt, a), lo = INFINITY;
+    for (int j = 0; j < k; j++) {
+      double d[3];
+      lo = fmin(lo, ss_v3_dot(nt, pts[j]));
+      ss_v3_sub(d, pts[j], s.pos);
+      double ax = ss_v3_dot(d, a);
+      ss_v3_addscl(d, a, -ax);
+      off = fmax(off, fmax(fabs(fabs(ax) - 0.1), fabs(ss_v3_norm(d) - 0.3)));
+    }
+    double want = ss_v3_dot(nt, s.pos) - 0.1 * fabs(na) - 0.3 * sqrt(1 - na * na);
+    worst = fmax(worst, fabs(lo - want));
+  }
+  ok(count_ok, "cylinder candidates: 2 lowest rim points + 8 per cap");
+  ok(worst <= 1e-14, "cylinder candidates: the lowest is the support along -n (worst %.3g)", worst);
+  ok(off <= 1e-14, "cylinder candidates lie on the cap rims (worst %.3g)", off);
+
+  /* standing on its end: the rim, not the cap centre */
+  double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  s = make_shape(SS_GEOM_CYLINDER, 0.3, 0.2, 0, 0, 0, 0, I);
+  k = ss_shape_candidates(&s, n, pts, 32);
+  int rim = 0;
+  for (int j = 0; j < k; j++)
+    if (fabs(pts[j][2] + 0.1) <= 1e-15 && fabs(hypot(pts[j][0], pts[j][1]) - 0.3) <= 1e-15) rim++;
+  ok(rim == 9, "standing cylinder: 9 candidates on the bottom rim (%d)", rim);
+}
+
+/* effective width b: DESIGN 2.4, invariant under yaw */
+static void test_width(void)
+{
+  double R[9], A[9], B[9], n[3] = {0, 0, 1};
+  int same = 1;
+  double b0;
+
+  /* flat plate: the shorter horizontal side */
+  for (int t = 0; t < 50; t++) {
+    rot_z(R, urand(-PI, PI));
+    ssShape s = make_shape(SS_GEOM_BOX, 0.4, 0.6, 0.05, 0, 0, 0, R);
+    if (ss_shape_width(&s, n) != 0.4) same = 0;
+    s.size[0] = 0.7;
+    if (ss_shape_width(&s, n) != 0.6) same = 0;
+  }
+  ok(same, "flat plate: b = shorter horizontal side at every heading");
+
+  /* a box on its side: local x vertical */
+  rot_y(A, 0.5 * PI);
+  same = 1;
+  b0 = -1;
+  for (int t = 0; t < 50; t++) {
+    rot_z(B, urand(-PI, PI));
+    ss_m3_mul(R, B, A);
+    ssShape s = make_shape(SS_GEOM_BOX, 0.05, 0.5, 0.3, 0, 0, 0, R);
+    double b = ss_shape_width(&s, n);
+    if (b0 < 0) b0 = b;
+    if (b != b0) same = 0;
+  }
+  ok(same && b0 == 0.3, "box standing on its thin side: b = 0.3 (got %g)", b0);
+
+  /* wheels: tread width whatever heading and spin; standing: diameter */
+  same = 1;
+  for (int t = 0; t < 50; t++) {
+    rot_wheel(R, urand(-PI, PI), urand(-PI, PI));
+    ssShape s = make_shape(SS_GEOM_CYLINDER, 0.3, 0.2, 0, 0, 0, 0, R);
+    if (ss_shape_width(&s, n) != 0.2) same = 0;
+  }
+  ok(same, "lying wheel: b = tread width at every heading and spin");
+  rot_tilt(R, 0.5 * PI - 0.6, 1.0);  /* axle 0.6 rad (< 45 deg) out of the plane */
+  ssShape s = make_shape(SS_GEOM_CYLINDER, 0.3, 0.2, 0, 0, 0, 0, R);
+  ok(ss_shape_width(&s, n) == 0.2, "cylinder with axle 34 deg out of the plane: tread width");
+  rot_tilt(R, 0.5 * PI - 0.9, 1.0);
+  s = make_shape(SS_GEOM_CYLINDER, 0.3, 0.2, 0, 0, 0, 0, R);
+  ok(ss_shape_width(&s, n) == 0.6, "cylinder with axle 52 deg out of the plane: diameter");
+
+  s = make_shape(SS_GEOM_SPHERE, 0.3, 0, 0, 0, 0, 0, R);
+  ok(ss_shape_width(&s, n) == 0.6, "sphere: b = diameter");
+  s = make_shape(SS_GEOM_CAPSULE, 0.3, 1.0, 0, 0, 0, 0, R);
+  ok(ss_shape_width(&s, n) == 0.6, "capsule: b = diameter");
+
+  /* a tilted bed: the same plate tilted with it keeps its width */
+  double nt[3];
+  rot_x(A, 0.4);
+  ss_v3_set(nt, A[2], A[5], A[8]);
+  same = 1;
+  for (int t = 0; t < 20; t++) {
+    rot_z(B, urand(-PI, PI));
+    ss_m3_mul(R, A, B);
+    s = make_shape(SS_GEOM_BOX, 0.4, 0.6, 0.05, 0, 0, 0, R);
+    if (ss_shape_width(&s, nt) != 0.4) same = 0;
+  }
+  ok(same, "plate on a tilted bed: b = 0.4 at every heading");
+}
+
+/* tight bounds */
+static void test_aabb(void)
+{
+  double R[9], lo[3], hi[3];
+  double worst = 0;
+  for (int t = 0; t < 100; t++) {
+    rot_random(R);
+    ssShape s = make_shape(SS_GEOM_BOX, 0.3, 0.4, 0.5, 1, 2, 3, R);
+    ss_shape_aabb(&s, lo, hi);
+    double clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int i = 0; i < 8; i++) {
+      double l[3] = {(i & 1) ? 0.15 : -0.15, (i & 2) ? 0.2 : -0.2, (i & 4) ? 0.25 : -0.25}, w[3];
+      ss_m3_mulv(w, R, l);
+      for (int k = 0; k < 3; k++) {
+        clo[k] = fmin(clo[k], s.pos[k] + w[k]);
+        chi[k] = fmax(chi[k], s.pos[k] + w[k]);
+      }
+    }
+    for (int k = 0; k < 3; k++) worst = fmax(worst, fmax(fabs(lo[k] - clo[k]), fabs(hi[k] - chi[k])));
+  }
+  ok(worst <= 1e-15, "box bounds = extremes of its corners (worst %.3g)", worst);
+
+  ssShape s = make_shape(SS_GEOM_SPHERE, 0.3, 0, 0, 1, 2, 3, R);
+  ss_shape_aabb(&s, lo, hi);
+  ok(lo[0] == 0.7 && hi[1] == 2.3 && lo[2] == 2.7, "sphere bounds = c +- r");
+
+  /* cylinder and capsule: sampled surfaces touch but never pass the bounds */
+  for (int type = SS_GEOM_CYLINDER; type <= SS_GEOM_CAPSULE; type++) {
+    double over = 0, gap = 0;
+    for (int t = 0; t < 20; t++) {
+      rot_random(R);
+      s = make_shape(type, 0.3, 0.5, 0, 1, 2, 3, R);
+      ss_shape_aabb(&s, lo, hi);
+      double slo[3] = {INFINITY, INFINITY, INFINITY}, shi[3] = {-INFINITY, -INFINITY, -INFINITY};
+      for (int i = 0; i < 20000; i++) {
+        double l[3], w[3];
+        if (type == SS_GEOM_CYLINDER) {
+          double al = 2 * PI * i / 10000.0;
+          ss_v3_set(l, 0.3 * cos(al), 0.3 * sin(al), i < 10000 ? 0.25 : -0.25);
+        } else {
+          /* a fine latitude-longitude grid of both end spheres */
+          double al = 2 * PI * (i % 200) / 200.0, be = PI * ((i / 200) % 50) / 49.0;
+          ss_v3_set(l, 0.3 * sin(be) * cos(al), 0.3 * sin(be) * sin(al), 0.3 * cos(be));
+          l[2] += i < 10000 ? 0.25 : -0.25;
+        }
+        ss_m3_mulv(w, R, l);
+        for (int k = 0; k < 3; k++) {
+          slo[k] = fmin(slo[k], s.pos[k] + w[k]);
+          shi[k] = fmax(shi[k], s.pos[k] + w[k]);
+        }
+      }
+      for (int k = 0; k < 3; k++) {
+        over = fmax(over, fmax(lo[k] - slo[k], shi[k] - hi[k]));
+        gap = fmax(gap, fmax(slo[k] - lo[k], hi[k] - shi[k]));
+      }
+    }
+    ok(over <= 1e-15 && gap <= 2e-3, "%s bounds contain the surface and are tight "
+       "(overshoot %.3g, gap %.3g)", type == SS_GEOM_CYLINDER ? "cylinder" : "capsule",
+       over, gap);
+  }
+  {
+    double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    s = make_shape(SS_GEOM_CYLINDER, 0.3, 0.5, 0, 0, 0, 0, I);
+    ss_shape_aabb(&s, lo, hi);
+    ok(hi[0] == 0.3 && hi[1] == 0.3 && hi[2] == 0.25, "standing cylinder bounds");
+    s.type = SS_GEOM_CAPSULE;
+    ss_shape_aabb(&s, lo, hi);
+    ok(hi[0] == 0.3 && hi[2] == 0.55, "standing capsule bounds");
+  }
+}
+
+int main(void)
+{
+  test_plate_quadrature();
+  test_box_footprint();
+  test_round_footprints();
+  test_poly_clip();
+  test_lowest_z();
+  test_candidates();
+  test_width();
+  test_aabb();
+  return done_testing();
+}

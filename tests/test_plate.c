@@ -1,0 +1,433 @@
+/* test_plate.c -- rigid bodies on soil and rigid ground, end to end through
+ * the contact solver, against the closed forms of DESIGN 2.7. */
+#include "soilsim.h"
+#include "solver.h"
+#include "ss_math.h"
+#include "tap.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static const double G = 9.81;
+
+typedef struct {
+  ssModel *m;
+  ssData *d;
+  int plate, bed;
+} World;
+
+static ssSoilMaterial plate_soil(void)
+{
+  ssSoilMaterial s = ss_soil_material_default();
+  s.bekker_kc = 0;
+  s.bekker_kphi = 1e5;
+  s.sinkage_exponent = 1;
+  s.elastic_stiffness = 2e6;
+  /* overdamped settling (critical ~ 5800 Pa s/m for this plate): the
+   * quasi-static reference of DESIGN 2.7 without overshoot */
+  s.damping = 1e4;
+  return s;
+}
+
+/* a flat bed (size x size, spacing h) and a box plate lx x ly x 0.05 */
+static World make_world(ssSoilMaterial soil, double size, double h, double lx,
+                        double ly, double mass, double ox, double oy,
+                        double yaw, double lift)
+{
+  World w;
+  ssError e;
+  w.m = ss_model_new();
+  int n = (int)lround(size / h) + 1;
+  double *z = calloc((size_t)n * n, sizeof(double));
+  ssHfieldDef hd = ss_hfield_def_default();
+  hd.name = "bed";
+  hd.nx = hd.ny = n;
+  hd.x_size = hd.y_size = size;
+  hd.height = z;
+  hd.soil = 1;
+  hd.soilmat = soil;
+  w.bed = ss_model_add_hfield(w.m, &hd, &e);
+  free(z);
+  ssBodyDef bd = ss_body_def_default();
+  bd.name = "plate";
+  bd.shape = SS_GEOM_BOX;
+  bd.size[0] = lx;
+  bd.size[1] = ly;
+  bd.size[2] = 0.05;
+  bd.mass = mass;
+  ss_v3_set(bd.pos, ox, oy, 0.025 + lift);
+  double axis[3] = {0, 0, 1};
+  ss_quat_from_axis_angle(bd.quat, axis, yaw);
+  w.plate = ss_model_add_body(w.m, &bd, &e);
+  w.d = ss_data_new(w.m);
+  if (w.bed < 0 || w.plate < 0 || !w.d) diag("world build failed: %s", e.message);
+  return w;
+}
+
+static void free_world(World *w)
+{
+  ss_data_free(w->d);
+  ss_model_free(w->m);
+}
+
+static int run(World *w, int steps)
+{
+  ssError e;
+  for (int k = 0; k < steps; k++)
+    if (ss_step(w->m, w->d, &e) != SS_OK) {
+      diag("step failed: %s", e.message);
+      return 0;
+    }
+  return 1;
+}
+
+/* plate sinkage from its pose: depth of the bottom face centre */
+static double plate_sinkage(const World *w) { return -(w->d->qpos[2] - 0.025); }
+
+/* mean of a soil array over vertices at least `inset` inside the plate */
+static double mean_under(const World *w, const double *arr, double cx,
+                         double cy, double yaw, double lx, double ly,
+                         double inset, int *count)
+{
+  const ssModel *m = w->m;
+  int n = m->hfield_nx[w->bed];
+  double size = m->hfield_size[0], h = size / (n - 1), sum = 0;
+  int cnt = 0;
+  for (int j = 0; j < n; j++)
+    for (int i = 0; i < n; i++) {
+      double x = -0.5 * size + i * h - cx, y = -0.5 * size + j * h - cy;
+      double u = cos(yaw) * x + sin(yaw) * y, v = -sin(yaw) * x + cos(yaw) * y;
+      if (fabs(u) < 0.5 * lx - inset && fabs(v) < 0.5 * ly - inset) {
+        sum += arr[j * n + i];
+        cnt++;
+      }
+    }
+  *count = cnt;
+  return cnt ? sum / cnt : NAN;
+}
+
+static double max_outside(const World *w, const double *arr, double cx,
+                          double cy, double yaw, double lx, double ly,
+                          double outset)
+{
+  const ssModel *m = w->m;
+  int n = m->hfield_nx[w->bed];
+  double size = m->hfield_size[0], h = size / (n - 1), mx = 0;
+  for (int j = 0; j < n; j++)
+    for (int i = 0; i < n; i++) {
+      double x = -0.5 * size + i * h - cx, y = -0.5 * size + j * h - cy;
+      double u = cos(yaw) * x + sin(yaw) * y, v = -sin(yaw) * x + cos(yaw) * y;
+      if (fabs(u) > 0.5 * lx + outset || fabs(v) > 0.5 * ly + outset)
+        if (fabs(arr[j * n + i]) > mx) mx = fabs(arr[j * n + i]);
+    }
+  return mx;
+}
+
+/* DESIGN 2.7: 20 kg, 0.4 x 0.6 m -> 8.175 mm; rut after lifting 7.766 mm */
+static void test_analytic_plate(void)
+{
+  const double s_ref = 8.175e-3, rut_ref = 7.76625e-3;
+  struct { double h, ox, oy, yaw; } cases[] = {
+    {0.01, 0, 0, 0},           {0.02, 0, 0, 0},
+    {0.03, 0.013, -0.007, 0},  {0.05, 0.021, 0.012, 0},
+    {0.02, 0.013, -0.007, M_PI / 6}, {0.05, -0.004, 0.017, M_PI / 4},
+    {0.03, 0, 0, 1.0},
+  };
+  for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+    double h = cases[c].h, ox = cases[c].ox, oy = cases[c].oy, yaw = cases[c].yaw;
+    World w = make_world(plate_soil(), 1.2, h, 0.4, 0.6, 20, ox, oy, yaw, 0);
+    if (!run(&w, 1500)) {
+      ok(0, "settle run failed");
+      free_world(&w);
+      continue;
+    }
+    char what[160];
+    snprintf(what, sizeof what, "h = %g m, offset (%g, %g), heading %.3g rad: plate sinkage",
+             h, ox, oy, yaw);
+    close_enough(plate_sinkage(&w), s_ref, 0.005 * s_ref, what);
+    close_enough(w.d->stats.soil_contact_area, 0.24, 1e-9, "  loaded area = true plate area");
+    close_enough(w.d->stats.soil_normal_force, 20 * G, 1e-3 * 20 * G, "  normal force = m g at rest");
+    int cnt;
+    double mean = mean_under(&w, w.d->soil_sinkage, ox, oy, yaw, 0.4, 0.6, h, &cnt);
+    close_enough(mean, s_ref, 0.005 * s_ref, "  soil sinkage under the plate");
+    /* remove the plate: the elastic part recovers, the rut remains */
+    ssError e;
+    ss_remove(w.m, w.d, "plate", &e);
+    run(&w, 1);
+    double rut = mean_under(&w, w.d->soil_sinkage, ox, oy, yaw, 0.4, 0.6, h, &cnt);
+    close_enough(rut, rut_ref, 0.01 * rut_ref, "  rut after removing the plate");
+    double pl = mean_under(&w, w.d->soil_plastic, ox, oy, yaw, 0.4, 0.6, h, &cnt);
+    close_enough(rut, pl, 1e-15, "  after removal sinkage = plastic sinkage");
+    ok(max_outside(&w, w.d->soil_sinkage, ox, oy, yaw, 0.4, 0.6, 0.75 * h) == 0,
+       "  soil outside the footprint untouched");
+    free_world(&w);
+  }
+}
+
+/* n != 1 and two widths separating k_c and k_phi, end to end */
+static void test_envelope_shapes(void)
+{
+  ssSoilMaterial s = plate_soil();
+  s.sinkage_exponent = 1.1;
+  double p = 20 * G / 0.24, s_ref = 0.01;
+  s.bekker_kphi = p / pow(s_ref, 1.1);
+  World w = make_world(s, 1.2, 0.02, 0.4, 0.6, 20, 0, 0, 0, 0);
+  run(&w, 2000);
+  close_enough(plate_sinkage(&w), s_ref, 0.005 * s_ref, "n = 1.1, k_phi = p/s_ref^n: sinkage s_ref");
+  free_world(&w);
+
+  /* same area and load, widths 0.4 and 0.2: s = (p / (k_c/b + k_phi))^(1/n) */
+  ssSoilMaterial c = plate_soil();
+  c.bekker_kc = 5000;
+  c.bekker_kphi = 6e4;
+  double dims[2][2] = {{0.4, 0.6}, {0.2, 1.2}};
+  for (int k = 0; k < 2; k++) {
+    double b = dims[k][0];
+    double want = p / (c.bekker_kc / b + c.bekker_kphi);
+    World v = make_world(c, 1.6, 0.02, dims[k][0], dims[k][1], 20, 0, 0, 0, 0);
+    run(&v, 2000);
+    char what[96];
+    snprintf(what, sizeof what, "k_c = 5000, width %.1f m: sinkage", b);
+    close_enough(plate_sinkage(&v), want, 0.005 * want, what);
+    free_world(&v);
+  }
+}
+
+/* reloading a rut follows K_e, then the envelope */
+static void test_reload(void)
+{
+  World w = make_world(plate_soil(), 1.2, 0.02, 0.4, 0.6, 20, 0, 0, 0, 0);
+  run(&w, 1500);
+  ssError e;
+  ss_remove(w.m, w.d, "plate", &e);
+  run(&w, 1);
+  int n = w.m->nhfielddata;
+  double *sk = malloc(n * sizeof(double)), *pl = malloc(n * sizeof(double)), *sh = malloc(n * sizeof(double));
+  ss_soil_get_state(w.m, w.d, 0, sk, pl, sh, &e);
+  double rut = 7.76625e-3;
+
+  /* a 10 kg plate in the rut: elastic only, extra sinkage p/K_e */
+  for (int k = 0; k < 2; k++) {
+    double mass = k == 0 ? 10 : 40;
+    World v = make_world(plate_soil(), 1.2, 0.02, 0.4, 0.6, mass, 0, 0, 0, -rut);
+    ss_soil_set_state(v.m, v.d, 0, sk, pl, sh, &e);
+    run(&v, 1500);
+    double pm = mass * G / 0.24;
+    int cnt;
+    if (k == 0) {
+      close_enough(plate_sinkage(&v), rut + pm / 2e6, 0.005 * pm / 2e6,
+                   "10 kg in the rut: reload along K_e (rut + p/K_e)");
+      double plm = mean_under(&v, v.d->soil_plastic, 0, 0, 0, 0.4, 0.6, 0.02, &cnt);
+      close_enough(plm, rut, 1e-6 * rut, "  the rut does not deepen on elastic reload");
+    } else {
+      close_enough(plate_sinkage(&v), pm / 1e5, 0.005 * pm / 1e5,
+                   "40 kg in the rut: K_e until the envelope, then yield");
+    }
+    free_world(&v);
+  }
+  free(sk);
+  free(pl);
+  free(sh);
+  free_world(&w);
+}
+
+/* an impact compacts deeper than slow loading; lifting has no suction */
+static void test_impact_and_lift(void)
+{
+  ssSoilMaterial s = plate_soil();
+  s.damping = 2000;
+  World w = make_world(s, 1.2, 0.02, 0.4, 0.6, 20, 0, 0, 0, 0.05);
+  run(&w, 1500);
+  ssError e;
+  ss_remove(w.m, w.d, "plate", &e);
+  run(&w, 1);
+  int cnt;
+  double rut = mean_under(&w, w.d->soil_plastic, 0, 0, 0, 0.4, 0.6, 0.02, &cnt);
+  ok(rut > 1.2 * 7.76625e-3, "dropped from 5 cm: rut %.4g mm deeper than the slow 7.766 mm", rut * 1e3);
+  free_world(&w);
+
+  /* settle, then pull up with 2 m g: the soil never pulls the plate down */
+  World v = make_world(plate_soil(), 1.2, 0.02, 0.4, 0.6, 20, 0, 0, 0, 0);
+  double up[3] = {0, 0, 2 * 20 * G}, zero[3] = {0, 0, 0};
+  ss_model_add_xforce(v.m, 0, up, zero, 1.0, 1e9, &e);
+  run(&v, 1000);
+  int suction = 0, negative = 0;
+  for (int k = 0; k < 300; k++) {
+    double vz = v.d->qvel[2];
+    run(&v, 1);
+    if (v.d->qvel[2] - vz < 1e-3 * G * 1e-3 - 1e-12) suction++;
+    if (v.d->stats.soil_normal_force < 0) negative++;
+  }
+  ok(suction == 0, "lifting: upward acceleration never below (F - m g)/m (%d steps)", suction);
+  ok(negative == 0, "no negative soil normal force");
+  ok(v.d->stats.soil_normal_force == 0 && v.d->qpos[2] > 0.05, "the plate left the soil");
+  double pl = mean_under(&v, v.d->soil_plastic, 0, 0, 0, 0.4, 0.6, 0.02, &cnt);
+  double sk = mean_under(&v, v.d->soil_sinkage, 0, 0, 0, 0.4, 0.6, 0.02, &cnt);
+  close_enough(sk, pl, 1e-15, "the surface recovered to the rut floor");
+  free_world(&v);
+}
+
+/* a horizontal pull below full strength, ramped up slowly (quasi-static,
+ * like the reference): the plate creeps until the mobilized Janosi strength
+ * carries the pull, F = (c A + mu m g)(1 - exp(-j/K_j)).  A sudden pull
+ * overshoots that (inertia), so the ramp's increments are far shorter than
+ * the plate's shear period 2 pi sqrt(m K_j / (c A + mu m g)) = 0.24 s. */
+static void test_drag(void)
+{
+  ssSoilMaterial s = plate_soil();
+  World w = make_world(s, 1.6, 0.04, 0.4, 0.6, 20, -0.2, 0, 0, 0);
+  ssError e;
+  const double F = 60, dt = w.m->opt.timestep;
+  const int nramp = 600;
+  double zero[3] = {0, 0, 0}, f[3] = {F / nramp, 0, 0};
+  for (int k = 0; k < nramp; k++) ss_model_add_xforce(w.m, 0, f, zero, 1.0 + 0.005 * k, 1e9, &e);
+  long sweeps = 0;
+  run(&w, 1000);
+  double x0 = w.d->qpos[0];
+  int visits = 0, slipping = 0;
+  double worst_bound = 0, worst_align = 0, power_sum = 0;
+  for (int k = 0; k < 4000; k++) {
+    run(&w, 1);
+    sweeps += w.d->stats.sweeps;
+    for (int i = 0; i < w.d->ncontact; i++) {
+      const ssContact *c = &w.d->contact[i];
+      if (!c->loaded) continue;
+      visits++;
+      double sc = c->area * dt, vt = hypot(c->v[1], c->v[2]);
+      double lt = hypot(c->lambda[1], c->lambda[2]);
+      double tmax = sc * ss_soil_shear_limit(&s, c->lambda[0] / sc, c->j + dt * vt);
+      worst_bound = fmax(worst_bound, (lt - tmax) / (sc * ss_soil_shear_strength(&s, c->lambda[0] / sc)));
+      double power = c->lambda[1] * c->v[1] + c->lambda[2] * c->v[2];
+      /* where a point really slips, the shear is antiparallel to the slip;
+       * below ~1e-8 m/s a slip velocity is the converged solve's noise
+       * (N contacts x G x tolerance x impulse), so 1e-6 m/s is the floor */
+      if (vt > 1e-6 && lt > 0) {
+        slipping++;
+        power_sum += power;
+        worst_align = fmax(worst_align, 1 + power / (lt * vt));
+      }
+    }
+  }
+  diag("drag: %.1f sweeps per step", (double)sweeps / 4000);
+  /* each point meets its bound when visited; the sweeps stop at a relative
+   * impulse change of 1e-9, so the end-of-step velocities used here may
+   * differ by that order: allow 1e-6 tau_f */
+  ok(visits > 0 && worst_bound <= 1e-6,
+     "shear within tau_max at every loaded point (%d visits, worst excess %.2g tau_f)", visits, worst_bound);
+  ok(slipping > 0 && worst_align <= 1e-9,
+     "shear opposes slip where points slip (%d, worst 1 + cos = %.2g)", slipping, worst_align);
+  ok(power_sum <= 0, "shear never adds energy (total shear power %.3g W)", power_sum / dt);
+  double tf = s.cohesion * 0.24 + s.friction_coefficient * 20 * G;
+  double jstar = -s.shear_displacement * log(1 - F / tf);
+  double dx = w.d->qpos[0] - x0;
+  /* 3 %: the leading strip of the plate meets fresh soil with j = 0 */
+  close_enough(dx, jstar, 0.03 * jstar, "creep distance from Janosi-Hanamoto");
+  ok(fabs(w.d->qvel[0]) < 1e-4, "the creep stops (v = %g m/s)", w.d->qvel[0]);
+  free_world(&w);
+
+  /* above full strength the plate slides on */
+  World v = make_world(s, 3.0, 0.02, 0.4, 0.6, 20, -1.0, 0, 0, 0);
+  double f2[3] = {2 * tf, 0, 0};
+  (void)f;
+  ss_model_add_xforce(v.m, 0, f2, zero, 1.0, 1e9, &e);
+  run(&v, 1600);
+  double v1 = v.d->qvel[0];
+  run(&v, 200);
+  ok(v.d->qvel[0] > v1 && v1 > 0.1, "pulled with twice the strength it slides and accelerates");
+  free_world(&v);
+}
+
+/* rigid ground: rest, friction and restitution from the material pairs */
+static void test_rigid(void)
+{
+  ssError e;
+  ssModel *m = ss_model_new();
+  ss_model_add_plane(m, "ground", 0, "steel", 0, &e);
+  ss_model_set_pair(m, "steel", "rubber", 0.5, 0.5, 0.01, &e);
+  ssBodyDef b = ss_body_def_default();
+  b.name = "ball";
+  b.shape = SS_GEOM_SPHERE;
+  b.size[0] = 0.1;
+  b.mass = 1;
+  b.material = "rubber";
+  ss_v3_set(b.pos, 0, 0, 1.1);
+  ss_model_add_body(m, &b, &e);
+  ssBodyDef p = ss_body_def_default();
+  p.name = "slider";
+  p.size[0] = p.size[1] = 0.2;
+  p.size[2] = 0.1;
+  p.mass = 5;
+  p.material = "rubber";
+  ss_v3_set(p.pos, 2, 0, 0.05);
+  p.lin_vel[0] = 3;
+  ss_model_add_body(m, &p, &e);
+  ssData *d = ss_data_new(m);
+  /* ball falls 1 m: impact at sqrt(2 g) ~ 4.43 m/s, rebounds at e times */
+  double vmin = 0, vmax_after = 0;
+  int bounced = 0;
+  for (int k = 0; k < 700; k++) {
+    ss_step(m, d, &e);
+    double vz = d->qvel[2];
+    if (!bounced && vz < vmin) vmin = vz;
+    if (vz > 0) bounced = 1;
+    if (bounced && vz > vmax_after) vmax_after = vz;
+  }
+  close_enough(vmax_after / -vmin, 0.5, 0.02, "restitution 0.5 from the material pair");
+  /* the slider decelerates at mu g and stops after v^2 / (2 mu g) */
+  double want = 9.0 / (2 * 0.5 * G);
+  close_enough(d->qpos[7] - 2, want, 0.02 * want, "sliding box stops after v^2/(2 mu g)");
+  close_enough(d->qpos[9], 0.05, 1e-3, "box rests on the ground plane");
+  ss_data_free(d);
+  ss_model_free(m);
+
+  /* a rigid height map inclined at 20 degrees: mu 0.5 < tan 20 = 0.364? no:
+   * 0.5 > 0.364, the box stays; with mu 0.2 it slides at g (sin - mu cos) */
+  for (int k = 0; k < 2; k++) {
+    double mu = k == 0 ? 0.5 : 0.2, th = 20 * M_PI / 180;
+    ssModel *m2 = ss_model_new();
+    int n = 41;
+    double *z = malloc(n * n * sizeof(double));
+    for (int j = 0; j < n; j++)
+      for (int i = 0; i < n; i++) z[j * n + i] = tan(th) * (-2 + 4.0 * i / (n - 1));
+    ssHfieldDef hd = ss_hfield_def_default();
+    hd.name = "slope";
+    hd.nx = hd.ny = n;
+    hd.x_size = hd.y_size = 4;
+    hd.height = z;
+    ss_model_add_hfield(m2, &hd, &e);
+    free(z);
+    ss_model_set_pair(m2, NULL, NULL, mu, 0, 0, &e);
+    ssBodyDef bx = ss_body_def_default();
+    bx.name = "box";
+    bx.size[0] = bx.size[1] = 0.2;
+    bx.size[2] = 0.1;
+    bx.mass = 2;
+    double axis[3] = {0, 1, 0};
+    ss_quat_from_axis_angle(bx.quat, axis, -th);
+    ss_v3_set(bx.pos, 0, 0, 0.05 / cos(th));
+    ss_model_add_body(m2, &bx, &e);
+    ssData *d2 = ss_data_new(m2);
+    for (int s = 0; s < 300; s++) ss_step(m2, d2, &e);
+    double v0 = -d2->qvel[0] / cos(th), x0 = d2->qpos[0];
+    for (int s = 0; s < 300; s++) ss_step(m2, d2, &e);
+    double v1 = -d2->qvel[0] / cos(th);
+    if (k == 0)
+      ok(fabs(d2->qpos[0] - x0) < 1e-4 && fabs(v1) < 1e-3, "mu 0.5 on a 20 degree rigid height map: the box holds");
+    else
+      close_enough((v1 - v0) / 0.3, G * (sin(th) - mu * cos(th)), 0.02 * G,
+                   "mu 0.2 on a 20 degree rigid height map: slides at g (sin - mu cos)");
+    ss_data_free(d2);
+    ss_model_free(m2);
+  }
+}
+
+int main(void)
+{
+  test_analytic_plate();
+  test_envelope_shapes();
+  test_reload();
+  test_impact_and_lift();
+  test_drag();
+  test_rigid();
+  return done_testing();
+}

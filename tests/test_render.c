@@ -1,0 +1,773 @@
+/* test_render.c -- off-screen frames, rut maps and PNG input/output
+ * (DESIGN 6).  Every check reads decoded pixels, never PNG bytes.
+ *
+ * Set SS_TEST_KEEP=DIR to keep the images the tests write in DIR;
+ * Frame times are reported as diagnostics, never asserted: speed is the
+ * benchmark program's business (shared machines are noisy). */
+#include "png_io.h"
+#include "render.h"
+#include "soilsim.h"
+#include "tap.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+static char outdir[512];
+
+static const char *out_path(const char *name)
+{
+  static char buf[4][1024];
+  static int k;
+  k = (k + 1) % 4;
+  snprintf(buf[k], sizeof buf[k], "%s/%s", outdir, name);
+  return buf[k];
+}
+
+static double now_s(void)
+{
+  struct timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* CPU time of the whole process (all of llvmpipe's threads included). */
+static double cpu_s(void)
+{
+  struct timespec t;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static const unsigned char *pix(const unsigned char *rgba, int w, int col, int row)
+{
+  return rgba + ((size_t)row * (size_t)w + (size_t)col) * 4;
+}
+
+/* max |difference| over the three channels */
+static int rgb_diff(const unsigned char *p, int r, int g, int b)
+{
+  int d = abs(p[0] - r);
+  if (abs(p[1] - g) > d) d = abs(p[1] - g);
+  if (abs(p[2] - b) > d) d = abs(p[2] - b);
+  return d;
+}
+
+/* ---------------------------------------------------------------------- */
+/* a small world: a 2 m x 2 m soil bed, a blue box in its middle and an
+ * imposed rectangular rut of depth RUT_DEPTH over x in [0.4, 0.8],
+ * y in [-0.3, 0.3] */
+
+#define BED_N 81 /* vertices per side: 2.5 cm spacing */
+#define RUT_DEPTH 0.0082
+#define RUT_X0 0.4
+#define RUT_X1 0.8
+#define RUT_Y0 -0.3
+#define RUT_Y1 0.3
+
+typedef struct world {
+  ssModel *m;
+  ssData *d;
+  int bed, box;
+} world;
+
+static double bed_coord(int i) { return -1.0 + 2.0 * i / (BED_N - 1); }
+
+static int in_rut(double x, double y)
+{
+  return x >= RUT_X0 - 1e-9 && x <= RUT_X1 + 1e-9 && y >= RUT_Y0 - 1e-9 &&
+         y <= RUT_Y1 + 1e-9;
+}
+
+static int make_world(world *w, int with_box, double plastic_fraction)
+{
+  ssError err;
+  memset(w, 0, sizeof *w);
+  w->m = ss_model_new();
+  if (!w->m) return 0;
+  double *z = calloc(BED_N * BED_N, sizeof *z);
+  ssHfieldDef hd = ss_hfield_def_default();
+  hd.name = "soil";
+  hd.nx = hd.ny = BED_N;
+  hd.x_size = hd.y_size = 2.0;
+  hd.height = z;
+  hd.soil = 1;
+  w->bed = ss_model_add_hfield(w->m, &hd, &err);
+  free(z);
+  if (w->bed < 0) {
+    diag("add_hfield: %s", err.message);
+    return 0;
+  }
+  w->box = -1;
+  if (with_box) {
+    ssBodyDef bd = ss_body_def_default();
+    bd.name = "block";
+    bd.shape = SS_GEOM_BOX;
+    bd.size[0] = 0.3;
+    bd.size[1] = 0.3;
+    bd.size[2] = 0.1;
+    bd.mass = 5;
+    bd.pos[2] = 0.05;
+    bd.rgba[0] = 0.2;
+    bd.rgba[1] = 0.4;
+    bd.rgba[2] = 0.8;
+    bd.rgba[3] = 1.0;
+    w->box = ss_model_add_body(w->m, &bd, &err);
+    if (w->box < 0) {
+      diag("add_body: %s", err.message);
+      return 0;
+    }
+  }
+  w->d = ss_data_new(w->m);
+  if (!w->d) return 0;
+  ss_forward(w->m, w->d);
+
+  double *s = calloc(BED_N * BED_N, sizeof *s), *p = calloc(BED_N * BED_N, sizeof *p);
+  for (int j = 0; j < BED_N; j++)
+    for (int i = 0; i < BED_N; i++)
+      if (in_rut(bed_coord(i), bed_coord(j))) {
+        s[j * BED_N + i] = RUT_DEPTH;
+        p[j * BED_N + i] = plastic_fraction * RUT_DEPTH;
+      }
+  ssStatus st = ss_soil_set_state(w->m, w->d, w->bed, s, p, NULL, &err);
+  free(s);
+  free(p);
+  if (st != SS_OK) {
+    diag("soil_set_state: %s", err.message);
+    return 0;
+  }
+  return 1;
+}
+
+static void free_world(world *w)
+{
+  ss_data_free(w->d);
+  ss_model_free(w->m);
+  memset(w, 0, sizeof *w);
+}
+
+/* ---------------------------------------------------------------------- */
+
+static void test_png_io(void)
+{
+  ssError err;
+  int w = 37, h = 23;
+  unsigned char *img = malloc((size_t)w * h * 4);
+  for (int k = 0; k < w * h * 4; k++) img[k] = (unsigned char)(k * 7 + (k >> 5));
+  const char *path = out_path("roundtrip.png");
+  ok(ss_png_write_rgba(path, w, h, img, &err) == SS_OK, "png: write %dx%d", w, h);
+  int w2 = 0, h2 = 0;
+  unsigned char *back = NULL;
+  ok(ss_png_read_rgba(path, &w2, &h2, &back, &err) == SS_OK && w2 == w && h2 == h &&
+         memcmp(back, img, (size_t)w * h * 4) == 0,
+     "png: RGBA round trip is exact");
+  free(back);
+
+  /* grey read of a grey-looking RGBA image */
+  for (int k = 0; k < w * h; k++) {
+    img[4 * k] = img[4 * k + 1] = img[4 * k + 2] = (unsigned char)(k % 256);
+    img[4 * k + 3] = 255;
+  }
+  ss_png_write_rgba(path, w, h, img, &err);
+  double *g = NULL;
+  ok(ss_png_read_gray(path, &w2, &h2, &g, &err) == SS_OK && w2 == w && h2 == h,
+     "png: grey read");
+  if (g) {
+    double worst = 0;
+    for (int k = 0; k < w * h; k++)
+      worst = fmax(worst, fabs(g[k] - (k % 256) / 255.0));
+    ok(worst < 1e-12, "png: grey values of a grey image are v/255 (worst %.3g)", worst);
+    free(g);
+  }
+
+  /* every truncation of a valid file is refused cleanly */
+  FILE *f = fopen(path, "rb");
+  fseek(f, 0, SEEK_END);
+  long n = ftell(f);
+  rewind(f);
+  unsigned char *bytes = malloc((size_t)n);
+  size_t got = fread(bytes, 1, (size_t)n, f);
+  fclose(f);
+  int accepted = 0, clean = 1;
+  const char *tpath = out_path("truncated.png");
+  for (long k = 0; k < (long)got; k += (k < 64 ? 1 : 7)) {
+    FILE *o = fopen(tpath, "wb");
+    fwrite(bytes, 1, (size_t)k, o);
+    fclose(o);
+    unsigned char *px = NULL;
+    memset(&err, 0, sizeof err);
+    ssStatus st = ss_png_read_rgba(tpath, &w2, &h2, &px, &err);
+    if (st == SS_OK) {
+      accepted++;
+      free(px);
+    } else if (px != NULL || strcmp(err.file, tpath) != 0 || !err.message[0]) {
+      clean = 0;
+    }
+  }
+  ok(accepted == 0 && clean, "png: truncated files are refused with the path and a message");
+  memset(&err, 0, sizeof err);
+  ss_png_read_rgba(tpath, &w2, &h2, &back, &err);
+  diag("truncated: %s: %s", err.file, err.message);
+  free(bytes);
+
+  /* not a PNG at all */
+  FILE *o = fopen(tpath, "wb");
+  fputs("this is not an image\n", o);
+  fclose(o);
+  ok(ss_png_read_gray(tpath, &w2, &h2, &g, &err) == SS_ERR_PARSE &&
+         strstr(err.message, "not a PNG") != NULL,
+     "png: a text file is 'not a PNG file' (%s)", err.message);
+  ok(ss_png_read_gray(out_path("missing.png"), &w2, &h2, &g, &err) == SS_ERR_IO,
+     "png: a missing file is an I/O error");
+  ok(ss_png_write_rgba("/nonexistent-dir/x/y.png", w, h, img, &err) == SS_ERR_IO &&
+         strcmp(err.file, "/nonexistent-dir/x/y.png") == 0,
+     "png: unwritable path fails cleanly (%s)", err.message);
+  free(img);
+}
+
+static void test_colormap(void)
+{
+  unsigned char c[3];
+  ss_colormap(0.0, c);
+  ok(c[0] == SS_CMAP_ZERO_R && c[1] == SS_CMAP_ZERO_G && c[2] == SS_CMAP_ZERO_B,
+     "colour map: t = 0 is the documented zero colour (%d %d %d)", c[0], c[1], c[2]);
+  ss_colormap(1.0, c);
+  ok(c[0] == SS_CMAP_DEEP_R && c[1] == SS_CMAP_DEEP_G && c[2] == SS_CMAP_DEEP_B,
+     "colour map: t = 1 is the documented deep colour (%d %d %d)", c[0], c[1], c[2]);
+  int invertible = 1, monotone = 1;
+  double prev_l = 1e9;
+  for (int k = 0; k < SS_CMAP_N; k++) {
+    ss_colormap_entry(k, c);
+    int d2;
+    double t = ss_colormap_inverse(c, &d2);
+    if (d2 != 0 || fabs(t - (double)k / (SS_CMAP_N - 1)) > 1e-12) invertible = 0;
+    double l = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    if (l > prev_l + 1e-9) monotone = 0;
+    prev_l = l;
+  }
+  ok(invertible, "colour map: every entry reads back to its own value");
+  ok(monotone, "colour map: lightness falls from zero to deep");
+  close_enough(ss_nice_ceil(0.0082), 0.01, 1e-15, "full scale of 8.2 mm");
+  close_enough(ss_nice_ceil(0.01), 0.01, 1e-15, "full scale of 10 mm");
+  close_enough(ss_nice_ceil(0.0041), 0.005, 1e-15, "full scale of 4.1 mm");
+  close_enough(ss_nice_ceil(0.021), 0.025, 1e-15, "full scale of 21 mm");
+  close_enough(ss_nice_ceil(0.0), SS_FULL_SCALE_MIN, 0, "full scale of an untouched bed");
+}
+
+static void test_bad_sizes(void)
+{
+  world w;
+  if (!ok(make_world(&w, 1, 0.5), "world for size checks")) return;
+  int sizes[][2] = {{0, 240}, {320, 0}, {100000, 240}, {320, 100000}, {-5, -5}};
+  for (int k = 0; k < 5; k++) {
+    ssRenderOptions o = ss_render_options_default();
+    o.width = sizes[k][0];
+    o.height = sizes[k][1];
+    ssError err;
+    memset(&err, 0, sizeof err);
+    ssRenderer *r = ss_render_new(w.m, &o, &err);
+    ok(r == NULL && err.code == SS_ERR_VALUE && strstr(err.message, "image size"),
+       "render_new %d x %d fails: %s", o.width, o.height, err.message);
+    ss_render_free(r);
+  }
+  ssRenderOptions o = ss_render_options_default();
+  strcpy(o.camera_follow, "no_such_body");
+  ssError err;
+  ssRenderer *r = ss_render_new(w.m, &o, &err);
+  ok(r == NULL && err.code == SS_ERR_NOTFOUND,
+     "render_new with an unknown follow target fails: %s", err.message);
+  ss_render_free(r);
+  free_world(&w);
+}
+
+/* Camera straight down over the bed centre. */
+static ssRenderOptions top_view(int W, int H)
+{
+  ssRenderOptions o = ss_render_options_default();
+  o.width = W;
+  o.height = H;
+  o.camera_given = 1;
+  o.camera_pos[0] = 0;
+  o.camera_pos[1] = 0;
+  o.camera_pos[2] = 4;
+  o.camera_look_at[0] = 0;
+  o.camera_look_at[1] = 0;
+  o.camera_look_at[2] = 0;
+  o.camera_fov_deg = 45;
+  return o;
+}
+
+static void test_frame(void)
+{
+  world w;
+  if (!ok(make_world(&w, 1, 0.5), "world for frames")) return;
+  int W = 320, H = 240;
+  ssRenderOptions o = top_view(W, H);
+  o.sinkage_max = RUT_DEPTH; /* the rut is exactly full scale */
+  ssError err;
+  ssRenderer *r = ss_render_new(w.m, &o, &err);
+  if (!ok(r != NULL, "render_new 320x240 (%s)", r ? "ok" : err.message)) {
+    free_world(&w);
+    return;
+  }
+  unsigned char *a = malloc((size_t)W * H * 4), *b = malloc((size_t)W * H * 4);
+  ok(ss_render_pixels(r, w.m, w.d, a, &err) == SS_OK, "render_pixels");
+
+  /* background corners */
+  int corners[4][2] = {{0, 0}, {W - 1, 0}, {0, H - 1}, {W - 1, H - 1}};
+  int bg = 1;
+  for (int k = 0; k < 4; k++) {
+    const unsigned char *p = pix(a, W, corners[k][0], corners[k][1]);
+    if (p[0] != SS_CLEAR_R || p[1] != SS_CLEAR_G || p[2] != SS_CLEAR_B || p[3] != 255)
+      bg = 0;
+  }
+  ok(bg, "frame corners show the clear colour (%d %d %d)", SS_CLEAR_R, SS_CLEAR_G,
+     SS_CLEAR_B);
+
+  /* the box's top faces the overhead light: exactly its own colour */
+  double top[3] = {0, 0, 0.1}, col = -1, row = -1;
+  int projected = ss_render_project(r, top, &col, &row);
+  ok(projected && fabs(col - W / 2.0) < 1e-6 &&
+         fabs(row - H / 2.0) < 1e-6,
+     "the look-at point projects to the image centre (%.2f, %.2f)", col, row);
+  const unsigned char *p = pix(a, W, (int)col, (int)row);
+  ok(rgb_diff(p, 51, 102, 204) <= 1, "box top at its projected centre: %d %d %d, want 51 102 204",
+     p[0], p[1], p[2]);
+
+  /* the rut floor (full scale) and untouched soil */
+  double rut[3] = {0.6, 0.0, -RUT_DEPTH}, soil[3] = {-0.6, 0.5, 0};
+  ss_render_project(r, rut, &col, &row);
+  p = pix(a, W, (int)col, (int)row);
+  ok(rgb_diff(p, SS_CMAP_DEEP_R, SS_CMAP_DEEP_G, SS_CMAP_DEEP_B) <= 1,
+     "rut floor pixel (%d, %d) has the deep colour: %d %d %d", (int)col, (int)row,
+     p[0], p[1], p[2]);
+  int rut_col = (int)col, rut_row = (int)row;
+  ss_render_project(r, soil, &col, &row);
+  p = pix(a, W, (int)col, (int)row);
+  ok(rgb_diff(p, SS_CMAP_ZERO_R, SS_CMAP_ZERO_G, SS_CMAP_ZERO_B) <= 1,
+     "untouched soil pixel (%d, %d) has the zero colour: %d %d %d", (int)col,
+     (int)row, p[0], p[1], p[2]);
+  int soil_col = (int)col, soil_row = (int)row;
+
+  /* image-up is world +y when looking straight down */
+  double py[3] = {0, 0.5, 0}, px[3] = {0.5, 0, 0};
+  double c1, r1, c2, r2;
+  ss_render_project(r, py, &c1, &r1);
+  ss_render_project(r, px, &c2, &r2);
+  ok(r1 < H / 2.0 && fabs(c1 - W / 2.0) < 1e-6 && c2 > W / 2.0 && fabs(r2 - H / 2.0) < 1e-6,
+     "top view: +y is up and +x is right in the image");
+
+  /* the same state twice gives the same pixels */
+  ok(ss_render_pixels(r, w.m, w.d, b, &err) == SS_OK &&
+         memcmp(a, b, (size_t)W * H * 4) == 0,
+     "rendering the same state twice gives identical pixels");
+
+  /* the frame as a PNG decodes to the same pixels, at the requested size */
+  const char *fp = out_path("frame_000000.png");
+  ok(ss_render_frame(r, w.m, w.d, fp, &err) == SS_OK, "render_frame writes %s", fp);
+  int w2 = 0, h2 = 0;
+  unsigned char *back = NULL;
+  ok(ss_png_read_rgba(fp, &w2, &h2, &back, &err) == SS_OK && w2 == W && h2 == H &&
+         memcmp(back, a, (size_t)W * H * 4) == 0,
+     "the PNG frame has the requested size %dx%d and the rendered pixels", W, H);
+  free(back);
+  memset(&err, 0, sizeof err);
+  ok(ss_render_frame(r, w.m, w.d, "/nonexistent-dir/frame.png", &err) == SS_ERR_IO &&
+         err.message[0],
+     "unwritable frame path fails cleanly: %s: %s", err.file, err.message);
+  ss_render_free(r);
+
+  /* plain soil colour: the rut floor is lit like flat ground */
+  o.color_mode = SS_COLOR_SOIL;
+  r = ss_render_new(w.m, &o, &err);
+  ss_render_pixels(r, w.m, w.d, b, &err);
+  p = pix(b, W, rut_col, rut_row);
+  ok(rgb_diff(p, SS_SOIL_R, SS_SOIL_G, SS_SOIL_B) <= 1,
+     "soil colour mode: rut floor is the plain soil colour (%d %d %d)", p[0], p[1], p[2]);
+  ss_render_free(r);
+
+  /* permanent sinkage (half the rut) on an automatic scale of 5 mm */
+  o.color_mode = SS_COLOR_PLASTIC;
+  o.sinkage_max = 0;
+  r = ss_render_new(w.m, &o, &err);
+  ss_render_pixels(r, w.m, w.d, b, &err);
+  p = pix(b, W, rut_col, rut_row);
+  int d2;
+  double v = ss_colormap_inverse(p, &d2) * ss_nice_ceil(0.5 * RUT_DEPTH);
+  ok(fabs(v - 0.5 * RUT_DEPTH) <= ss_nice_ceil(0.5 * RUT_DEPTH) / (SS_CMAP_N - 1) && d2 <= 3,
+     "plastic mode: rut floor decodes to %.3f mm (want %.3f)", v * 1e3,
+     0.5 * RUT_DEPTH * 1e3);
+  p = pix(b, W, soil_col, soil_row);
+  ok(rgb_diff(p, SS_CMAP_ZERO_R, SS_CMAP_ZERO_G, SS_CMAP_ZERO_B) <= 1,
+     "plastic mode: untouched soil has the zero colour");
+  ss_render_free(r);
+
+  /* a removed body is not drawn: the soil under it shows */
+  o.color_mode = SS_COLOR_SINKAGE;
+  r = ss_render_new(w.m, &o, &err);
+  ss_remove(w.m, w.d, "block", &err);
+  ss_render_pixels(r, w.m, w.d, b, &err);
+  p = pix(b, W, W / 2, H / 2);
+  ok(rgb_diff(p, SS_CMAP_ZERO_R, SS_CMAP_ZERO_G, SS_CMAP_ZERO_B) <= 1,
+     "a removed body is not drawn (centre shows soil: %d %d %d)", p[0], p[1], p[2]);
+  ss_render_free(r);
+
+  free(a);
+  free(b);
+  free_world(&w);
+}
+
+/* Following a body keeps the camera's offset from it. */
+static void test_follow(void)
+{
+  world w;
+  if (!ok(make_world(&w, 1, 0.5), "world for the follow camera")) return;
+  int W = 200, H = 150;
+  ssRenderOptions o = top_view(W, H);
+  o.camera_pos[0] = 0.5; /* look at a point beside the box */
+  o.camera_look_at[0] = 0.5;
+  strcpy(o.camera_follow, "block");
+  ssError err;
+  ssRenderer *r = ss_render_new(w.m, &o, &err);
+  if (!ok(r != NULL, "render_new with camera_follow")) {
+    free_world(&w);
+    return;
+  }
+  unsigned char *a = malloc((size_t)W * H * 4);
+  ss_render_pixels(r, w.m, w.d, a, &err);
+  double top[3] = {0, 0, 0.1}, c0, r0, c1, r1;
+  ss_render_project(r, top, &c0, &r0);
+  /* move the box 0.3 m along -x and draw again */
+  int q = w.m->sys_qadr[w.box];
+  w.d->qpos[q] -= 0.3;
+  ss_forward(w.m, w.d);
+  ss_render_pixels(r, w.m, w.d, a, &err);
+  double top1[3] = {-0.3, 0, 0.1};
+  ss_render_project(r, top1, &c1, &r1);
+  ok(fabs(c0 - c1) < 1e-6 && fabs(r0 - r1) < 1e-6,
+     "a followed body stays at the same pixel (%.2f, %.2f) -> (%.2f, %.2f)", c0, r0, c1, r1);
+  const unsigned char *p = pix(a, W, (int)c1, (int)r1);
+  ok(rgb_diff(p, 51, 102, 204) <= 1, "and it is drawn there (%d %d %d)", p[0], p[1], p[2]);
+  free(a);
+  ss_render_free(r);
+  free_world(&w);
+}
+
+/* A ground plane at the bed's height stays behind the bed; a rigid height
+ * map is drawn in its plain colour. */
+static void test_plane(void)
+{
+  world w;
+  if (!ok(make_world(&w, 0, 0.5), "world for the ground plane")) return;
+  ssError err;
+  /* rebuild with a plane at z = 0 and a rigid map beside the bed */
+  ss_data_free(w.d);
+  ss_model_add_plane(w.m, "ground", 0.0, NULL, 0, &err);
+  double z[4] = {0.2, 0.2, 0.2, 0.2};
+  ssHfieldDef hd = ss_hfield_def_default();
+  hd.name = "rock";
+  hd.x_size = hd.y_size = 0.5;
+  hd.height = z;
+  hd.pos[0] = -1.5;
+  int rock = ss_model_add_hfield(w.m, &hd, &err);
+  w.d = ss_data_new(w.m);
+  ok(rock == 1 && w.d != NULL, "plane and rigid height map added");
+  int W = 320, H = 240;
+  ssRenderOptions o = top_view(W, H);
+  ssRenderer *r = ss_render_new(w.m, &o, &err);
+  unsigned char *a = malloc((size_t)W * H * 4);
+  ok(r && ss_render_pixels(r, w.m, w.d, a, &err) == SS_OK, "frame with a ground plane");
+  double soil[3] = {-0.6, 0.5, 0}, rk[3] = {-1.5, 0, 0.2}, col, row;
+  ss_render_project(r, soil, &col, &row);
+  const unsigned char *p = pix(a, W, (int)col, (int)row);
+  ok(rgb_diff(p, SS_CMAP_ZERO_R, SS_CMAP_ZERO_G, SS_CMAP_ZERO_B) <= 1,
+     "a plane at the bed's height stays behind it (%d %d %d)", p[0], p[1], p[2]);
+  p = pix(a, W, 0, H - 1);
+  ok(rgb_diff(p, SS_PLANE_R, SS_PLANE_G, SS_PLANE_B) <= 1,
+     "the ground plane fills the corner in its grey (%d %d %d)", p[0], p[1], p[2]);
+  ss_render_project(r, rk, &col, &row);
+  p = pix(a, W, (int)col, (int)row);
+  ok(rgb_diff(p, SS_RIGID_R, SS_RIGID_G, SS_RIGID_B) <= 1,
+     "a rigid height map is drawn in its plain grey (%d %d %d)", p[0], p[1], p[2]);
+  free(a);
+  ss_render_free(r);
+  free_world(&w);
+}
+
+/* The automatic overview frames the first soil bed. */
+static void test_auto_camera(void)
+{
+  world w;
+  if (!ok(make_world(&w, 1, 0.5), "world for the automatic camera")) return;
+  int W = 320, H = 180;
+  ssRenderOptions o = ss_render_options_default();
+  o.width = W;
+  o.height = H;
+  ssError err;
+  ssRenderer *r = ss_render_new(w.m, &o, &err);
+  unsigned char *a = malloc((size_t)W * H * 4);
+  ok(r && ss_render_pixels(r, w.m, w.d, a, &err) == SS_OK, "automatic camera frame");
+  int inside = 1;
+  for (int k = 0; k < 4; k++) {
+    double c[3] = {(k & 1) ? 1 : -1, (k & 2) ? 1 : -1, 0}, col, row;
+    if (!ss_render_project(r, c, &col, &row) || col < 0 || col > W || row < 0 || row > H)
+      inside = 0;
+  }
+  ok(inside, "all four bed corners are inside the automatic view");
+  const unsigned char *p = pix(a, W, 0, 0);
+  ok(p[0] == SS_CLEAR_R && p[1] == SS_CLEAR_G && p[2] == SS_CLEAR_B,
+     "automatic view: corner shows the sky");
+  if (getenv("SS_TEST_KEEP")) ss_render_frame(r, w.m, w.d, out_path("auto.png"), &err);
+  free(a);
+  ss_render_free(r);
+  free_world(&w);
+}
+
+static void test_rut_map(void)
+{
+  world w;
+  if (!ok(make_world(&w, 1, 0.5), "world for rut maps")) return;
+  int W = 640, H = 400;
+  ssError err;
+  const char *path = out_path("ruts.png");
+  ok(ss_render_rut_map(w.m, w.d, -1, 0, W, H, path, &err) == SS_OK,
+     "rut map of total sinkage written");
+  int w2 = 0, h2 = 0;
+  unsigned char *a = NULL;
+  if (!ok(ss_png_read_rgba(path, &w2, &h2, &a, &err) == SS_OK && w2 == W && h2 == H,
+          "rut map decodes at the requested size %dx%d", W, H)) {
+    free(a);
+    free_world(&w);
+    return;
+  }
+  ssRutMapLayout L;
+  int laid = ss_rut_map_layout(W, H, 2.0, 2.0, &L);
+  ok(laid == 0 && L.map_w > 100 &&
+         abs(L.map_w - L.map_h) <= 1,
+     "layout: a square bed gets a square map (%d x %d at %d, %d)", L.map_w, L.map_h,
+     L.map_x, L.map_y);
+
+  /* every map pixel: inside the rut (a cell away from its edge) it reads
+   * 8.2 mm; a cell away from the rut it is exactly the zero colour */
+  double fs = ss_nice_ceil(RUT_DEPTH), res = fs / (SS_CMAP_N - 1);
+  double cell = 2.0 / (BED_N - 1);
+  long n_in = 0, bad_in = 0, n_out = 0, bad_out = 0;
+  double worst = 0;
+  for (int row = L.map_y; row < L.map_y + L.map_h; row++)
+    for (int col = L.map_x; col < L.map_x + L.map_w; col++) {
+      double u = (col - L.map_x + 0.5) / L.map_w, v = 1 - (row - L.map_y + 0.5) / L.map_h;
+      double x = -1 + 2 * u, y = -1 + 2 * v;
+      const unsigned char *p = pix(a, W, col, row);
+      int inner = x > RUT_X0 + cell && x < RUT_X1 - cell && y > RUT_Y0 + cell &&
+                  y < RUT_Y1 - cell;
+      int outer = x < RUT_X0 - cell || x > RUT_X1 + cell || y < RUT_Y0 - cell ||
+                  y > RUT_Y1 + cell;
+      if (inner) {
+        int d2;
+        double val = ss_colormap_inverse(p, &d2) * fs;
+        worst = fmax(worst, fabs(val - RUT_DEPTH));
+        n_in++;
+        if (fabs(val - RUT_DEPTH) > res || d2 != 0) bad_in++;
+      } else if (outer) {
+        n_out++;
+        if (p[0] != SS_CMAP_ZERO_R || p[1] != SS_CMAP_ZERO_G || p[2] != SS_CMAP_ZERO_B)
+          bad_out++;
+      }
+    }
+  ok(n_in > 1000 && bad_in == 0,
+     "rut map: %ld footprint pixels read 8.2 mm within %.3f mm (worst %.4f mm, %ld off)",
+     n_in, res * 1e3, worst * 1e3, bad_in);
+  ok(n_out > 10000 && bad_out == 0,
+     "rut map: %ld pixels off the rut have exactly the zero colour (%ld off)", n_out,
+     bad_out);
+
+  /* the pixel of one bed point, through the layout */
+  int col, row;
+  ss_rut_map_pixel(&L, (0.6 + 1) / 2, (0.0 + 1) / 2, &col, &row);
+  int d2;
+  double val = ss_colormap_inverse(pix(a, W, col, row), &d2) * fs;
+  close_enough(val * 1e3, RUT_DEPTH * 1e3, res * 1e3, "rut centre (0.6, 0) in mm");
+
+  /* colour bar: full scale at the top, zero at the bottom */
+  const unsigned char *t = pix(a, W, L.bar_x + L.bar_w / 2, L.bar_y);
+  const unsigned char *bt = pix(a, W, L.bar_x + L.bar_w / 2, L.bar_y + L.bar_h - 1);
+  ok(rgb_diff(t, SS_CMAP_DEEP_R, SS_CMAP_DEEP_G, SS_CMAP_DEEP_B) == 0 &&
+         rgb_diff(bt, SS_CMAP_ZERO_R, SS_CMAP_ZERO_G, SS_CMAP_ZERO_B) == 0,
+     "colour bar: deep colour on top, zero colour at the bottom");
+  /* labels and the scale bar are drawn in ink somewhere right of the bar
+   * and under the map */
+  long ink_right = 0, ink_below = 0;
+  for (int r2 = 0; r2 < H; r2++)
+    for (int c2 = L.bar_x + L.bar_w + 2; c2 < W; c2++)
+      if (pix(a, W, c2, r2)[0] < 100) ink_right++;
+  for (int r2 = L.map_y + L.map_h + 2; r2 < H; r2++)
+    for (int c2 = 0; c2 < W; c2++)
+      if (pix(a, W, c2, r2)[0] < 100) ink_below++;
+  ok(ink_right > 50 && ink_below > 50, "labels beside the bar (%ld px) and a scale below (%ld px)",
+     ink_right, ink_below);
+  ok(L.scale_len > 0 && fabs(L.scale_len - L.scale_m / 2.0 * L.map_w) <= 0.5,
+     "metre scale: %g m is %d px on a %d px wide 2 m map", L.scale_m, L.scale_len, L.map_w);
+  const unsigned char *corner = pix(a, W, 0, H - 1);
+  ok(corner[0] == 255 && corner[1] == 255 && corner[2] == 255, "rut map paper is white");
+  free(a);
+
+  /* permanent sinkage: 4.1 mm on a 5 mm scale */
+  path = out_path("ruts_plastic.png");
+  ok(ss_render_rut_map(w.m, w.d, 0, 1, W, H, path, &err) == SS_OK,
+     "rut map of permanent sinkage written");
+  ss_png_read_rgba(path, &w2, &h2, &a, &err);
+  fs = ss_nice_ceil(0.5 * RUT_DEPTH);
+  val = ss_colormap_inverse(pix(a, W, col, row), &d2) * fs;
+  close_enough(val * 1e3, 0.5 * RUT_DEPTH * 1e3, fs / (SS_CMAP_N - 1) * 1e3,
+               "permanent rut centre in mm");
+  free(a);
+
+  /* rut map errors */
+  ok(ss_render_rut_map(w.m, w.d, -1, 0, 10, 10, out_path("tiny.png"), &err) == SS_ERR_VALUE,
+     "rut map 10x10 is refused: %s", err.message);
+  ok(ss_render_rut_map(w.m, w.d, 5, 0, W, H, out_path("x.png"), &err) == SS_ERR_VALUE,
+     "rut map of a missing height map is refused: %s", err.message);
+  ok(ss_render_rut_map(w.m, w.d, -1, 0, W, H, "/nonexistent-dir/ruts.png", &err) == SS_ERR_IO,
+     "unwritable rut map path fails cleanly: %s", err.message);
+  free_world(&w);
+
+  ssModel *m = ss_model_new();
+  ssData *d = ss_data_new(m);
+  ok(ss_render_rut_map(m, d, -1, 0, W, H, out_path("none.png"), &err) == SS_ERR_NOTFOUND,
+     "rut map of a world without soil: %s", err.message);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
+/* The size of the vehicle scene: a 16 m x 6 m bed of 801 x 301 vertices
+ * with two ruts, a ground plane and 40 primitives, at 1280 x 720. */
+static void test_timing(void)
+{
+  ssError err;
+  ssModel *m = ss_model_new();
+  int nx = 801, ny = 301;
+  double *z = malloc(sizeof *z * (size_t)nx * ny);
+  for (int j = 0; j < ny; j++)
+    for (int i = 0; i < nx; i++)
+      z[j * nx + i] = 0.03 * sin(0.05 * i) * cos(0.07 * j);
+  ssHfieldDef hd = ss_hfield_def_default();
+  hd.name = "bed";
+  hd.nx = nx;
+  hd.ny = ny;
+  hd.x_size = 16;
+  hd.y_size = 6;
+  hd.height = z;
+  hd.soil = 1;
+  int bed = ss_model_add_hfield(m, &hd, &err);
+  ss_model_add_plane(m, "ground", -0.05, NULL, 0, &err);
+  for (int k = 0; k < 40; k++) {
+    ssBodyDef bd = ss_body_def_default();
+    char name[32];
+    snprintf(name, sizeof name, "b%d", k);
+    bd.name = name;
+    bd.shape = (ssGeomType)(k % 4);
+    bd.size[0] = bd.shape == SS_GEOM_BOX ? 0.4 : 0.2;
+    bd.size[1] = 0.3;
+    bd.size[2] = 0.2;
+    bd.pos[0] = -7 + 14.0 * k / 39;
+    bd.pos[1] = (k % 3 - 1) * 1.5;
+    bd.pos[2] = 0.4;
+    bd.quat[0] = cos(0.1 * k);
+    bd.quat[1] = sin(0.1 * k);
+    ss_model_add_body(m, &bd, &err);
+  }
+  ssData *d = ss_data_new(m);
+  double *s = calloc((size_t)nx * ny, sizeof *s);
+  for (int j = 0; j < ny; j++)
+    for (int i = 0; i < nx; i++) {
+      double y = -3 + 6.0 * j / (ny - 1);
+      if (fabs(fabs(y) - 0.8) < 0.08 && i < 600) s[j * nx + i] = 0.02 * (1 - fabs(fabs(y) - 0.8) / 0.08);
+    }
+  ss_soil_set_state(m, d, bed, s, s, NULL, &err);
+  free(s);
+  free(z);
+
+  ssRenderOptions o = ss_render_options_default();
+  ssRenderer *r = ss_render_new(m, &o, &err);
+  if (!ok(r != NULL, "1280x720 renderer for the timing scene")) {
+    ss_data_free(d);
+    ss_model_free(m);
+    return;
+  }
+  unsigned char *a = malloc((size_t)o.width * o.height * 4);
+  double t0 = now_s();
+  ss_render_pixels(r, m, d, a, &err); /* the first frame compiles shaders */
+  double first = now_s() - t0;
+  int frames = 2, failed = 0;
+  t0 = now_s();
+  double c0 = cpu_s();
+  for (int k = 0; k < frames; k++)
+    if (ss_render_pixels(r, m, d, a, &err) != SS_OK) failed++;
+  double per = (now_s() - t0) / frames, per_cpu = (cpu_s() - c0) / frames;
+  diag("801x301 bed + 40 primitives, 1280x720: first frame %.0f ms, then %.1f ms/frame "
+       "(%.1f ms CPU/frame)",
+       first * 1e3, per * 1e3, per_cpu * 1e3);
+  ok(failed == 0, "the vehicle-sized scene renders at 1280x720");
+  if (getenv("SS_TEST_KEEP")) ss_render_frame(r, m, d, out_path("big.png"), &err);
+  ss_render_free(r);
+
+  /* a close-up only draws the tiles it sees */
+  o.camera_given = 1;
+  o.camera_pos[0] = -6;
+  o.camera_pos[1] = -2.5;
+  o.camera_pos[2] = 1.2;
+  o.camera_look_at[0] = -5;
+  o.camera_look_at[1] = -0.8;
+  o.camera_look_at[2] = 0;
+  r = ss_render_new(m, &o, &err);
+  ss_render_pixels(r, m, d, a, &err);
+  t0 = now_s();
+  c0 = cpu_s();
+  for (int k = 0; k < frames; k++) ss_render_pixels(r, m, d, a, &err);
+  diag("close-up of the same scene: %.1f ms/frame (%.1f ms CPU/frame)",
+       (now_s() - t0) / frames * 1e3, (cpu_s() - c0) / frames * 1e3);
+  if (getenv("SS_TEST_KEEP")) ss_render_frame(r, m, d, out_path("closeup.png"), &err);
+  ss_render_free(r);
+  o.camera_given = 0;
+  o.width = 800;
+  o.height = 400;
+  if (getenv("SS_TEST_KEEP"))
+    ss_render_rut_map(m, d, bed, 0, 1280, 560, out_path("big_ruts.png"), &err);
+  free(a);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
+int main(void)
+{
+  const char *keep = getenv("SS_TEST_KEEP");
+  if (keep && *keep) {
+    snprintf(outdir, sizeof outdir, "%s", keep);
+  } else {
+    snprintf(outdir, sizeof outdir, "/tmp/ss_test_render_XXXXXX");
+    if (!mkdtemp(outdir)) {
+      printf("Bail out! cannot make a temporary folder\n");
+      return 1;
+    }
+  }
+  test_png_io();
+  test_colormap();
+  test_bad_sizes();
+  test_frame();
+  test_follow();
+  test_plane();
+  test_auto_camera();
+  test_rut_map();
+  test_timing();
+  if (!(keep && *keep)) {
+    /* remove what we wrote */
+    const char *names[] = {"roundtrip.png", "truncated.png", "frame_000000.png", "ruts.png",
+                           "ruts_plastic.png"};
+    for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) unlink(out_path(names[k]));
+    rmdir(outdir);
+  }
+  return done_testing();
+}
