@@ -7,8 +7,8 @@
 # driver wrote (one ":test-result: RESULT" line per TAP test case) and counts
 # the cases: PASS and XFAIL pass; FAIL and XPASS fail; SKIP is skipped; an
 # ERROR (bad exit status or plan, "Bail out!") fails when nothing else did.  A test without a .trs file (it did not build or did not run)
-# counts as one failure.  Prints one line per test, the tail of the log of
-# every failing test, and ends with exactly one line
+# counts as one failure.  Prints one line per test, what failed (from the
+# log of every failing test), and ends with exactly one line
 #     N passed, N failed[, N skipped]
 # Exit status 1 when anything failed or nothing ran.
 
@@ -71,15 +71,28 @@ EOF
   fi
 done
 
-# What went wrong, from each failing test's log.
+# What went wrong, from each failing test's log: the failing cases with
+# their diagnostics, then the last lines that are not TAP results (crash
+# messages, output of a test that never got going).
 for t in $failed_tests; do
   log=$(base_of "$t").log
   [ -f "$log" ] || { [ -f "$t.log" ] && log=$t.log; }
   printf '\n--- %s ---\n' "$t"
   if [ -f "$log" ]; then
-    grep -E '^(not ok|Bail out!|ERROR:)' "$log" | head -n 20
-    printf -- '--- last %s lines of %s ---\n' "$TAIL_LINES" "$log"
-    tail -n "$TAIL_LINES" "$log"
+    awk '
+      /^not ok/ { shown++; keep = 1; if (shown <= 40) print; next }
+      /^FAIL:|^XPASS:/ && keep { next }
+      /^#/ && keep { if (shown <= 40) print; next }
+      { keep = 0 }
+      /^(Bail out!|ERROR:)/ { print }
+      END { if (shown > 40) printf "(%d failing cases in all)\n", shown }
+    ' "$log"
+    other=$(grep -Ev '^(ok|not ok|PASS:|FAIL:|XFAIL:|XPASS:|SKIP:|ERROR:|#|1\.\.)' "$log" |
+      tail -n "$TAIL_LINES")
+    if [ -n "$other" ]; then
+      printf -- '--- other output (last %s lines) in %s ---\n' "$TAIL_LINES" "$log"
+      printf '%s\n' "$other"
+    fi
   else
     printf '(no log %s: the test did not build or did not run; run make check)\n' \
       "$log"

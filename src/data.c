@@ -1,5 +1,6 @@
 /* data.c -- the mutable state of a world and its accessors. */
 #include "soilsim.h"
+#include "articulated.h"
 #include "solver.h"
 #include "ss_math.h"
 
@@ -26,6 +27,9 @@ ssData *ss_data_new(const ssModel *m)
   d->geom_xpos = calloc(ng * 3, sizeof(double));
   d->geom_xmat = calloc(ng * 9, sizeof(double));
   d->body_iinv = calloc(nb * 9, sizeof(double));
+  d->body_xipos = calloc(nb * 3, sizeof(double));
+  d->pd_target = calloc((size_t)(m->npd ? m->npd : 1) * 2, sizeof(double));
+  d->art = calloc(ns, sizeof(*d->art));
   d->hfield_pos = calloc(nh * 3, sizeof(double));
   d->hfield_quat = calloc(nh * 4, sizeof(double));
   d->soil_sinkage = calloc(nhd, sizeof(double));
@@ -33,11 +37,17 @@ ssData *ss_data_new(const ssModel *m)
   d->soil_shear = calloc(nhd, sizeof(double));
   if (!d->qpos || !d->qvel || !d->qvel_free || !d->sys_active ||
       !d->body_xpos || !d->body_xquat || !d->body_xmat || !d->geom_xpos ||
-      !d->geom_xmat || !d->body_iinv || !d->hfield_pos || !d->hfield_quat || !d->soil_sinkage ||
+      !d->geom_xmat || !d->body_iinv || !d->body_xipos || !d->pd_target ||
+      !d->art || !d->hfield_pos || !d->hfield_quat || !d->soil_sinkage ||
       !d->soil_plastic || !d->soil_shear) {
     ss_data_free(d);
     return NULL;
   }
+  for (int s = 0; s < m->nsys; s++)
+    if (m->sys_type[s] == SS_SYS_ARTICULATED && !(d->art[s] = ss_art_work_new(m, s))) {
+      ss_data_free(d);
+      return NULL;
+    }
   ss_data_reset(m, d);
   return d;
 }
@@ -48,6 +58,10 @@ void ss_data_free(ssData *d)
   free(d->qpos); free(d->qvel); free(d->qvel_free); free(d->sys_active);
   free(d->body_xpos); free(d->body_xquat); free(d->body_xmat);
   free(d->geom_xpos); free(d->geom_xmat); free(d->body_iinv);
+  free(d->body_xipos); free(d->pd_target);
+  if (d->art)
+    for (int s = 0; s < d->model->nsys; s++) ss_art_work_free(d->art[s]);
+  free(d->art);
   free(d->hfield_pos); free(d->hfield_quat);
   free(d->soil_sinkage); free(d->soil_plastic); free(d->soil_shear);
   free(d->contact); free(d->jac); free(d->warm); free(d->soil_loaded);
@@ -62,6 +76,8 @@ void ss_data_reset(const ssModel *m, ssData *d)
   if (m->nq) memcpy(d->qpos, m->qpos0, (size_t)m->nq * sizeof(double));
   if (m->nv) memcpy(d->qvel, m->qvel0, (size_t)m->nv * sizeof(double));
   memset(d->sys_active, 1, (size_t)m->nsys);
+  if (m->npd) memcpy(d->pd_target, m->pd_target0, (size_t)m->npd * 2 * sizeof(double));
+  d->closure_error = 0;
   if (m->nhfield) {
     memcpy(d->hfield_pos, m->hfield_pos0, (size_t)m->nhfield * 3 * sizeof(double));
     memcpy(d->hfield_quat, m->hfield_quat0, (size_t)m->nhfield * 4 * sizeof(double));
@@ -81,11 +97,16 @@ void ss_data_reset(const ssModel *m, ssData *d)
 
 void ss_forward(const ssModel *m, ssData *d)
 {
-  for (int b = 0; b < m->nbody; b++) {
-    int s = m->body_sys[b];
-    /* single bodies: qpos holds the COM pose directly */
+  for (int s = 0; s < m->nsys; s++) {
+    if (m->sys_type[s] == SS_SYS_ARTICULATED) {
+      ss_art_forward(m, d, s);
+      continue;
+    }
+    /* single bodies: qpos holds the pose of the body frame (its COM) */
+    int b = m->sys_bodyadr[s];
     const double *q = d->qpos + m->sys_qadr[s];
     memcpy(d->body_xpos + 3 * b, q, 3 * sizeof(double));
+    memcpy(d->body_xipos + 3 * b, q, 3 * sizeof(double));
     memcpy(d->body_xquat + 4 * b, q + 3, 4 * sizeof(double));
     ss_quat_to_mat(d->body_xmat + 9 * b, q + 3);
   }

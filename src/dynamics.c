@@ -7,6 +7,7 @@
  * velocity), then positions from the new velocities; orientations advance
  * by the exact exponential map of omega dt. */
 #include "dynamics.h"
+#include "articulated.h"
 #include "ss_math.h"
 
 #include <string.h>
@@ -16,10 +17,15 @@ static int sys_dynamic(const ssModel *m, const ssData *d, int s)
   return m->sys_type[s] == SS_SYS_FREE && d->sys_active[s];
 }
 
-void ss_dyn_free_velocity(const ssModel *m, ssData *d)
+ssStatus ss_dyn_free_velocity(const ssModel *m, ssData *d, ssError *err)
 {
   const double dt = m->opt.timestep;
   for (int s = 0; s < m->nsys; s++) {
+    if (m->sys_type[s] == SS_SYS_ARTICULATED && d->sys_active[s] && m->sys_nv[s]) {
+      ssStatus st = ss_art_free_velocity(m, d, s, err);
+      if (st) return st;
+      continue;
+    }
     if (!sys_dynamic(m, d, s)) continue;
     int b = m->sys_bodyadr[s];
     double *v = d->qvel + m->sys_vadr[s], *w = v + 3;
@@ -57,16 +63,20 @@ void ss_dyn_free_velocity(const ssModel *m, ssData *d)
     ss_v3_addscl(v, f, dt / mass);
     ss_v3_addscl(w, dw, dt);
   }
+  return SS_OK;
 }
 
-void ss_dyn_contact_jacobian(const ssModel *m, const ssData *d, int s,
+void ss_dyn_contact_jacobian(const ssModel *m, ssData *d, int b,
                              const double p[3], const double frame[9],
                              double *J, double *W, double G[9])
 {
-  int b = m->sys_bodyadr[s];
+  if (m->sys_type[m->body_sys[b]] == SS_SYS_ARTICULATED) {
+    ss_art_contact_jacobian(m, d, b, p, frame, J, W, G);
+    return;
+  }
   double r[3], inv_m = 1.0 / m->body_mass[b];
   const double *Iinv = d->body_iinv + 9 * b;
-  ss_v3_sub(r, p, d->body_xpos + 3 * b);
+  ss_v3_sub(r, p, d->body_xipos + 3 * b);
   double ang[3][3], wang[3][3];
   for (int k = 0; k < 3; k++) {
     const double *f = frame + 3 * k;
@@ -86,25 +96,59 @@ void ss_dyn_contact_jacobian(const ssModel *m, const ssData *d, int s,
                      ss_v3_dot(ang[a], wang[c]);
 }
 
-void ss_dyn_point_velocity(const ssModel *m, const ssData *d, int s,
+void ss_dyn_point_velocity(const ssModel *m, const ssData *d, int b,
                            const double p[3], double v[3])
 {
+  int s = m->body_sys[b];
   if (m->sys_nv[s] == 0 || !d->sys_active[s]) {
     ss_v3_set(v, 0, 0, 0);
     return;
   }
-  int b = m->sys_bodyadr[s];
+  if (m->sys_type[s] == SS_SYS_ARTICULATED) {
+    ss_art_point_velocity(m, d, b, p, v);
+    return;
+  }
   const double *u = d->qvel + m->sys_vadr[s];
   double r[3], wr[3];
-  ss_v3_sub(r, p, d->body_xpos + 3 * b);
+  ss_v3_sub(r, p, d->body_xipos + 3 * b);
   ss_v3_cross(wr, u + 3, r);
   ss_v3_add(v, u, wr);
+}
+
+double ss_dyn_geom_speed(const ssModel *m, const ssData *d, int g,
+                         double radius)
+{
+  int b = m->geom_body[g], s = m->body_sys[b];
+  if (!m->sys_nv[s] || !d->sys_active[s]) return 0;
+  const double *c = d->geom_xpos + 3 * g;
+  double v[3], w[3];
+  ss_dyn_point_velocity(m, d, b, c, v);
+  if (m->sys_type[s] == SS_SYS_ARTICULATED) {
+    /* angular velocity of the body: difference of two point velocities
+     * is w x r; bound |w| through the velocity of a point one metre away
+     * along each axis */
+    double wmax = 0;
+    for (int k = 0; k < 3; k++) {
+      double p[3] = {c[0], c[1], c[2]}, vk[3], dv[3];
+      p[k] += 1;
+      ss_dyn_point_velocity(m, d, b, p, vk);
+      ss_v3_sub(dv, vk, v);
+      wmax = fmax(wmax, ss_v3_norm(dv));
+    }
+    return ss_v3_norm(v) + 2 * wmax * radius;
+  }
+  ss_v3_copy(w, d->qvel + m->sys_vadr[s] + 3);
+  return ss_v3_norm(v) + ss_v3_norm(w) * radius;
 }
 
 void ss_dyn_integrate(const ssModel *m, ssData *d)
 {
   const double dt = m->opt.timestep;
   for (int s = 0; s < m->nsys; s++) {
+    if (m->sys_type[s] == SS_SYS_ARTICULATED && d->sys_active[s] && m->sys_nv[s]) {
+      ss_art_integrate(m, d, s);
+      continue;
+    }
     if (!sys_dynamic(m, d, s)) continue;
     double *q = d->qpos + m->sys_qadr[s];
     const double *u = d->qvel + m->sys_vadr[s];

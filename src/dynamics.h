@@ -5,16 +5,22 @@
 
 #include "soilsim.h"
 
-/* qvel <- qvel + dt M^-1 (gravity + external forces - gyroscopic terms). */
-void ss_dyn_free_velocity(const ssModel *m, ssData *d);
-/* Contact Jacobian rows (frame rows n, t1, t2) of a point on system sys:
- * J (3 x nv) and W = M^-1 J^T (nv x 3), G = J W (3 x 3). */
-void ss_dyn_contact_jacobian(const ssModel *m, const ssData *d, int sys,
+/* qvel <- qvel + dt M^-1 (gravity + external forces - gyroscopic terms),
+ * for articulated systems with their force elements and loop closures. */
+ssStatus ss_dyn_free_velocity(const ssModel *m, ssData *d, ssError *err);
+/* Contact Jacobian rows (frame rows n, t1, t2) of a point on body b:
+ * J (3 x nv) and W = M^-1 J^T (nv x 3) over the body's system, and
+ * G = J W (3 x 3). */
+void ss_dyn_contact_jacobian(const ssModel *m, ssData *d, int body,
                              const double point[3], const double frame[9],
                              double *J, double *W, double G[9]);
-/* Velocity of a point on a system, world frame. */
-void ss_dyn_point_velocity(const ssModel *m, const ssData *d, int sys,
+/* Velocity of a world point on body b. */
+void ss_dyn_point_velocity(const ssModel *m, const ssData *d, int body,
                            const double point[3], double v[3]);
+/* A bound on the speed of any point of geom g (radius: its bounding
+ * radius about the geom centre). */
+double ss_dyn_geom_speed(const ssModel *m, const ssData *d, int g,
+                         double radius);
 /* Positions from velocities (semi-implicit Euler); quaternions exact. */
 void ss_dyn_integrate(const ssModel *m, ssData *d);
 /* First system whose state is non-finite, or -1. */

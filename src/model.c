@@ -1,6 +1,8 @@
 /* model.c -- the immutable world description and its builder. */
 #include "soilsim.h"
 #include "collide.h"
+#include "mesh.h"
+#include "model_build.h"
 #include "ss_math.h"
 
 #include <limits.h>
@@ -76,12 +78,28 @@ void ss_model_free(ssModel *m)
   free_names(m->sys_name, m->nsys);
   free(m->sys_type); free(m->sys_qadr); free(m->sys_nq); free(m->sys_vadr);
   free(m->sys_nv); free(m->sys_bodyadr); free(m->sys_nbody); free(m->sys_line);
+  free(m->sys_fixed); free_names(m->sys_source, m->nsys);
+  free_names(m->sys_resdir, m->nsys);
   free(m->qpos0); free(m->qvel0);
   free_names(m->body_name, m->nbody);
   free(m->body_sys); free(m->body_mass); free(m->body_inertia);
-  free(m->body_inertia_given);
+  free(m->body_inertia_given); free(m->body_ipos); free(m->body_parent);
+  free(m->body_jnttype); free_names(m->body_jntname, m->nbody);
+  free(m->body_jntpos); free(m->body_jntquat); free(m->body_jntaxis);
+  free(m->body_qadr); free(m->body_dofadr); free(m->body_ndof);
+  free(m->body_jntdamping); free(m->body_jntstiffness); free(m->body_jntref);
+  free(m->body_jntlimited); free(m->body_jntrange);
+  free_names(m->eq_name, m->neq);
+  free(m->eq_type); free(m->eq_sys); free(m->eq_body); free(m->eq_anchor);
+  free(m->eq_data); free(m->eq_line);
+  free_names(m->spring_name, m->nspring);
+  free(m->spring_body); free(m->spring_anchor); free(m->spring_param);
+  free(m->pd_body); free(m->pd_gain); free(m->pd_target0);
+  for (int i = 0; i < m->nmesh; i++) ss_mesh_free(m->mesh[i]);
+  free(m->mesh); free_names(m->mesh_path, m->nmesh);
   free(m->geom_type); free(m->geom_body); free(m->geom_size); free(m->geom_pos);
   free(m->geom_quat); free(m->geom_material); free(m->geom_rgba);
+  free(m->geom_group); free(m->geom_mesh);
   free_names(m->plane_name, m->nplane);
   free(m->plane_height); free(m->plane_material);
   free_names(m->hfield_name, m->nhfield);
@@ -271,6 +289,257 @@ static int finite_n(const double *v, int n)
   return 1;
 }
 
+/* realloc *p to n items of size sz (n >= 1) */
+static int re(void **p, size_t n, size_t sz)
+{
+  void *q = realloc(*p, n * sz);
+  if (!q) return -1;
+  *p = q;
+  return 0;
+}
+#define RE(p, n, k) re((void **)&(p), (size_t)(n) * (k), sizeof *(p))
+
+static int next_cap(int cap, int need)
+{
+  int c = cap ? cap : 8;
+  while (c < need) c *= 2;
+  return c;
+}
+
+static int reserve_sys(ssModel *m, int n)
+{
+  if (n <= m->cap_sys) return 0;
+  int c = next_cap(m->cap_sys, n);
+  if (RE(m->sys_name, c, 1) || RE(m->sys_type, c, 1) || RE(m->sys_qadr, c, 1) ||
+      RE(m->sys_nq, c, 1) || RE(m->sys_vadr, c, 1) || RE(m->sys_nv, c, 1) ||
+      RE(m->sys_bodyadr, c, 1) || RE(m->sys_nbody, c, 1) || RE(m->sys_line, c, 1) ||
+      RE(m->sys_fixed, c, 1) || RE(m->sys_source, c, 1) || RE(m->sys_resdir, c, 1))
+    return -1;
+  m->cap_sys = c;
+  return 0;
+}
+
+static int reserve_body(ssModel *m, int n)
+{
+  if (n <= m->cap_body) return 0;
+  int c = next_cap(m->cap_body, n);
+  if (RE(m->body_name, c, 1) || RE(m->body_sys, c, 1) || RE(m->body_mass, c, 1) ||
+      RE(m->body_inertia, c, 9) || RE(m->body_inertia_given, c, 1) ||
+      RE(m->body_ipos, c, 3) || RE(m->body_parent, c, 1) ||
+      RE(m->body_jnttype, c, 1) || RE(m->body_jntname, c, 1) ||
+      RE(m->body_jntpos, c, 3) || RE(m->body_jntquat, c, 4) ||
+      RE(m->body_jntaxis, c, 3) || RE(m->body_qadr, c, 1) ||
+      RE(m->body_dofadr, c, 1) || RE(m->body_ndof, c, 1) ||
+      RE(m->body_jntdamping, c, 1) || RE(m->body_jntstiffness, c, 1) ||
+      RE(m->body_jntref, c, 1) || RE(m->body_jntlimited, c, 1) ||
+      RE(m->body_jntrange, c, 2))
+    return -1;
+  m->cap_body = c;
+  return 0;
+}
+
+static int reserve_geom(ssModel *m, int n)
+{
+  if (n <= m->cap_geom) return 0;
+  int c = next_cap(m->cap_geom, n);
+  if (RE(m->geom_type, c, 1) || RE(m->geom_body, c, 1) || RE(m->geom_size, c, 3) ||
+      RE(m->geom_pos, c, 3) || RE(m->geom_quat, c, 4) || RE(m->geom_material, c, 1) ||
+      RE(m->geom_rgba, c, 4) || RE(m->geom_group, c, 1) || RE(m->geom_mesh, c, 1))
+    return -1;
+  m->cap_geom = c;
+  return 0;
+}
+
+int ss_model_push_sys(ssModel *m, const char *name, int type, int nq, int nv,
+                      int line, ssError *err)
+{
+  if (check_name(m, name, line, err) != SS_OK) return -1;
+  int s = m->nsys;
+  if (reserve_sys(m, s + 1)) goto nomem;
+  if (m->nq + nq > m->cap_q) {
+    int c = next_cap(m->cap_q, m->nq + nq);
+    if (RE(m->qpos0, c, 1)) goto nomem;
+    m->cap_q = c;
+  }
+  if (m->nv + nv > m->cap_v) {
+    int c = next_cap(m->cap_v, m->nv + nv);
+    if (RE(m->qvel0, c, 1)) goto nomem;
+    m->cap_v = c;
+  }
+  char *n1 = dupstr(name), *n2 = dupstr(""), *n3 = dupstr("");
+  if (!n1 || !n2 || !n3) {
+    free(n1); free(n2); free(n3);
+    goto nomem;
+  }
+  m->sys_name[s] = n1;
+  m->sys_source[s] = n2;
+  m->sys_resdir[s] = n3;
+  m->sys_type[s] = type;
+  m->sys_qadr[s] = m->nq;
+  m->sys_nq[s] = nq;
+  m->sys_vadr[s] = m->nv;
+  m->sys_nv[s] = nv;
+  m->sys_bodyadr[s] = m->nbody;
+  m->sys_nbody[s] = 0;
+  m->sys_line[s] = line;
+  m->sys_fixed[s] = 0;
+  memset(m->qpos0 + m->nq, 0, (size_t)nq * sizeof(double));
+  memset(m->qvel0 + m->nv, 0, (size_t)nv * sizeof(double));
+  m->nq += nq;
+  m->nv += nv;
+  return m->nsys++;
+nomem:
+  ss_error_set(err, SS_ERR_NOMEM, m->source_path, line, "out of memory");
+  return -1;
+}
+
+int ss_model_push_body(ssModel *m, int sys, const char *name,
+                       const char *jntname, int parent, ssError *err)
+{
+  int b = m->nbody;
+  if (reserve_body(m, b + 1)) goto nomem;
+  char *n1 = dupstr(name), *n2 = dupstr(jntname ? jntname : "");
+  if (!n1 || !n2) {
+    free(n1); free(n2);
+    goto nomem;
+  }
+  m->body_name[b] = n1;
+  m->body_jntname[b] = n2;
+  m->body_sys[b] = sys;
+  m->body_mass[b] = 0;
+  memset(m->body_inertia + 9 * b, 0, 9 * sizeof(double));
+  m->body_inertia_given[b] = 0;
+  memset(m->body_ipos + 3 * b, 0, 3 * sizeof(double));
+  m->body_parent[b] = parent;
+  m->body_jnttype[b] = SS_JOINT_FIXED;
+  memset(m->body_jntpos + 3 * b, 0, 3 * sizeof(double));
+  ss_quat_identity(m->body_jntquat + 4 * b);
+  memset(m->body_jntaxis + 3 * b, 0, 3 * sizeof(double));
+  m->body_qadr[b] = -1;
+  m->body_dofadr[b] = -1;
+  m->body_ndof[b] = 0;
+  m->body_jntdamping[b] = m->body_jntstiffness[b] = m->body_jntref[b] = 0;
+  m->body_jntlimited[b] = 0;
+  m->body_jntrange[2 * b] = m->body_jntrange[2 * b + 1] = 0;
+  m->sys_nbody[sys]++;
+  return m->nbody++;
+nomem:
+  ss_error_set(err, SS_ERR_NOMEM, m->source_path, 0, "out of memory");
+  return -1;
+}
+
+int ss_model_push_geom(ssModel *m, int body, int type, const double size[3],
+                       const double pos[3], const double quat[4], int material,
+                       const double rgba[4], int group, int mesh, ssError *err)
+{
+  int g = m->ngeom;
+  if (reserve_geom(m, g + 1)) {
+    ss_error_set(err, SS_ERR_NOMEM, m->source_path, 0, "out of memory");
+    return -1;
+  }
+  m->geom_type[g] = type;
+  m->geom_body[g] = body;
+  memcpy(m->geom_size + 3 * g, size, 3 * sizeof(double));
+  memcpy(m->geom_pos + 3 * g, pos, 3 * sizeof(double));
+  memcpy(m->geom_quat + 4 * g, quat, 4 * sizeof(double));
+  ss_quat_normalize(m->geom_quat + 4 * g);
+  m->geom_material[g] = material;
+  if (rgba && rgba[3] > 0)
+    memcpy(m->geom_rgba + 4 * g, rgba, 4 * sizeof(double));
+  else
+    memcpy(m->geom_rgba + 4 * g, palette[m->body_sys[body] % 6], 4 * sizeof(double));
+  m->geom_group[g] = group;
+  m->geom_mesh[g] = mesh;
+  return m->ngeom++;
+}
+
+int ss_model_push_mesh(ssModel *m, struct ssMesh *mesh, const char *path,
+                       ssError *err)
+{
+  int k = m->nmesh;
+  if (k + 1 > m->cap_mesh) {
+    int c = next_cap(m->cap_mesh, k + 1);
+    if (RE(m->mesh, c, 1) || RE(m->mesh_path, c, 1)) goto nomem;
+    m->cap_mesh = c;
+  }
+  char *p = dupstr(path ? path : "");
+  if (!p) goto nomem;
+  m->mesh[k] = mesh;
+  m->mesh_path[k] = p;
+  return m->nmesh++;
+nomem:
+  ss_error_set(err, SS_ERR_NOMEM, m->source_path, 0, "out of memory");
+  return -1;
+}
+
+int ss_model_push_eq(ssModel *m, const char *name, int type, int sys,
+                     int body1, int body2, const double anchor[6],
+                     const double data[2], int line, ssError *err)
+{
+  int k = m->neq;
+  if (k + 1 > m->cap_eq) {
+    int c = next_cap(m->cap_eq, k + 1);
+    if (RE(m->eq_name, c, 1) || RE(m->eq_type, c, 1) || RE(m->eq_sys, c, 1) ||
+        RE(m->eq_body, c, 2) || RE(m->eq_anchor, c, 6) || RE(m->eq_data, c, 2) ||
+        RE(m->eq_line, c, 1))
+      goto nomem;
+    m->cap_eq = c;
+  }
+  if (!(m->eq_name[k] = dupstr(name ? name : ""))) goto nomem;
+  m->eq_type[k] = type;
+  m->eq_sys[k] = sys;
+  m->eq_body[2 * k] = body1;
+  m->eq_body[2 * k + 1] = body2;
+  memcpy(m->eq_anchor + 6 * k, anchor, 6 * sizeof(double));
+  memcpy(m->eq_data + 2 * k, data, 2 * sizeof(double));
+  m->eq_line[k] = line;
+  return m->neq++;
+nomem:
+  ss_error_set(err, SS_ERR_NOMEM, m->source_path, line, "out of memory");
+  return -1;
+}
+
+int ss_model_push_spring(ssModel *m, const char *name, int body1, int body2,
+                         const double anchor[6], const double param[3],
+                         ssError *err)
+{
+  int k = m->nspring;
+  if (k + 1 > m->cap_spring) {
+    int c = next_cap(m->cap_spring, k + 1);
+    if (RE(m->spring_name, c, 1) || RE(m->spring_body, c, 2) ||
+        RE(m->spring_anchor, c, 6) || RE(m->spring_param, c, 3))
+      goto nomem;
+    m->cap_spring = c;
+  }
+  if (!(m->spring_name[k] = dupstr(name ? name : ""))) goto nomem;
+  m->spring_body[2 * k] = body1;
+  m->spring_body[2 * k + 1] = body2;
+  memcpy(m->spring_anchor + 6 * k, anchor, 6 * sizeof(double));
+  memcpy(m->spring_param + 3 * k, param, 3 * sizeof(double));
+  return m->nspring++;
+nomem:
+  ss_error_set(err, SS_ERR_NOMEM, m->source_path, 0, "out of memory");
+  return -1;
+}
+
+int ss_model_push_pd(ssModel *m, int body, const double gain[3],
+                     const double target[2], ssError *err)
+{
+  int k = m->npd;
+  if (k + 1 > m->cap_pd) {
+    int c = next_cap(m->cap_pd, k + 1);
+    if (RE(m->pd_body, c, 1) || RE(m->pd_gain, c, 3) || RE(m->pd_target0, c, 2)) {
+      ss_error_set(err, SS_ERR_NOMEM, m->source_path, 0, "out of memory");
+      return -1;
+    }
+    m->cap_pd = c;
+  }
+  m->pd_body[k] = body;
+  memcpy(m->pd_gain + 3 * k, gain, 3 * sizeof(double));
+  memcpy(m->pd_target0 + 2 * k, target, 2 * sizeof(double));
+  return m->npd++;
+}
+
 int ss_model_add_body(ssModel *m, const ssBodyDef *def, ssError *err)
 {
   const char *f = m->source_path;
@@ -330,89 +599,38 @@ int ss_model_add_body(ssModel *m, const ssBodyDef *def, ssError *err)
     shape_inertia(def->shape, def->size, def->is_static ? 1 : def->mass, I);
   }
   int mat = ss_model_material(m, def->material);
-  if (mat < 0) goto nomem;
-
-  int s = m->nsys, b = m->nbody, g = m->ngeom;
-  int nq = 7, nv = def->is_static ? 0 : 6;
-  /* systems */
-  if (GROW(m->sys_name, m->cap_sys, s + 1, 1) || GROW(m->sys_type, m->cap_sys, s + 1, 1) ||
-      GROW(m->sys_qadr, m->cap_sys, s + 1, 1) || GROW(m->sys_nq, m->cap_sys, s + 1, 1) ||
-      GROW(m->sys_vadr, m->cap_sys, s + 1, 1) || GROW(m->sys_nv, m->cap_sys, s + 1, 1) ||
-      GROW(m->sys_bodyadr, m->cap_sys, s + 1, 1) || GROW(m->sys_nbody, m->cap_sys, s + 1, 1) ||
-      GROW(m->sys_line, m->cap_sys, s + 1, 1))
-    goto nomem;
-  if (m->cap_sys < s + 1) m->cap_sys = s + 1;
-  /* bodies */
-  if (GROW(m->body_name, m->cap_body, b + 1, 1) || GROW(m->body_sys, m->cap_body, b + 1, 1) ||
-      GROW(m->body_mass, m->cap_body, b + 1, 1) || GROW(m->body_inertia, m->cap_body, b + 1, 9) ||
-      GROW(m->body_inertia_given, m->cap_body, b + 1, 1))
-    goto nomem;
-  if (m->cap_body < b + 1) m->cap_body = b + 1;
-  /* geoms */
-  if (GROW(m->geom_type, m->cap_geom, g + 1, 1) || GROW(m->geom_body, m->cap_geom, g + 1, 1) ||
-      GROW(m->geom_size, m->cap_geom, g + 1, 3) || GROW(m->geom_pos, m->cap_geom, g + 1, 3) ||
-      GROW(m->geom_quat, m->cap_geom, g + 1, 4) || GROW(m->geom_material, m->cap_geom, g + 1, 1) ||
-      GROW(m->geom_rgba, m->cap_geom, g + 1, 4))
-    goto nomem;
-  if (m->cap_geom < g + 1) m->cap_geom = g + 1;
-  /* coordinates */
-  if (GROW(m->qpos0, m->cap_q, m->nq + nq, 1)) goto nomem;
-  if (m->cap_q < m->nq + nq) m->cap_q = m->nq + nq;
-  if (GROW(m->qvel0, m->cap_v, m->nv + nv + 1, 1)) goto nomem;
-  if (m->cap_v < m->nv + nv + 1) m->cap_v = m->nv + nv + 1;
-
-  char *n1 = dupstr(def->name), *n2 = dupstr(def->name);
-  if (!n1 || !n2) {
-    free(n1);
-    free(n2);
-    goto nomem;
+  if (mat < 0) {
+    ss_error_set(err, SS_ERR_NOMEM, f, def->line, "out of memory");
+    return -1;
   }
-  m->sys_name[s] = n1;
-  m->sys_type[s] = def->is_static ? SS_SYS_STATIC : SS_SYS_FREE;
-  m->sys_qadr[s] = m->nq;
-  m->sys_nq[s] = nq;
-  m->sys_vadr[s] = m->nv;
-  m->sys_nv[s] = nv;
-  m->sys_bodyadr[s] = b;
-  m->sys_nbody[s] = 1;
-  m->sys_line[s] = def->line;
-
-  m->body_name[b] = n2;
-  m->body_sys[b] = s;
+  int nv = def->is_static ? 0 : 6;
+  int s = ss_model_push_sys(m, def->name, def->is_static ? SS_SYS_STATIC : SS_SYS_FREE,
+                            7, nv, def->line, err);
+  if (s < 0) return -1;
+  int b = ss_model_push_body(m, s, def->name, "", -1, err);
+  if (b < 0) return -1;
   m->body_mass[b] = def->is_static ? 0 : def->mass;
   memcpy(m->body_inertia + 9 * b, I, sizeof I);
   m->body_inertia_given[b] = def->inertia_given;
-
-  m->geom_type[g] = def->shape;
-  m->geom_body[g] = b;
-  memcpy(m->geom_size + 3 * g, def->size, 3 * sizeof(double));
-  if (def->shape == SS_GEOM_SPHERE) m->geom_size[3 * g + 1] = m->geom_size[3 * g + 2] = 0;
-  if (def->shape == SS_GEOM_CYLINDER || def->shape == SS_GEOM_CAPSULE) m->geom_size[3 * g + 2] = 0;
-  m->geom_pos[3 * g] = m->geom_pos[3 * g + 1] = m->geom_pos[3 * g + 2] = 0;
-  ss_quat_identity(m->geom_quat + 4 * g);
-  m->geom_material[g] = mat;
-  if (def->rgba[3] > 0)
-    memcpy(m->geom_rgba + 4 * g, def->rgba, 4 * sizeof(double));
-  else
-    memcpy(m->geom_rgba + 4 * g, palette[s % 6], 4 * sizeof(double));
-
-  double *q = m->qpos0 + m->nq;
+  m->body_jnttype[b] = def->is_static ? SS_JOINT_FIXED : SS_JOINT_FLOATING;
+  m->body_qadr[b] = m->sys_qadr[s];
+  m->body_dofadr[b] = nv ? m->sys_vadr[s] : -1;
+  m->body_ndof[b] = nv;
+  double size[3] = {def->size[0], def->shape == SS_GEOM_SPHERE ? 0 : def->size[1],
+                    def->shape == SS_GEOM_BOX ? def->size[2] : 0};
+  double zero[3] = {0, 0, 0}, ident[4] = {1, 0, 0, 0};
+  if (ss_model_push_geom(m, b, def->shape, size, zero, ident, mat, def->rgba, 3,
+                         -1, err) < 0)
+    return -1;
+  double *q = m->qpos0 + m->sys_qadr[s];
   memcpy(q, def->pos, 3 * sizeof(double));
   memcpy(q + 3, def->quat, 4 * sizeof(double));
   ss_quat_normalize(q + 3);
   if (nv) {
-    memcpy(m->qvel0 + m->nv, def->lin_vel, 3 * sizeof(double));
-    memcpy(m->qvel0 + m->nv + 3, def->ang_vel, 3 * sizeof(double));
+    memcpy(m->qvel0 + m->sys_vadr[s], def->lin_vel, 3 * sizeof(double));
+    memcpy(m->qvel0 + m->sys_vadr[s] + 3, def->ang_vel, 3 * sizeof(double));
   }
-  m->nq += nq;
-  m->nv += nv;
-  m->nsys++;
-  m->nbody++;
-  m->ngeom++;
   return s;
-nomem:
-  ss_error_set(err, SS_ERR_NOMEM, f, def->line, "out of memory");
-  return -1;
 }
 
 int ss_model_add_plane(ssModel *m, const char *name, double height,

@@ -6,6 +6,8 @@
  * builder; every element is checked against a list of allowed attributes
  * and children so that typos are reported instead of ignored. */
 #include "scene.h"
+#include "articulated.h"
+#include "urdf.h"
 #include "ss_math.h"
 
 #include <libxml/parser.h>
@@ -1241,10 +1243,146 @@ static ssStatus read_heightmap(readCtx *c, xmlNodePtr n)
   return st;
 }
 
+/* <articulated_system name urdf_path res_dir base material> with optional
+ * <state qpos qvel pos quat> and any number of <pd joint p_gain d_gain
+ * position_target velocity_target effort_limit> */
+typedef struct pendingPd {
+  char joint[128];
+  double g[5];
+  int line;
+} pendingPd;
+
+static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
+{
+  static const char *const allowed[] = {"name", "urdf_path", "res_dir", "base",
+                                        "material", NULL};
+  static const char *const kids[] = {"state", "pd", NULL};
+  xEl e;
+  ssStatus st = el_open(c, n, NULL, &e);
+  if (!st) st = el_allow(c, &e, allowed);
+  const char *name = NULL, *raw = NULL, *res = NULL, *base = NULL, *mat = NULL;
+  if (!st) st = get_str(c, &e, "name", 1, &name);
+  if (!st) st = get_str(c, &e, "urdf_path", 1, &raw);
+  if (!st) st = get_str(c, &e, "res_dir", 0, &res);
+  if (!st) st = get_str(c, &e, "base", 0, &base);
+  if (!st) st = get_str(c, &e, "material", 0, &mat);
+  char path[1024] = "", resdir[1024] = "";
+  if (!st) st = resolve_path(c, &e, "urdf_path", raw, path, sizeof path);
+  if (!st && res) st = resolve_path(c, &e, "res_dir", res, resdir, sizeof resdir);
+  if (!st && base && strcmp(base, "floating") && strcmp(base, "fixed"))
+    st = fail(c, SS_ERR_VALUE, e.line,
+              "%s: base = '%s' (allowed: floating, fixed)", e.label, base);
+  ssArtDef def = ss_art_def_default();
+  def.line = e.line;
+  double *qpos = NULL, *qvel = NULL;
+  int nqpos = 0, nqvel = 0, seen_state = 0, npd = 0;
+  pendingPd pd[64];
+  for (xmlNodePtr k = n->children; !st && k; k = k->next) {
+    if (k->type != XML_ELEMENT_NODE) {
+      st = check_other_node(c, k, &e);
+      continue;
+    }
+    char kn[NAME_CAP];
+    norm_name((const char *)k->name, kn);
+    if (!strcmp(kn, "state")) {
+      static const char *const sa[] = {"qpos", "qvel", "pos", "quat", NULL};
+      xEl se;
+      st = open_leaf(c, k, e.label, sa, &se);
+      if (!st) st = once(c, &seen_state, &se);
+      const char *v;
+      if (!st && (v = el_find(&se, "qpos"))) {
+        nqpos = (int)vec_count(v);
+        st = get_array(c, &se, "qpos", nqpos, "as many", 0, &qpos);
+      }
+      if (!st && (v = el_find(&se, "qvel"))) {
+        nqvel = (int)vec_count(v);
+        st = get_array(c, &se, "qvel", nqvel, "as many", 0, &qvel);
+      }
+      if (!st) st = get_vec(c, &se, "pos", 3, 0, def.pos);
+      if (!st) st = get_vec(c, &se, "quat", 4, 0, def.quat);
+      if (!st && quat_is_zero(def.quat))
+        st = fail(c, SS_ERR_VALUE, se.line, "%s: quat has zero length", se.label);
+      el_free(&se);
+    } else if (!strcmp(kn, "pd")) {
+      static const char *const pa[] = {"joint", "p_gain", "d_gain", "position_target",
+                                       "velocity_target", "effort_limit", NULL};
+      xEl pe;
+      st = open_leaf(c, k, e.label, pa, &pe);
+      if (!st && npd == 64)
+        st = fail(c, SS_ERR_VALUE, pe.line, "%s: at most 64 <pd> per system", e.label);
+      const char *jn = NULL;
+      if (!st) st = get_str(c, &pe, "joint", 1, &jn);
+      if (!st) {
+        pendingPd *p = &pd[npd];
+        snprintf(p->joint, sizeof p->joint, "%s", jn);
+        memset(p->g, 0, sizeof p->g);
+        p->line = pe.line;
+        st = get_num(c, &pe, "p_gain", 0, &p->g[0]);
+        if (!st) st = get_num(c, &pe, "d_gain", 0, &p->g[1]);
+        if (!st) st = get_num(c, &pe, "position_target", 0, &p->g[2]);
+        if (!st) st = get_num(c, &pe, "velocity_target", 0, &p->g[3]);
+        if (!st) st = get_num(c, &pe, "effort_limit", 0, &p->g[4]);
+        if (!st) npd++;
+      }
+      el_free(&pe);
+    } else {
+      st = unknown_child(c, k, &e, kids);
+    }
+  }
+  ssUrdf *u = NULL;
+  if (!st) {
+    ssError ue;
+    if (ss_urdf_load(path, res ? resdir : NULL, &u, &ue) != SS_OK) {
+      /* errors inside the URDF name the URDF's line; a URDF that cannot
+       * be read at all is reported where the scene names it */
+      if (ue.line > 0)
+        c->e = ue;
+      else
+        fail(c, ue.code, e.line, "%s '%s': cannot load URDF %s: %s", e.label,
+             name, path, ue.message);
+      st = ue.code;
+    }
+  }
+  if (!st) {
+    def.name = name;
+    def.fixed_base = base ? !strcmp(base, "fixed") : -1;
+    def.material = mat;
+    def.qpos = qpos;
+    def.nqpos = nqpos;
+    def.qvel = qvel;
+    def.nqvel = nqvel;
+    def.urdf_path = path;
+    def.res_dir = res ? resdir : "";
+    int sys = ss_model_add_articulated(c->m, u, &def, &c->e);
+    if (sys < 0) {
+      st = c->e.code ? c->e.code : SS_ERR_VALUE;
+      if (!c->e.file[0] || !strcmp(c->e.file, c->path)) {
+        snprintf(c->e.file, sizeof c->e.file, "%s", c->path);
+        if (!c->e.line) c->e.line = e.line;
+      }
+    }
+    for (int i = 0; !st && i < npd; i++) {
+      const double *g = pd[i].g;
+      if (ss_model_add_pd(c->m, sys, pd[i].joint, g[0], g[1], g[2], g[3], g[4],
+                          pd[i].line, &c->e) < 0) {
+        st = c->e.code ? c->e.code : SS_ERR_VALUE;
+        snprintf(c->e.file, sizeof c->e.file, "%s", c->path);
+        c->e.line = pd[i].line;
+      }
+    }
+  }
+  ss_urdf_free(u);
+  free(qpos);
+  free(qvel);
+  el_free(&e);
+  return st;
+}
+
 static ssStatus read_objects(readCtx *c, xmlNodePtr n)
 {
   static const char *const kids[] = {"ground", "box", "sphere", "cylinder",
-                                     "capsule", "heightmap", NULL};
+                                     "capsule", "heightmap",
+                                     "articulated_system", NULL};
   static const char *const none[] = {NULL};
   xEl e;
   ssStatus st = el_open(c, n, NULL, &e);
@@ -1262,11 +1400,12 @@ static ssStatus read_objects(readCtx *c, xmlNodePtr n)
     else if (!strcmp(kn, "cylinder")) st = read_body(c, k, SS_GEOM_CYLINDER);
     else if (!strcmp(kn, "capsule")) st = read_body(c, k, SS_GEOM_CAPSULE);
     else if (!strcmp(kn, "heightmap")) st = read_heightmap(c, k);
-    else if (!strcmp(kn, "articulated_system") || !strcmp(kn, "mesh")) {
+    else if (!strcmp(kn, "articulated_system")) st = read_articulated(c, k);
+    else if (!strcmp(kn, "mesh")) {
       xmlChar *nm = xmlGetProp(k, BAD_CAST "name");
       st = fail(c, SS_ERR_UNSUPPORTED, line_of(k),
                 "<%s>%s%s%s is not supported yet (supported objects: ground, "
-                "box, sphere, cylinder, capsule, heightmap)", kn,
+                "box, sphere, cylinder, capsule, heightmap, articulated_system)", kn,
                 nm ? " '" : "", nm ? (const char *)nm : "", nm ? "'" : "");
       if (nm) xmlFree(nm);
     } else

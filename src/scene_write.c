@@ -289,6 +289,45 @@ static void write_hfield(wBuf *w, const ssModel *m, const ssData *d, int h)
   w_s(w, "/>\n    </heightmap>\n");
 }
 
+/* <articulated_system> with its URDF, base, full state and PD targets */
+static void write_articulated(wBuf *w, const ssModel *m, const ssData *d, int s)
+{
+  w_s(w, "    <articulated_system");
+  a_str(w, "name", m->sys_name[s]);
+  a_str(w, "urdf_path", m->sys_source[s]);
+  if (m->sys_resdir[s][0]) a_str(w, "res_dir", m->sys_resdir[s]);
+  a_str(w, "base", m->sys_fixed[s] ? "fixed" : "floating");
+  int b0 = m->sys_bodyadr[s], mat = 0;
+  for (int g = 0; g < m->ngeom; g++)
+    if (m->geom_body[g] >= b0 && m->geom_body[g] < b0 + m->sys_nbody[s]) {
+      mat = m->geom_material[g];
+      break;
+    }
+  a_str(w, "material", mat_name(m, mat));
+  w_s(w, ">\n      <state");
+  if (m->sys_fixed[s]) {
+    a_vec(w, "pos", m->body_jntpos + 3 * b0, 3);
+    a_vec(w, "quat", m->body_jntquat + 4 * b0, 4);
+  }
+  if (m->sys_nq[s]) a_vec(w, "qpos", d->qpos + m->sys_qadr[s], m->sys_nq[s]);
+  if (m->sys_nv[s]) a_vec(w, "qvel", d->qvel + m->sys_vadr[s], m->sys_nv[s]);
+  w_s(w, "/>\n");
+  for (int k = 0; k < m->npd; k++) {
+    int b = m->pd_body[k];
+    if (m->body_sys[b] != s) continue;
+    const double *g = m->pd_gain + 3 * k, *t = d->pd_target + 2 * k;
+    w_s(w, "      <pd");
+    a_str(w, "joint", m->body_jntname[b]);
+    a_num(w, "p_gain", g[0]);
+    a_num(w, "d_gain", g[1]);
+    a_num(w, "position_target", t[0]);
+    a_num(w, "velocity_target", t[1]);
+    a_num(w, "effort_limit", g[2]);
+    w_s(w, "/>\n");
+  }
+  w_s(w, "    </articulated_system>\n");
+}
+
 static void write_world(wBuf *w, const ssModel *m, const ssData *d)
 {
   const ssOption *o = &m->opt;
@@ -331,6 +370,10 @@ static void write_world(wBuf *w, const ssModel *m, const ssData *d)
   }
   for (int s = 0; s < m->nsys; s++) {
     if (!d->sys_active[s]) continue;
+    if (m->sys_type[s] == SS_SYS_ARTICULATED) {
+      write_articulated(w, m, d, s);
+      continue;
+    }
     int b = m->sys_bodyadr[s];
     for (int g = 0; g < m->ngeom; g++)
       if (m->geom_body[g] == b) {
@@ -368,10 +411,11 @@ static ssStatus check_exportable(const ssModel *m, const ssData *d,
                         "cannot export in the middle of a step");
   for (int s = 0; s < m->nsys; s++) {
     if (!d->sys_active[s]) continue;
-    if (m->sys_type[s] == SS_SYS_ARTICULATED || m->sys_nbody[s] != 1)
+    if (m->sys_type[s] == SS_SYS_ARTICULATED) continue;
+    if (m->sys_nbody[s] != 1)
       return ss_error_set(err, SS_ERR_UNSUPPORTED, path, 0,
-                          "cannot export '%s': articulated systems are not "
-                          "supported yet", m->sys_name[s]);
+                          "cannot export '%s': a single body must have one "
+                          "body", m->sys_name[s]);
     int b = m->sys_bodyadr[s], ng = 0;
     for (int g = 0; g < m->ngeom; g++)
       if (m->geom_body[g] == b) {

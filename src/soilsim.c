@@ -58,32 +58,34 @@ typedef struct Progress {
 } Progress;
 
 static volatile sig_atomic_t g_signal;
+static int g_interrupted; /* the run stopped early because of g_signal */
 
 /* ---------------------------------------------------------------------- */
 /* messages                                                                */
 
 static void usage(FILE *out)
 {
-  fputs(
+  ssRenderOptions r = ss_render_options_default();
+  fprintf(out,
 "usage: soilsim SCENE.xml [options]\n"
 "Simulate rigid bodies on deformable soil beds described by a world XML scene.\n"
 "\n"
 "options:\n"
-"  --steps N            number of time steps to run (default 1000; 0 = none)\n"
+"  --steps N            number of time steps to run (default %ld; 0 = none)\n"
 "  --export OUT.xml     write the final world (with soil state) as XML\n"
 "  --csv FILE           write one row of statistics and positions per step\n"
 "  --remove NAME@STEP   remove body or system NAME after step STEP (repeatable)\n"
 "  --render DIR         write frames DIR/frame_NNNNNN.png (created if needed)\n"
-"  --render-every K     render every K steps (default 20; needs --render)\n"
-"  --size WxH           image size for --render and --rut-map (e.g. 800x600)\n"
+"  --render-every K     render every K steps (default %ld; needs --render)\n"
+"  --size WxH           image size for --render and --rut-map (default %dx%d)\n"
 "  --rut-map FILE.png   write a top-down map of the final plastic sinkage\n"
-"  --quiet              no progress line and no summary; errors only\n"
-"  --help               show this help and exit\n"
-"  --version            show the version and exit\n"
+"  -q, --quiet          no progress line and no summary; errors only\n"
+"  -h, --help           show this help and exit\n"
+"  -V, --version        show the version and exit\n"
 "\n"
 "Options also accept the form --option=VALUE.  Exit status: 0 success,\n"
 "1 bad input or failed run, 2 bad usage.  See soilsim(1).\n",
-      out);
+      DEFAULT_STEPS, DEFAULT_RENDER_EVERY, r.width, r.height);
 }
 
 /* A usage error: what is wrong, then where to look; exit status 2. */
@@ -278,7 +280,7 @@ static int parse_args(int argc, char **argv, Options *o)
 
     switch (spec->id) {
     case OPT_STEPS:
-      if (!parse_long(value, 0, LONG_MAX, &o->steps))
+      if (!parse_long(value, 0, LONG_MAX - 1, &o->steps))
         return usage_error("invalid --steps value '%s': expected an integer "
                            ">= 0", value);
       steps_given = 1;
@@ -613,7 +615,9 @@ static int run(const Options *o)
   ssRenderer *r = NULL;
   ssAtomicFile csv;
   int csv_open = 0, status = EXIT_RUN_FAILED;
-  long nframes = 0, unconverged = 0;
+  long nframes = 0, unconverged = 0, done = 0;
+  double t0, wall;
+  ssRenderOptions ropt = ss_render_options_default();
   Progress prog;
   memset(&prog, 0, sizeof prog);
   memset(&csv, 0, sizeof csv);
@@ -634,7 +638,6 @@ static int run(const Options *o)
     goto fail;
   if (o->rut_map && check_output(o->rut_map, "--rut-map", &err)) goto fail;
 
-  ssRenderOptions ropt = ss_render_options_default();
   if (o->width > 0) {
     ropt.width = o->width;
     ropt.height = o->height;
@@ -663,12 +666,11 @@ static int run(const Options *o)
             !(getenv("CI") && *getenv("CI"));
   catch_signals();
   ss_forward(m, d);
-  double t0 = now_seconds();
+  t0 = now_seconds();
   prog.start = prog.last = t0;
 
   /* step k's outputs are recorded, then the removals scheduled for k apply;
    * k counts this run's steps (a scene may start at a later time) */
-  long done = 0;
   for (long k = 0; k <= o->steps; k++) {
     if (g_signal) break;
     if (k > 0) {
@@ -692,19 +694,19 @@ static int run(const Options *o)
         progress_draw(&prog, k, o->steps, now);
     }
   }
-  double wall = now_seconds() - t0;
+  wall = now_seconds() - t0;
   if (g_signal) {
     progress_clear(&prog);
     fprintf(stderr, "soilsim: interrupted after step %ld; no output files "
             "written\n", done);
+    g_interrupted = 1;
     goto cleanup;
   }
   progress_clear(&prog);
 
   /* outputs of the final state; the CSV appears last, once all else worked */
   if (o->rut_map &&
-      ss_render_rut_map(m, d, -1, 1, o->width > 0 ? o->width : ropt.width,
-                        o->height > 0 ? o->height : ropt.height, o->rut_map,
+      ss_render_rut_map(m, d, -1, 1, ropt.width, ropt.height, o->rut_map,
                         &err) != SS_OK)
     goto fail;
   if (o->export_path && ss_scene_export(m, d, o->export_path, &err) != SS_OK)
@@ -735,7 +737,7 @@ int main(int argc, char **argv)
   int status = parse_args(argc, argv, &o);
   if (status < 0) status = run(&o);
   options_free(&o);
-  if (g_signal) {
+  if (g_interrupted) {
     /* let the caller see how we ended (a shell loop stops on Ctrl-C) */
     int sig = g_signal;
     signal(sig, SIG_DFL);

@@ -112,6 +112,20 @@ typedef enum ssGeomType {
   SS_GEOM_MESH      /* triangle mesh (articulated links; later issue) */
 } ssGeomType;
 
+typedef enum ssJointType {
+  SS_JOINT_FIXED = 0,
+  SS_JOINT_REVOLUTE,   /* 1 DOF about axis (continuous = revolute, no limits) */
+  SS_JOINT_PRISMATIC,  /* 1 DOF along axis */
+  SS_JOINT_SPHERICAL,  /* 3 DOF ball joint: quaternion q, local angular velocity */
+  SS_JOINT_FLOATING    /* 6 DOF: position + quaternion, world lin/ang velocity */
+} ssJointType;
+
+typedef enum ssClosureType {
+  SS_CLOSURE_PIN = 0,  /* point on body1 coincides with point on body2 */
+  SS_CLOSURE_DISTANCE, /* |p1 - p2| = length */
+  SS_CLOSURE_EQUALITY  /* q(joint1) = ratio q(joint2) + offset */
+} ssClosureType;
+
 typedef enum ssSysType {
   SS_SYS_FREE = 0,   /* single rigid body, 6 DOF: nq = 7, nv = 6 */
   SS_SYS_STATIC,     /* single fixed body: nq = 7 (pose), nv = 0 */
@@ -164,18 +178,65 @@ typedef struct ssModel {
   int *sys_bodyadr;     /* (nsys) first body */
   int *sys_nbody;       /* (nsys) */
   int *sys_line;        /* (nsys) line in the scene file (0 if built in code) */
+  int *sys_fixed;       /* (nsys) articulated: 1 if the base is welded */
+  char **sys_source;    /* (nsys) articulated: URDF path ("" otherwise) */
+  char **sys_resdir;    /* (nsys) articulated: resource folder ("" if none) */
 
   int nq, nv;           /* generalized coordinate / velocity counts */
   double *qpos0;        /* (nq) initial positions (pos, quat for free bodies) */
   double *qvel0;        /* (nv) initial velocities (lin_vel, ang_vel world) */
 
-  /* bodies: rigid links (a single rigid body is one body) */
+  /* bodies: rigid links (a single rigid body is one body whose frame is
+   * its centre of mass) */
   int nbody;
   char **body_name;     /* (nbody) */
   int *body_sys;        /* (nbody) owning system */
   double *body_mass;    /* (nbody) (kg) */
   double *body_inertia; /* (nbody x 9) about the centre of mass, body frame */
   int *body_inertia_given; /* (nbody) 1 if the scene overrode it */
+  double *body_ipos;    /* (nbody x 3) centre of mass in the body frame */
+
+  /* joints: every articulated link has one joint to its parent */
+  int *body_parent;     /* (nbody) parent body, -1 for a system's root */
+  int *body_jnttype;    /* (nbody) ssJointType of the joint to the parent */
+  char **body_jntname;  /* (nbody) joint name ("" for single bodies) */
+  double *body_jntpos;  /* (nbody x 3) joint frame in the parent frame; for
+                           a fixed-base root: its pose in the world */
+  double *body_jntquat; /* (nbody x 4) */
+  double *body_jntaxis; /* (nbody x 3) unit axis in the joint (child) frame */
+  int *body_qadr;       /* (nbody) first qpos of the joint (-1: none) */
+  int *body_dofadr;     /* (nbody) first qvel of the joint (-1: none) */
+  int *body_ndof;       /* (nbody) 0, 1, 3 or 6 */
+  double *body_jntdamping;   /* (nbody) viscous joint damping */
+  double *body_jntstiffness; /* (nbody) joint spring stiffness */
+  double *body_jntref;       /* (nbody) joint spring rest position */
+  int *body_jntlimited;      /* (nbody) 1: range applies */
+  double *body_jntrange;     /* (nbody x 2) lower, upper (rad or m) */
+
+  /* loop closures of articulated systems (DESIGN 3) */
+  int neq;
+  char **eq_name;       /* (neq) */
+  int *eq_type;         /* (neq) ssClosureType */
+  int *eq_sys;          /* (neq) */
+  int *eq_body;         /* (neq x 2) bodies (pin, distance) or the bodies
+                           whose joints are coupled (equality) */
+  double *eq_anchor;    /* (neq x 6) anchor1 in body1, anchor2 in body2 */
+  double *eq_data;      /* (neq x 2) distance: length; equality: ratio, offset */
+  int *eq_line;         /* (neq) source line */
+
+  /* point-to-point spring-dampers between two bodies (coil-overs) */
+  int nspring;
+  char **spring_name;   /* (nspring) */
+  int *spring_body;     /* (nspring x 2) */
+  double *spring_anchor;/* (nspring x 6) in each body's frame */
+  double *spring_param; /* (nspring x 3) stiffness (N/m), damping (N s/m),
+                           rest length (m) */
+
+  /* joint PD controllers (the scene's <pd>) */
+  int npd;
+  int *pd_body;         /* (npd) the controlled joint is this body's joint */
+  double *pd_gain;      /* (npd x 3) p_gain, d_gain, effort_limit (0 = none) */
+  double *pd_target0;   /* (npd x 2) initial position and velocity targets */
 
   /* geoms: colliders and visuals attached to bodies */
   int ngeom;
@@ -186,6 +247,13 @@ typedef struct ssModel {
   double *geom_quat;    /* (ngeom x 4) in the body frame */
   int *geom_material;   /* (ngeom) rigid material index */
   double *geom_rgba;    /* (ngeom x 4) display colour */
+  int *geom_group;      /* (ngeom) bit 1: collides, bit 2: drawn */
+  int *geom_mesh;       /* (ngeom) mesh index, -1 for primitives */
+
+  /* triangle meshes (struct ssMesh, see mesh.h) */
+  int nmesh;
+  struct ssMesh **mesh; /* (nmesh) */
+  char **mesh_path;     /* (nmesh) file each mesh came from */
 
   /* rigid ground planes z = height */
   int nplane;
@@ -237,7 +305,8 @@ typedef struct ssModel {
 
   /* builder capacities (internal) */
   int cap_sys, cap_body, cap_geom, cap_plane, cap_hfield, cap_hfielddata,
-      cap_material, cap_pair, cap_xforce, cap_q, cap_v;
+      cap_material, cap_pair, cap_xforce, cap_q, cap_v, cap_eq, cap_spring,
+      cap_pd, cap_mesh;
 } ssModel;
 
 /* ---------------------------------------------------------------------- */
@@ -340,6 +409,7 @@ typedef struct ssData {
   double *qpos;           /* (nq) free body: COM position (3), quat (4) */
   double *qvel;           /* (nv) free body: lin vel (3), ang vel (3), world */
   unsigned char *sys_active; /* (nsys) 0 once removed from the world */
+  double *pd_target;      /* (npd x 2) position and velocity targets */
 
   /* derived kinematics (ss_forward) */
   double *body_xpos;      /* (nbody x 3) COM position, world */
@@ -348,6 +418,10 @@ typedef struct ssData {
   double *geom_xpos;      /* (ngeom x 3) */
   double *geom_xmat;      /* (ngeom x 9) */
   double *body_iinv;      /* (nbody x 9) inverse inertia, world frame */
+  double *body_xipos;     /* (nbody x 3) centre of mass, world */
+  struct ssArtWork **art; /* (nsys) articulated workspaces (NULL otherwise) */
+  double closure_error;   /* largest loop-closure violation after the last
+                             step (m for points, rad or m for joints) */
 
   /* height map poses (settable between steps) */
   double *hfield_pos;     /* (nhfield x 3) */

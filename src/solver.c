@@ -263,6 +263,53 @@ static void rigid_point(ssContact *c, const double v0[3], double tol)
 }
 
 /* ---------------------------------------------------------------------- */
+/* joint rows: PD (bounded, implicit) and limits (unilateral)              */
+
+static void pd_row(ssContact *c, const double v0[3])
+{
+  /* lambda = a - b (v0 + G lambda), clamped to the effort bound */
+  double l = (c->row_a - c->row_b * v0[0]) / (1 + c->row_b * c->G[0]);
+  if (l > c->row_bound) l = c->row_bound;
+  if (l < -c->row_bound) l = -c->row_bound;
+  c->lambda[0] = l;
+}
+
+static void limit_row(ssContact *c, const double v0[3])
+{
+  double l = c->G[0] > 0 ? (c->vn_target - v0[0]) / c->G[0] : 0;
+  c->lambda[0] = l > 0 ? l : 0;
+}
+
+ssContact *ss_contact_new(ssData *d, int nv)
+{
+  if (d->ncontact == d->cap_contact) {
+    int c = d->cap_contact ? 2 * d->cap_contact : 256;
+    ssContact *p = realloc(d->contact, (size_t)c * sizeof *p);
+    if (!p) return NULL;
+    d->contact = p;
+    d->cap_contact = c;
+  }
+  ssContact *c = d->contact + d->ncontact;
+  long jadr = d->ncontact ? d->contact[d->ncontact - 1].jadr +
+                                6 * (long)d->contact[d->ncontact - 1].nv
+                          : 0;
+  size_t need = (size_t)jadr + 6 * (size_t)nv;
+  if (need > d->cap_jac) {
+    size_t cap = d->cap_jac ? 2 * d->cap_jac : 4096;
+    while (cap < need) cap *= 2;
+    double *q = realloc(d->jac, cap * sizeof(double));
+    if (!q) return NULL;
+    d->jac = q;
+    d->cap_jac = cap;
+  }
+  memset(c, 0, sizeof *c);
+  c->jadr = jadr;
+  c->nv = nv;
+  d->ncontact++;
+  return c;
+}
+
+/* ---------------------------------------------------------------------- */
 /* sweeps                                                                  */
 
 static void contact_velocity(const ssData *d, const ssContact *c, double v[3])
@@ -291,42 +338,65 @@ static int cmp_warm(const void *a, const void *b)
   return (x->geom > y->geom) - (x->geom < y->geom);
 }
 
+/* cache key of a joint row: its dof and kind (PD, or the limit's side) */
+static void row_key(const ssData *d, const ssContact *c, ssWarmEntry *k)
+{
+  int upper = c->type == SS_CONTACT_LIMIT && d->jac[c->jadr + (c->dof - c->vadr)] < 0;
+  k->vertex = 2 * c->dof + upper;
+  k->geom = c->type == SS_CONTACT_PD ? -2 : -3;
+}
+
 /* Initial impulses from last step's tractions, scaled by the current area
- * and time step and projected into the current bounds. */
+ * and time step and projected into the current bounds; joint rows start
+ * from last step's impulse rate. */
 static void warm_start(const ssModel *m, ssData *d)
 {
   const double dt = m->opt.timestep;
   for (int i = 0; i < d->ncontact; i++) {
     ssContact *c = d->contact + i;
     c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
-    if (!m->opt.terrain_warm_start || c->type != SS_CONTACT_SOIL || !d->nwarm)
+    if (!m->opt.terrain_warm_start || c->type == SS_CONTACT_RIGID || !d->nwarm)
       continue;
     ssWarmEntry key = {c->vertex, c->geom, {0, 0, 0}};
+    if (c->type != SS_CONTACT_SOIL) row_key(d, c, &key);
     const ssWarmEntry *e = bsearch(&key, d->warm, (size_t)d->nwarm, sizeof key, cmp_warm);
     if (!e) continue;
-    double scale = c->area * dt;
-    double ln = e->traction[0] > 0 ? e->traction[0] * scale : 0;
-    double lt0 = e->traction[1] * scale, lt1 = e->traction[2] * scale;
-    double lim = scale * ss_soil_shear_strength(&m->hfield_soilmat[c->hfield], ln / scale);
-    double mag = sqrt(lt0 * lt0 + lt1 * lt1);
-    if (mag > lim) {
-      lt0 *= lim / mag;
-      lt1 *= lim / mag;
+    if (c->type == SS_CONTACT_PD) {
+      double l = e->traction[0] * dt;
+      c->lambda[0] = l > c->row_bound ? c->row_bound : l < -c->row_bound ? -c->row_bound : l;
+    } else if (c->type == SS_CONTACT_LIMIT) {
+      c->lambda[0] = e->traction[0] > 0 ? e->traction[0] * dt : 0;
+    } else {
+      double scale = c->area * dt;
+      double ln = e->traction[0] > 0 ? e->traction[0] * scale : 0;
+      double lt0 = e->traction[1] * scale, lt1 = e->traction[2] * scale;
+      double lim = scale * ss_soil_shear_strength(&m->hfield_soilmat[c->hfield], ln / scale);
+      double mag = sqrt(lt0 * lt0 + lt1 * lt1);
+      if (mag > lim) {
+        lt0 *= lim / mag;
+        lt1 *= lim / mag;
+      }
+      c->lambda[0] = ln;
+      c->lambda[1] = lt0;
+      c->lambda[2] = lt1;
     }
-    c->lambda[0] = ln;
-    c->lambda[1] = lt0;
-    c->lambda[2] = lt1;
     if (c->nv) apply_impulse(d, c, c->lambda);
   }
 }
 
-/* keep this step's converged tractions for the next one */
+static int cached(const ssContact *c)
+{
+  return c->type == SS_CONTACT_PD || c->type == SS_CONTACT_LIMIT ||
+         (c->type == SS_CONTACT_SOIL && c->lambda[0] > 0);
+}
+
+/* keep this step's converged tractions (soil) and impulse rates (joint
+ * rows) for the next one */
 static ssStatus store_warm(const ssModel *m, ssData *d, ssError *err)
 {
   const double dt = m->opt.timestep;
   int n = 0;
-  for (int i = 0; i < d->ncontact; i++)
-    if (d->contact[i].type == SS_CONTACT_SOIL && d->contact[i].lambda[0] > 0) n++;
+  for (int i = 0; i < d->ncontact; i++) n += cached(d->contact + i);
   if (n > d->cap_warm) {
     ssWarmEntry *p = realloc(d->warm, (size_t)n * sizeof *p);
     if (!p) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
@@ -336,55 +406,80 @@ static ssStatus store_warm(const ssModel *m, ssData *d, ssError *err)
   n = 0;
   for (int i = 0; i < d->ncontact; i++) {
     const ssContact *c = d->contact + i;
-    if (c->type != SS_CONTACT_SOIL || !(c->lambda[0] > 0)) continue;
+    if (!cached(c)) continue;
     ssWarmEntry *e = d->warm + n++;
-    double inv = 1.0 / (c->area * dt);
-    e->vertex = c->vertex;
-    e->geom = c->geom;
-    e->traction[0] = c->lambda[0] * inv;
-    e->traction[1] = c->lambda[1] * inv;
-    e->traction[2] = c->lambda[2] * inv;
+    if (c->type == SS_CONTACT_SOIL) {
+      double inv = 1.0 / (c->area * dt);
+      e->vertex = c->vertex;
+      e->geom = c->geom;
+      e->traction[0] = c->lambda[0] * inv;
+      e->traction[1] = c->lambda[1] * inv;
+      e->traction[2] = c->lambda[2] * inv;
+    } else {
+      row_key(d, c, e);
+      e->traction[0] = c->lambda[0] / dt;
+      e->traction[1] = e->traction[2] = 0;
+    }
   }
   qsort(d->warm, (size_t)n, sizeof *d->warm, cmp_warm);
   d->nwarm = n;
   return SS_OK;
 }
 
+/* one Gauss-Seidel visit: new impulse of contact c with the others held */
+static void visit(const ssModel *m, ssData *d, ssContact *c, double *dmax,
+                  double *lmax)
+{
+  const double dt = m->opt.timestep, stol = m->opt.scalar_tolerance;
+  double v[3] = {0, 0, 0}, v0[3], old[3];
+  if (c->nv) contact_velocity(d, c, v);
+  memcpy(old, c->lambda, sizeof old);
+  ss_m3_mulv(v0, c->G, old);
+  ss_v3_sub(v0, v, v0);
+  switch (c->type) {
+  case SS_CONTACT_SOIL:
+    ss_solver_soil_point(&m->hfield_soilmat[c->hfield], dt, c, v0, stol);
+    break;
+  case SS_CONTACT_RIGID: rigid_point(c, v0, stol); break;
+  case SS_CONTACT_PD: pd_row(c, v0); break;
+  default: limit_row(c, v0); break;
+  }
+  double dl[3];
+  ss_v3_sub(dl, c->lambda, old);
+  if (c->nv) apply_impulse(d, c, dl);
+  double dn = fabs(dl[0]) + fabs(dl[1]) + fabs(dl[2]);
+  double ln = fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]);
+  if (dn > *dmax) *dmax = dn;
+  if (ln > *lmax) *lmax = ln;
+}
+
 ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
 {
   const double dt = m->opt.timestep, tol = m->opt.solver_tolerance;
-  const double stol = m->opt.scalar_tolerance;
   ssStepStats *st = &d->stats;
   st->sweeps = 0;
   st->residual = 0;
   st->converged = 1;
   warm_start(m, d);
 
+  /* joint rows (PD, limits) are few, stiff and coupled to everything:
+   * they are revisited every 64 contacts, a cheap stand-in for a block
+   * solve that keeps the sweep count low */
+  int first_row = d->ncontact;
+  while (first_row > 0 && (d->contact[first_row - 1].type == SS_CONTACT_PD ||
+                           d->contact[first_row - 1].type == SS_CONTACT_LIMIT))
+    first_row--;
   int sweeps = d->ncontact ? m->opt.solver_max_sweeps : 0;
   for (int sweep = 0; sweep < sweeps; sweep++) {
     double dmax = 0, lmax = 0;
     for (int i = 0; i < d->ncontact; i++) {
-      ssContact *c = d->contact + i;
-      double v[3] = {0, 0, 0}, v0[3], old[3];
-      if (c->nv) contact_velocity(d, c, v);
-      memcpy(old, c->lambda, sizeof old);
-      ss_m3_mulv(v0, c->G, old);
-      ss_v3_sub(v0, v, v0);
-      if (c->type == SS_CONTACT_SOIL)
-        ss_solver_soil_point(&m->hfield_soilmat[c->hfield], dt, c, v0, stol);
-      else
-        rigid_point(c, v0, stol);
-      double dl[3];
-      ss_v3_sub(dl, c->lambda, old);
-      if (c->nv) apply_impulse(d, c, dl);
-      double dn = fabs(dl[0]) + fabs(dl[1]) + fabs(dl[2]);
-      double ln = fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]);
-      if (dn > dmax) dmax = dn;
-      if (ln > lmax) lmax = ln;
+      visit(m, d, d->contact + i, &dmax, &lmax);
+      if (i < first_row && first_row < d->ncontact && (i & 63) == 63)
+        for (int r = first_row; r < d->ncontact; r++)
+          visit(m, d, d->contact + r, &dmax, &lmax);
     }
     st->sweeps = sweep + 1;
     st->residual = lmax > 0 ? dmax / lmax : 0;
-    /* a contact without a dynamic body is solved exactly in one visit */
     if (st->residual <= tol) break;
   }
   st->converged = st->residual <= tol;

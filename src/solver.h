@@ -13,7 +13,9 @@
 
 typedef enum ssContactType {
   SS_CONTACT_SOIL = 0, /* one soil quadrature point (DESIGN 3.1) */
-  SS_CONTACT_RIGID     /* Coulomb cone with restitution */
+  SS_CONTACT_RIGID,    /* Coulomb cone with restitution */
+  SS_CONTACT_PD,       /* joint PD controller: one bounded implicit row */
+  SS_CONTACT_LIMIT     /* joint limit: one unilateral row */
 } ssContactType;
 
 struct ssContact {
@@ -34,6 +36,9 @@ struct ssContact {
   double lambda[3];  /* impulse in the contact frame (N s) */
   double mu;         /* rigid: friction coefficient */
   double vn_target;  /* rigid: lowest allowed normal velocity (m/s) */
+  double row_a, row_b;/* PD: impulse = row_a - row_b v (before clamping) */
+  double row_bound;  /* PD: |impulse| <= row_bound (effort dt) */
+  int dof;           /* PD, limit: global velocity index */
   double v[3];       /* contact-frame velocity at the end of the solve */
   int loaded;        /* soil: 1 if the point carries load at the end */
 };
@@ -44,6 +49,10 @@ struct ssWarmEntry {
   int geom;
   double traction[3];/* impulse / (area dt), contact frame (Pa) */
 };
+
+/* Room for one more contact (zeroed) with a Jacobian block for a system of
+ * nv velocities; NULL when out of memory. */
+ssContact *ss_contact_new(ssData *d, int nv);
 
 /* Solve all contacts in d->contact; d->qvel holds the free velocity on entry
  * and the end-of-step velocity on return.  Fills d->stats. */

@@ -1,5 +1,6 @@
 /* step.c -- one time step, stage by stage, each timed. */
 #include "soilsim.h"
+#include "articulated.h"
 #include "dynamics.h"
 #include "solver.h"
 #include "terrain.h"
@@ -31,12 +32,15 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
   ss_forward(m, d);
   t1 = now(); t[0] = t1 - t0; t0 = t1;
 
-  /* velocities under gravity, external loads and gyroscopic torques */
-  ss_dyn_free_velocity(m, d);
+  /* velocities under gravity, external loads, force elements and loop
+   * closures */
+  if ((st = ss_dyn_free_velocity(m, d, err))) goto fail;
   t1 = now(); t[1] = t1 - t0; t0 = t1;
 
-  /* soil quadrature points and rigid contacts, with their responses */
+  /* soil quadrature points, rigid contacts and joint rows, with their
+   * responses */
   if ((st = ss_terrain_contacts(m, d, err))) goto fail;
+  if ((st = ss_art_rows(m, d, err))) goto fail;
   t1 = now(); t[2] = t1 - t0; t0 = t1;
 
   /* implicit contact impulses at the end-of-step velocity */
@@ -57,7 +61,8 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
   ss_terrain_update(m, d);
   t1 = now(); t[4] = t1 - t0; t0 = t1;
 
-  /* positions from the new velocities */
+  /* positions from the new velocities; loop-closure drift removed */
+  d->closure_error = 0;
   ss_dyn_integrate(m, d);
   ss_forward(m, d);
   t1 = now(); t[5] = t1 - t0;

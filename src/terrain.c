@@ -28,35 +28,6 @@ void ss_hfield_frame(const ssData *d, int h, double R[9], double p[3])
   ss_v3_copy(p, d->hfield_pos + 3 * h);
 }
 
-/* room for one more contact and its Jacobian block; NULL when out of memory */
-static ssContact *new_contact(ssData *d, int nv)
-{
-  if (d->ncontact == d->cap_contact) {
-    int c = d->cap_contact ? 2 * d->cap_contact : 256;
-    ssContact *p = realloc(d->contact, (size_t)c * sizeof *p);
-    if (!p) return NULL;
-    d->contact = p;
-    d->cap_contact = c;
-  }
-  ssContact *c = d->contact + d->ncontact;
-  memset(c, 0, sizeof *c);
-  c->jadr = d->ncontact ? d->contact[d->ncontact - 1].jadr +
-                              6 * (long)d->contact[d->ncontact - 1].nv
-                        : 0;
-  size_t need = (size_t)c->jadr + 6 * (size_t)nv;
-  if (need > d->cap_jac) {
-    size_t cap = d->cap_jac ? 2 * d->cap_jac : 4096;
-    while (cap < need) cap *= 2;
-    double *q = realloc(d->jac, cap * sizeof(double));
-    if (!q) return NULL;
-    d->jac = q;
-    d->cap_jac = cap;
-  }
-  c->nv = nv;
-  d->ncontact++;
-  return c;
-}
-
 /* fill the system-dependent part of a contact: Jacobian, response, G */
 static void attach(const ssModel *m, ssData *d, ssContact *c, int sys)
 {
@@ -64,7 +35,7 @@ static void attach(const ssModel *m, ssData *d, ssContact *c, int sys)
     c->sys = sys;
     c->vadr = m->sys_vadr[sys];
     double *J = d->jac + c->jadr, *W = J + 3 * c->nv;
-    ss_dyn_contact_jacobian(m, d, sys, c->pos, c->frame, J, W, c->G);
+    ss_dyn_contact_jacobian(m, d, m->geom_body[c->geom], c->pos, c->frame, J, W, c->G);
   } else {
     c->sys = -1;
     c->nv = 0;
@@ -104,13 +75,8 @@ static double geom_radius(const ssModel *m, int g)
 static double geom_margin(const ssModel *m, const ssData *d, int g, int sys)
 {
   double reach = m->opt.contact_margin;
-  if (sys >= 0 && m->sys_nv[sys] > 0) {
-    const double *u = d->qvel + m->sys_vadr[sys];
-    double r[3];
-    ss_v3_sub(r, d->geom_xpos + 3 * g, d->body_xpos + 3 * m->geom_body[g]);
-    reach += m->opt.timestep *
-             (ss_v3_norm(u) + ss_v3_norm(u + 3) * (ss_v3_norm(r) + geom_radius(m, g)));
-  }
+  if (sys >= 0 && m->sys_nv[sys] > 0)
+    reach += m->opt.timestep * ss_dyn_geom_speed(m, d, g, geom_radius(m, g));
   return reach;
 }
 
@@ -196,7 +162,7 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       double floor_z = z0[k] - sp[k];
       double g0 = zl - floor_z;
       if (g0 > margin) continue;
-      ssContact *c = new_contact(d, nv);
+      ssContact *c = ss_contact_new(d, nv);
       if (!c) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
       c->type = SS_CONTACT_SOIL;
       c->geom = g;
@@ -274,7 +240,7 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
     if (h >= 0 && !hfield_sample(m, h, pts[k][0], pts[k][1], &zs, nl)) continue;
     double gap = (pts[k][2] - zs) * nl[2];
     if (gap > margin) continue;
-    ssContact *c = new_contact(d, nv);
+    ssContact *c = ss_contact_new(d, nv);
     if (!c) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
     c->type = SS_CONTACT_RIGID;
     c->geom = g;
@@ -293,7 +259,7 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
     c->vn_target = gap >= 0 ? -gap / dt : -m->opt.rigid_erp * gap / dt;
     if (sys >= 0 && nv > 0 && gap <= m->opt.contact_margin) {
       double v[3];
-      ss_dyn_point_velocity(m, d, sys, c->pos, v);
+      ss_dyn_point_velocity(m, d, m->geom_body[g], c->pos, v);
       double vn = ss_v3_dot(v, nw);
       if (pair->restitution > 0 && vn < -pair->restitution_threshold &&
           -pair->restitution * vn > c->vn_target)
@@ -309,7 +275,7 @@ ssStatus ss_terrain_contacts(const ssModel *m, ssData *d, ssError *err)
   d->ncontact = 0;
   for (int g = 0; g < m->ngeom; g++) {
     int sys = m->body_sys[m->geom_body[g]];
-    if (!d->sys_active[sys]) continue;
+    if (!d->sys_active[sys] || !(m->geom_group[g] & 1)) continue;
     int dyn = m->sys_nv[sys] > 0;
     ssStatus st;
     for (int h = 0; h < m->nhfield; h++) {
@@ -355,7 +321,7 @@ void ss_terrain_update(const ssModel *m, ssData *d)
   for (int i = 0; i < d->ncontact; i++) {
     ssContact *c = d->contact + i;
     if (c->type != SS_CONTACT_SOIL) {
-      st->rigid_contacts++;
+      if (c->type == SS_CONTACT_RIGID) st->rigid_contacts++;
       continue;
     }
     st->soil_contacts++;

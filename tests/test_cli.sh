@@ -262,6 +262,33 @@ run "$PLATE" --steps 0 --export "$tmp/zero.xml" --csv "$tmp/zero.csv" --quiet
 check "--steps 0: exit 0, export written, CSV has only its header" \
   'rc_is 0 && [ -s "$tmp/zero.xml" ] && [ "$(wc -l <"$tmp/zero.csv")" -eq 1 ]'
 
+# The progress line: only on a terminal, not with --quiet, not under CI.
+# script(1) gives the program a pseudo-terminal.
+if command -v script >/dev/null 2>&1 &&
+   script -qec true /dev/null >/dev/null 2>&1; then
+  tty_run() {
+    last_cmd="(on a terminal) $2 soilsim $1"
+    # shellcheck disable=SC2086
+    env $2 $TIMEOUT script -qec "'$SOILSIM' '$PLATE' --steps 50 $1" /dev/null \
+      >"$tmp/out" 2>"$tmp/err" </dev/null
+    rc=$?
+  }
+  tty_run "" "CI="
+  check "on a terminal: a progress line with %, steps/s and ETA, then erased" \
+    'rc_is 0 && out_has "100%" && out_has "steps/s" && out_has "ETA" &&
+     out_has "$(printf "\r\033[K")"'
+  tty_run "" "CI=true"
+  check "on a terminal with CI set: no progress line, the summary stays" \
+    'rc_is 0 && ! out_has "steps/s" && out_has "wall time"'
+  tty_run "--quiet" "CI="
+  check "on a terminal with --quiet: nothing at all" \
+    'rc_is 0 && ! out_has "steps/s" && ! out_has "wall time"'
+else
+  skip "script(1) cannot make a terminal here"
+  skip "script(1) cannot make a terminal here"
+  skip "script(1) cannot make a terminal here"
+fi
+
 # An existing output file is replaced whole.
 echo "old" >"$tmp/old.xml"
 run "$PLATE" --steps 10 --export "$tmp/old.xml" --quiet

@@ -1,0 +1,1174 @@
+/* articulated.c -- reduced-coordinate articulated systems (see
+ * articulated.h for the formulation). */
+#include "articulated.h"
+#include "mesh.h"
+#include "model_build.h"
+#include "solver.h"
+#include "ss_math.h"
+
+#include <float.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct ssArtWork {
+  int sys, nv, nb, b0, v0;
+  int nrow;              /* closure rows (pin 3, distance 1, equality 1) */
+  int neq, *eq;          /* closures of this system (model indices) */
+  int *dof_body;         /* (nv) body of each local dof */
+  int *dof_parent;       /* (nv) LTDL parent dof, -1 at the root */
+  double *S;             /* (nv x 6) motion subspace columns, world */
+  double *vel;           /* (nb x 6) body spatial velocities */
+  double *acc;           /* (nb x 6) bias accelerations */
+  double *frc;           /* (nb x 6) RNEA forces */
+  double *I6;            /* (nb x 36) spatial inertias, world */
+  double *Ic;            /* (nb x 36) composite inertias */
+  double *M;             /* (nv x nv) M' = M + implicit terms */
+  double *L;             /* (nv x nv) LTDL factor of M' */
+  double *rhs, *x, *y;   /* (nv) scratch */
+  double *K;             /* (nrow x nv) closure Jacobian */
+  double *phi;           /* (nrow) closure residual */
+  double *MiKT;          /* (nv x nrow) M'^-1 K^T */
+  double *A;             /* (nrow x nrow) Cholesky factor of K M'^-1 K^T */
+  unsigned char *row_on; /* (nrow) 0: row dropped as dependent */
+  double *Y;             /* (nb x nv x 6) projected responses P M'^-1 J_b^T */
+  double *Lam;           /* (nb x 36) J_b Y_b */
+  unsigned char *Yok;    /* (nb) Y_b valid for this step */
+  int rank_deficient;    /* rows dropped in the last factorization */
+};
+
+/* ---------------------------------------------------------------------- */
+/* spatial algebra (world frame, about the origin): motion (w; v)          */
+
+/* r = a x b (motion cross motion) */
+static void mcross(double r[6], const double a[6], const double b[6])
+{
+  double t[6], u[3];
+  ss_v3_cross(t, a, b);
+  ss_v3_cross(t + 3, a, b + 3);
+  ss_v3_cross(u, a + 3, b);
+  ss_v3_add(t + 3, t + 3, u);
+  memcpy(r, t, sizeof t);
+}
+
+/* r = a x* f (motion cross force) */
+static void fcross(double r[6], const double a[6], const double f[6])
+{
+  double t[6], u[3];
+  ss_v3_cross(t, a, f);
+  ss_v3_cross(u, a + 3, f + 3);
+  ss_v3_add(t, t, u);
+  ss_v3_cross(t + 3, a, f + 3);
+  memcpy(r, t, sizeof t);
+}
+
+static void m6v(double r[6], const double M[36], const double v[6])
+{
+  for (int i = 0; i < 6; i++) {
+    double s = 0;
+    for (int j = 0; j < 6; j++) s += M[6 * i + j] * v[j];
+    r[i] = s;
+  }
+}
+
+static double dot6(const double a[6], const double b[6])
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5];
+}
+
+/* spatial inertia about the origin of mass m, COM c, inertia Ic (world,
+ * about the COM):  [[Ic - m [c]x[c]x, m [c]x], [-m [c]x, m 1]] */
+static void spatial_inertia(double I6[36], double mass, const double c[3],
+                            const double Ic[9])
+{
+  double cx[9] = {0, -c[2], c[1], c[2], 0, -c[0], -c[1], c[0], 0}, cc[9];
+  ss_m3_mul(cc, cx, cx);
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      I6[6 * i + j] = Ic[3 * i + j] - mass * cc[3 * i + j];
+      I6[6 * i + 3 + j] = mass * cx[3 * i + j];
+      I6[6 * (3 + i) + j] = -mass * cx[3 * i + j];
+      I6[6 * (3 + i) + 3 + j] = i == j ? mass : 0;
+    }
+}
+
+/* ---------------------------------------------------------------------- */
+/* workspace                                                               */
+
+static int sys_closures(const ssModel *m, int s, int *eq, int *rows)
+{
+  int n = 0, r = 0;
+  for (int k = 0; k < m->neq; k++) {
+    if (m->eq_sys[k] != s) continue;
+    if (eq) eq[n] = k;
+    n++;
+    r += m->eq_type[k] == SS_CLOSURE_PIN ? 3 : 1;
+  }
+  if (rows) *rows = r;
+  return n;
+}
+
+void ss_art_work_free(ssArtWork *w)
+{
+  if (!w) return;
+  free(w->eq); free(w->dof_body); free(w->dof_parent); free(w->S);
+  free(w->vel); free(w->acc); free(w->frc); free(w->I6); free(w->Ic);
+  free(w->M); free(w->L); free(w->rhs); free(w->x); free(w->y);
+  free(w->K); free(w->phi); free(w->MiKT); free(w->A); free(w->row_on);
+  free(w->Y); free(w->Lam); free(w->Yok);
+  free(w);
+}
+
+ssArtWork *ss_art_work_new(const ssModel *m, int s)
+{
+  ssArtWork *w = calloc(1, sizeof *w);
+  if (!w) return NULL;
+  w->sys = s;
+  w->nv = m->sys_nv[s];
+  w->nb = m->sys_nbody[s];
+  w->b0 = m->sys_bodyadr[s];
+  w->v0 = m->sys_vadr[s];
+  w->neq = sys_closures(m, s, NULL, &w->nrow);
+  size_t nv = w->nv ? w->nv : 1, nb = w->nb, nr = w->nrow ? w->nrow : 1;
+  w->eq = calloc(w->neq ? w->neq : 1, sizeof(int));
+  w->dof_body = calloc(nv, sizeof(int));
+  w->dof_parent = calloc(nv, sizeof(int));
+  w->S = calloc(nv * 6, sizeof(double));
+  w->vel = calloc(nb * 6, sizeof(double));
+  w->acc = calloc(nb * 6, sizeof(double));
+  w->frc = calloc(nb * 6, sizeof(double));
+  w->I6 = calloc(nb * 36, sizeof(double));
+  w->Ic = calloc(nb * 36, sizeof(double));
+  w->M = calloc(nv * nv, sizeof(double));
+  w->L = calloc(nv * nv, sizeof(double));
+  w->rhs = calloc(nv, sizeof(double));
+  w->x = calloc(nv, sizeof(double));
+  w->y = calloc(nv > nr ? nv : nr, sizeof(double));
+  w->K = calloc(nr * nv, sizeof(double));
+  w->phi = calloc(nr, sizeof(double));
+  w->MiKT = calloc(nv * nr, sizeof(double));
+  w->A = calloc(nr * nr, sizeof(double));
+  w->row_on = calloc(nr, 1);
+  w->Y = calloc(nb * nv * 6, sizeof(double));
+  w->Lam = calloc(nb * 36, sizeof(double));
+  w->Yok = calloc(nb, 1);
+  if (!w->eq || !w->dof_body || !w->dof_parent || !w->S || !w->vel || !w->acc ||
+      !w->frc || !w->I6 || !w->Ic || !w->M || !w->L || !w->rhs || !w->x || !w->y ||
+      !w->K || !w->phi || !w->MiKT || !w->A || !w->row_on || !w->Y || !w->Lam ||
+      !w->Yok) {
+    ss_art_work_free(w);
+    return NULL;
+  }
+  sys_closures(m, s, w->eq, NULL);
+  /* LTDL parent of each dof: the previous dof of its joint, else the last
+   * dof of the nearest ancestor that has one */
+  for (int lb = 0; lb < w->nb; lb++) {
+    int b = w->b0 + lb, nd = m->body_ndof[b];
+    if (!nd) continue;
+    int k0 = m->body_dofadr[b] - w->v0;
+    int par = -1;
+    for (int a = m->body_parent[b]; a >= 0; a = m->body_parent[a])
+      if (m->body_ndof[a]) {
+        par = m->body_dofadr[a] - w->v0 + m->body_ndof[a] - 1;
+        break;
+      }
+    for (int k = 0; k < nd; k++) {
+      w->dof_body[k0 + k] = lb;
+      w->dof_parent[k0 + k] = k ? k0 + k - 1 : par;
+    }
+  }
+  return w;
+}
+
+/* ---------------------------------------------------------------------- */
+/* kinematics                                                              */
+
+/* World pose of every body of system s from qpos (xpos, xquat per body,
+ * indexed by body - first body). */
+static void kinematics(const ssModel *m, int s, const double *qpos,
+                       double *xpos, double *xquat)
+{
+  int b0 = m->sys_bodyadr[s];
+  for (int lb = 0; lb < m->sys_nbody[s]; lb++) {
+    int b = b0 + lb, par = m->body_parent[b], type = m->body_jnttype[b];
+    double *p = xpos + 3 * lb, *q = xquat + 4 * lb;
+    const double *qa = m->body_qadr[b] >= 0 ? qpos + m->body_qadr[b] : NULL;
+    if (par < 0) {
+      if (type == SS_JOINT_FLOATING) {
+        memcpy(p, qa, 3 * sizeof(double));
+        memcpy(q, qa + 3, 4 * sizeof(double));
+      } else {
+        memcpy(p, m->body_jntpos + 3 * b, 3 * sizeof(double));
+        memcpy(q, m->body_jntquat + 4 * b, 4 * sizeof(double));
+      }
+      continue;
+    }
+    const double *pp = xpos + 3 * (par - b0), *pq = xquat + 4 * (par - b0);
+    double Rp[9], off[3], jq[4];
+    ss_quat_to_mat(Rp, pq);
+    ss_m3_mulv(off, Rp, m->body_jntpos + 3 * b);
+    ss_v3_add(p, pp, off);
+    ss_quat_mul(jq, pq, m->body_jntquat + 4 * b);
+    const double *ax = m->body_jntaxis + 3 * b;
+    switch (type) {
+    case SS_JOINT_REVOLUTE: {
+      double r[4];
+      ss_quat_from_axis_angle(r, ax, qa[0]);
+      ss_quat_mul(q, jq, r);
+      break;
+    }
+    case SS_JOINT_PRISMATIC: {
+      double Rj[9], d[3];
+      memcpy(q, jq, 4 * sizeof(double));
+      ss_quat_to_mat(Rj, jq);
+      ss_m3_mulv(d, Rj, ax);
+      ss_v3_addscl(p, d, qa[0]);
+      break;
+    }
+    case SS_JOINT_SPHERICAL:
+      ss_quat_mul(q, jq, qa);
+      break;
+    default:
+      memcpy(q, jq, 4 * sizeof(double));
+      break;
+    }
+    ss_quat_normalize(q);
+  }
+}
+
+void ss_art_forward(const ssModel *m, ssData *d, int s)
+{
+  ssArtWork *w = d->art[s];
+  int b0 = w->b0;
+  kinematics(m, s, d->qpos, d->body_xpos + 3 * b0, d->body_xquat + 4 * b0);
+  for (int lb = 0; lb < w->nb; lb++) {
+    int b = b0 + lb;
+    double *R = d->body_xmat + 9 * b, *p = d->body_xpos + 3 * b, off[3];
+    ss_quat_to_mat(R, d->body_xquat + 4 * b);
+    ss_m3_mulv(off, R, m->body_ipos + 3 * b);
+    ss_v3_add(d->body_xipos + 3 * b, p, off);
+    int nd = m->body_ndof[b];
+    if (!nd) continue;
+    double *S = w->S + 6 * (m->body_dofadr[b] - w->v0);
+    const double *ax = m->body_jntaxis + 3 * b;
+    switch (m->body_jnttype[b]) {
+    case SS_JOINT_REVOLUTE:
+      ss_m3_mulv(S, R, ax);
+      ss_v3_cross(S + 3, p, S);
+      break;
+    case SS_JOINT_PRISMATIC:
+      ss_v3_set(S, 0, 0, 0);
+      ss_m3_mulv(S + 3, R, ax);
+      break;
+    case SS_JOINT_SPHERICAL:
+      for (int k = 0; k < 3; k++) {
+        double *c = S + 6 * k;
+        ss_v3_set(c, R[k], R[3 + k], R[6 + k]);
+        ss_v3_cross(c + 3, p, c);
+      }
+      break;
+    case SS_JOINT_FLOATING:
+      memset(S, 0, 36 * sizeof(double));
+      for (int k = 0; k < 3; k++) {
+        S[6 * k + 3 + k] = 1;         /* linear velocity of the base origin */
+        double *c = S + 6 * (3 + k);  /* world angular velocity */
+        c[k] = 1;
+        ss_v3_cross(c + 3, p, c);
+      }
+      break;
+    default:
+      break;
+    }
+  }
+}
+
+/* ---------------------------------------------------------------------- */
+/* LTDL factorization of M' (Featherstone, RBDA 6.3)                        */
+
+static int ltdl_factor(ssArtWork *w)
+{
+  int n = w->nv;
+  double *H = w->L;
+  memcpy(H, w->M, (size_t)n * n * sizeof(double));
+  double dmax = 0;
+  for (int k = 0; k < n; k++) dmax = fmax(dmax, fabs(H[k * n + k]));
+  for (int k = n - 1; k >= 0; k--) {
+    if (!(H[k * n + k] > 1e-14 * dmax)) return -1 - k;
+    for (int i = w->dof_parent[k]; i >= 0; i = w->dof_parent[i]) {
+      double a = H[k * n + i] / H[k * n + k];
+      for (int j = i; j >= 0; j = w->dof_parent[j]) H[i * n + j] -= a * H[k * n + j];
+      H[k * n + i] = a;
+    }
+  }
+  return 0;
+}
+
+/* x <- M'^-1 x */
+static void ltdl_solve(const ssArtWork *w, double *x)
+{
+  int n = w->nv;
+  const double *H = w->L;
+  for (int i = n - 1; i >= 0; i--)
+    for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) x[j] -= H[i * n + j] * x[i];
+  for (int i = 0; i < n; i++) x[i] /= H[i * n + i];
+  for (int i = 0; i < n; i++)
+    for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) x[i] -= H[i * n + j] * x[j];
+}
+
+/* ---------------------------------------------------------------------- */
+/* Jacobians                                                               */
+
+/* r (length nv) += s * (point Jacobian row along dir of world point p on
+ * body b): sum over path dofs of dir . (v_k + w_k x p) */
+static void point_row(const ssModel *m, const ssArtWork *w, int b,
+                      const double p[3], const double dir[3], double s,
+                      double *r)
+{
+  double pxd[3];
+  ss_v3_cross(pxd, p, dir);
+  for (int a = b; a >= 0; a = m->body_parent[a]) {
+    int nd = m->body_ndof[a];
+    if (!nd) continue;
+    int k0 = m->body_dofadr[a] - w->v0;
+    for (int k = k0; k < k0 + nd; k++) {
+      const double *c = w->S + 6 * k;
+      r[k] += s * (ss_v3_dot(c + 3, dir) + ss_v3_dot(c, pxd));
+    }
+  }
+}
+
+static void body_point(const ssData *d, int b, const double local[3], double p[3])
+{
+  ss_m3_mulv(p, d->body_xmat + 9 * b, local);
+  ss_v3_add(p, p, d->body_xpos + 3 * b);
+}
+
+/* closure rows K (nrow x nv) and residual phi at the current kinematics */
+static void closures(const ssModel *m, const ssData *d, ssArtWork *w)
+{
+  int n = w->nv, r = 0;
+  memset(w->K, 0, (size_t)w->nrow * n * sizeof(double));
+  for (int e = 0; e < w->neq; e++) {
+    int k = w->eq[e], b1 = m->eq_body[2 * k], b2 = m->eq_body[2 * k + 1];
+    const double *an = m->eq_anchor + 6 * k;
+    switch (m->eq_type[k]) {
+    case SS_CLOSURE_PIN: {
+      double p1[3], p2[3];
+      body_point(d, b1, an, p1);
+      body_point(d, b2, an + 3, p2);
+      for (int i = 0; i < 3; i++) {
+        double dir[3] = {i == 0, i == 1, i == 2};
+        w->phi[r] = p1[i] - p2[i];
+        point_row(m, w, b1, p1, dir, 1, w->K + (size_t)r * n);
+        point_row(m, w, b2, p2, dir, -1, w->K + (size_t)r * n);
+        r++;
+      }
+      break;
+    }
+    case SS_CLOSURE_DISTANCE: {
+      double p1[3], p2[3], dv[3];
+      body_point(d, b1, an, p1);
+      body_point(d, b2, an + 3, p2);
+      ss_v3_sub(dv, p1, p2);
+      double len = ss_v3_normalize(dv);
+      w->phi[r] = len - m->eq_data[2 * k];
+      point_row(m, w, b1, p1, dv, 1, w->K + (size_t)r * n);
+      point_row(m, w, b2, p2, dv, -1, w->K + (size_t)r * n);
+      r++;
+      break;
+    }
+    case SS_CLOSURE_EQUALITY: {
+      double ratio = m->eq_data[2 * k], off = m->eq_data[2 * k + 1];
+      w->phi[r] = d->qpos[m->body_qadr[b1]] - ratio * d->qpos[m->body_qadr[b2]] - off;
+      w->K[(size_t)r * n + m->body_dofadr[b1] - w->v0] += 1;
+      w->K[(size_t)r * n + m->body_dofadr[b2] - w->v0] -= ratio;
+      r++;
+      break;
+    }
+    }
+  }
+}
+
+/* MiKT = M'^-1 K^T and the Cholesky factor of A = K M'^-1 K^T; dependent
+ * rows (pivot below 1e-10 of the largest diagonal) are dropped. */
+static void factor_closures(ssArtWork *w)
+{
+  int n = w->nv, nr = w->nrow;
+  w->rank_deficient = 0;
+  for (int r = 0; r < nr; r++) {
+    double *col = w->y;
+    memcpy(col, w->K + (size_t)r * n, (size_t)n * sizeof(double));
+    ltdl_solve(w, col);
+    for (int i = 0; i < n; i++) w->MiKT[(size_t)i * nr + r] = col[i];
+  }
+  double *A = w->A, amax = 0;
+  for (int i = 0; i < nr; i++)
+    for (int j = 0; j <= i; j++) {
+      double s = 0;
+      for (int k = 0; k < n; k++) s += w->K[(size_t)i * n + k] * w->MiKT[(size_t)k * nr + j];
+      A[i * nr + j] = A[j * nr + i] = s;
+      if (i == j) amax = fmax(amax, s);
+    }
+  for (int j = 0; j < nr; j++) {
+    double s = A[j * nr + j];
+    for (int k = 0; k < j; k++) s -= A[j * nr + k] * A[j * nr + k];
+    if (!(s > 1e-10 * amax)) {
+      w->row_on[j] = 0;
+      w->rank_deficient++;
+      for (int i = j; i < nr; i++) A[i * nr + j] = 0;
+      continue;
+    }
+    w->row_on[j] = 1;
+    double l = sqrt(s);
+    A[j * nr + j] = l;
+    for (int i = j + 1; i < nr; i++) {
+      double t = A[i * nr + j];
+      for (int k = 0; k < j; k++) t -= A[i * nr + k] * A[j * nr + k];
+      A[i * nr + j] = t / l;
+    }
+  }
+}
+
+/* z <- A^-1 z over the active rows (dropped rows give 0) */
+static void closure_solve(const ssArtWork *w, double *z)
+{
+  int nr = w->nrow;
+  const double *A = w->A;
+  for (int i = 0; i < nr; i++) {
+    if (!w->row_on[i]) { z[i] = 0; continue; }
+    double t = z[i];
+    for (int k = 0; k < i; k++) t -= A[i * nr + k] * z[k];
+    z[i] = t / A[i * nr + i];
+  }
+  for (int i = nr - 1; i >= 0; i--) {
+    if (!w->row_on[i]) { z[i] = 0; continue; }
+    double t = z[i];
+    for (int k = i + 1; k < nr; k++) t -= A[k * nr + i] * z[k];
+    z[i] = t / A[i * nr + i];
+  }
+}
+
+/* x (already M'^-1 b) <- P x: remove the part that violates K x = 0 */
+static void project(const ssArtWork *w, double *x)
+{
+  int n = w->nv, nr = w->nrow;
+  if (!nr) return;
+  double z[64], *zz = nr <= 64 ? z : malloc((size_t)nr * sizeof(double));
+  if (!zz) return;
+  for (int r = 0; r < nr; r++) {
+    double s = 0;
+    for (int k = 0; k < n; k++) s += w->K[(size_t)r * n + k] * x[k];
+    zz[r] = s;
+  }
+  closure_solve(w, zz);
+  for (int k = 0; k < n; k++) {
+    double s = 0;
+    for (int r = 0; r < nr; r++) s += w->MiKT[(size_t)k * nr + r] * zz[r];
+    x[k] -= s;
+  }
+  if (zz != z) free(zz);
+}
+
+/* ---------------------------------------------------------------------- */
+/* dynamics                                                                */
+
+static int is_ancestor(const ssModel *m, int a, int b)
+{
+  for (; b >= 0; b = m->body_parent[b])
+    if (b == a) return 1;
+  return 0;
+}
+
+ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
+{
+  ssArtWork *w = d->art[s];
+  const double dt = m->opt.timestep;
+  int n = w->nv, b0 = w->b0;
+  double *u = d->qvel + w->v0;
+
+  /* body velocities, bias accelerations and spatial inertias (RNEA forward) */
+  for (int lb = 0; lb < w->nb; lb++) {
+    int b = b0 + lb, par = m->body_parent[b], nd = m->body_ndof[b];
+    double *v = w->vel + 6 * lb, *a = w->acc + 6 * lb, su[6] = {0, 0, 0, 0, 0, 0};
+    if (par >= 0) {
+      memcpy(v, w->vel + 6 * (par - b0), 6 * sizeof(double));
+      memcpy(a, w->acc + 6 * (par - b0), 6 * sizeof(double));
+    } else {
+      memset(v, 0, 6 * sizeof(double));
+      /* the ground accelerates upwards at g: gravity without body forces */
+      a[0] = a[1] = a[2] = 0;
+      ss_v3_scale(a + 3, m->opt.gravity, -1);
+    }
+    if (nd) {
+      int k0 = m->body_dofadr[b] - w->v0;
+      for (int k = 0; k < nd; k++)
+        for (int i = 0; i < 6; i++) su[i] += w->S[6 * (k0 + k) + i] * u[k0 + k];
+      double c[6];
+      if (m->body_jnttype[b] == SS_JOINT_FLOATING) {
+        /* d/dt of the base's columns: only the origin term moves */
+        memset(c, 0, sizeof c);
+        ss_v3_cross(c + 3, u + k0, u + k0 + 3);
+      } else {
+        mcross(c, v, su); /* v_parent x S qdot */
+      }
+      for (int i = 0; i < 6; i++) {
+        v[i] += su[i];
+        a[i] += c[i];
+      }
+    }
+    double R[9], Rt[9], T[9], Iw[9];
+    memcpy(R, d->body_xmat + 9 * b, sizeof R);
+    ss_m3_transpose(Rt, R);
+    ss_m3_mul(T, R, m->body_inertia + 9 * b);
+    ss_m3_mul(Iw, T, Rt);
+    spatial_inertia(w->I6 + 36 * lb, m->body_mass[b], d->body_xipos + 3 * b, Iw);
+    double Iv[6], Ia[6], vf[6];
+    m6v(Iv, w->I6 + 36 * lb, v);
+    m6v(Ia, w->I6 + 36 * lb, a);
+    fcross(vf, v, Iv);
+    for (int i = 0; i < 6; i++) w->frc[6 * lb + i] = Ia[i] + vf[i];
+    /* external loads at the centre of mass */
+    for (int k = 0; k < m->nxforce; k++) {
+      if (m->xforce_body[k] != b) continue;
+      if (d->time < m->xforce_time[2 * k] || d->time >= m->xforce_time[2 * k + 1]) continue;
+      const double *F = m->xforce_force + 3 * k, *Tq = m->xforce_torque + 3 * k;
+      double cxf[3];
+      ss_v3_cross(cxf, d->body_xipos + 3 * b, F);
+      for (int i = 0; i < 3; i++) {
+        w->frc[6 * lb + i] -= Tq[i] + cxf[i];
+        w->frc[6 * lb + 3 + i] -= F[i];
+      }
+    }
+  }
+
+  /* backward pass: bias forces c (in rhs, negated) and composite inertias */
+  memcpy(w->Ic, w->I6, (size_t)w->nb * 36 * sizeof(double));
+  for (int lb = w->nb - 1; lb >= 0; lb--) {
+    int b = b0 + lb, par = m->body_parent[b], nd = m->body_ndof[b];
+    const double *f = w->frc + 6 * lb;
+    if (nd) {
+      int k0 = m->body_dofadr[b] - w->v0;
+      for (int k = 0; k < nd; k++) w->rhs[k0 + k] = -dot6(w->S + 6 * (k0 + k), f);
+    }
+    if (par >= 0) {
+      int lp = par - b0;
+      for (int i = 0; i < 6; i++) w->frc[6 * lp + i] += f[i];
+      for (int i = 0; i < 36; i++) w->Ic[36 * lp + i] += w->Ic[36 * lb + i];
+    }
+  }
+
+  /* CRBA: M[k][j] = S_j . (Ic_b S_k) for j on the path of k */
+  memset(w->M, 0, (size_t)n * n * sizeof(double));
+  for (int lb = 0; lb < w->nb; lb++) {
+    int b = b0 + lb, nd = m->body_ndof[b];
+    if (!nd) continue;
+    int k0 = m->body_dofadr[b] - w->v0;
+    for (int k = k0; k < k0 + nd; k++) {
+      double F[6];
+      m6v(F, w->Ic + 36 * lb, w->S + 6 * k);
+      for (int j = k; j >= 0; j = w->dof_parent[j]) {
+        double v = dot6(w->S + 6 * j, F);
+        w->M[k * n + j] = w->M[j * n + k] = v;
+      }
+    }
+  }
+
+  /* rhs = M u + dt (-c + explicit forces); implicit terms go into M' */
+  double *Mu = w->x;
+  for (int i = 0; i < n; i++) {
+    double t = 0;
+    for (int j = 0; j < n; j++) t += w->M[i * n + j] * u[j];
+    Mu[i] = t;
+  }
+  for (int i = 0; i < n; i++) w->rhs[i] = Mu[i] + dt * w->rhs[i];
+
+  /* joint dampers and springs, implicit */
+  for (int lb = 0; lb < w->nb; lb++) {
+    int b = b0 + lb, nd = m->body_ndof[b], t = m->body_jnttype[b];
+    if (!nd || t == SS_JOINT_FLOATING) continue;
+    int k0 = m->body_dofadr[b] - w->v0;
+    double dmp = m->body_jntdamping[b], stf = m->body_jntstiffness[b];
+    for (int k = k0; k < k0 + nd; k++) w->M[k * n + k] += dt * dmp;
+    if (stf > 0 && nd == 1) {
+      w->M[k0 * n + k0] += dt * dt * stf;
+      w->rhs[k0] -= dt * stf * (d->qpos[m->body_qadr[b]] - m->body_jntref[b]);
+    }
+  }
+
+  /* point-to-point spring-dampers: implicit when both ends lie on one
+   * chain (the rank-one term keeps the tree's sparsity), else explicit */
+  double *Js = w->y;
+  for (int k = 0; k < m->nspring; k++) {
+    int b1 = m->spring_body[2 * k], b2 = m->spring_body[2 * k + 1];
+    if (m->body_sys[b1] != s) continue;
+    const double *an = m->spring_anchor + 6 * k, *par = m->spring_param + 3 * k;
+    double p1[3], p2[3], dv[3];
+    body_point(d, b1, an, p1);
+    body_point(d, b2, an + 3, p2);
+    ss_v3_sub(dv, p1, p2);
+    double len = ss_v3_normalize(dv);
+    memset(Js, 0, (size_t)n * sizeof(double));
+    point_row(m, w, b1, p1, dv, 1, Js);
+    point_row(m, w, b2, p2, dv, -1, Js);
+    double ldot = 0;
+    for (int i = 0; i < n; i++) ldot += Js[i] * u[i];
+    double tension = par[0] * (len - par[2]);
+    if (is_ancestor(m, b1, b2) || is_ancestor(m, b2, b1)) {
+      double c = dt * (par[1] + dt * par[0]);
+      for (int i = 0; i < n; i++) {
+        if (Js[i] == 0) continue;
+        for (int j = 0; j < n; j++) w->M[i * n + j] += c * Js[i] * Js[j];
+        w->rhs[i] -= dt * tension * Js[i];
+      }
+    } else {
+      double f = tension + par[1] * ldot;
+      for (int i = 0; i < n; i++) w->rhs[i] -= dt * f * Js[i];
+    }
+  }
+
+  int bad = ltdl_factor(w);
+  if (bad) {
+    int k = -1 - bad;
+    return ss_error_set(err, SS_ERR_NUMERIC, NULL, 0,
+                        "articulated system '%s': the mass matrix is singular "
+                        "at the joint of link '%s' (a massless moving link?)",
+                        m->sys_name[s], m->body_name[b0 + w->dof_body[k]]);
+  }
+  memcpy(u, w->rhs, (size_t)n * sizeof(double));
+  ltdl_solve(w, u);
+  if (w->nrow) {
+    closures(m, d, w);
+    factor_closures(w);
+    project(w, u);
+  }
+  memset(w->Yok, 0, (size_t)w->nb);
+  return SS_OK;
+}
+
+/* Y_b = P M'^-1 J_b^T (nv x 6) and Lam_b = J_b Y_b, once per step */
+static void body_response(const ssModel *m, ssArtWork *w, int lb)
+{
+  if (w->Yok[lb]) return;
+  int n = w->nv, b = w->b0 + lb;
+  double *Y = w->Y + (size_t)lb * n * 6, *col = w->x;
+  for (int r = 0; r < 6; r++) {
+    memset(col, 0, (size_t)n * sizeof(double));
+    for (int a = b; a >= 0; a = m->body_parent[a]) {
+      int nd = m->body_ndof[a];
+      if (!nd) continue;
+      int k0 = m->body_dofadr[a] - w->v0;
+      for (int k = k0; k < k0 + nd; k++) col[k] = w->S[6 * k + r];
+    }
+    ltdl_solve(w, col);
+    project(w, col);
+    for (int k = 0; k < n; k++) Y[6 * k + r] = col[k];
+  }
+  double *Lam = w->Lam + 36 * lb;
+  memset(Lam, 0, 36 * sizeof(double));
+  for (int a = b; a >= 0; a = m->body_parent[a]) {
+    int nd = m->body_ndof[a];
+    if (!nd) continue;
+    int k0 = m->body_dofadr[a] - w->v0;
+    for (int k = k0; k < k0 + nd; k++)
+      for (int r = 0; r < 6; r++)
+        for (int c = 0; c < 6; c++) Lam[6 * r + c] += w->S[6 * k + r] * Y[6 * k + c];
+  }
+  w->Yok[lb] = 1;
+}
+
+void ss_art_contact_jacobian(const ssModel *m, ssData *d, int b,
+                             const double p[3], const double frame[9],
+                             double *J, double *W, double G[9])
+{
+  int s = m->body_sys[b];
+  ssArtWork *w = d->art[s];
+  int n = w->nv, lb = b - w->b0;
+  body_response(m, w, lb);
+  /* X (3 x 6): contact-frame velocity of the point from a spatial velocity */
+  double X[18];
+  for (int i = 0; i < 3; i++) {
+    const double *f = frame + 3 * i;
+    ss_v3_cross(X + 6 * i, p, f);
+    memcpy(X + 6 * i + 3, f, 3 * sizeof(double));
+  }
+  memset(J, 0, 3 * (size_t)n * sizeof(double));
+  for (int a = b; a >= 0; a = m->body_parent[a]) {
+    int nd = m->body_ndof[a];
+    if (!nd) continue;
+    int k0 = m->body_dofadr[a] - w->v0;
+    for (int k = k0; k < k0 + nd; k++)
+      for (int i = 0; i < 3; i++) J[i * n + k] = dot6(X + 6 * i, w->S + 6 * k);
+  }
+  const double *Y = w->Y + (size_t)lb * n * 6, *Lam = w->Lam + 36 * lb;
+  for (int k = 0; k < n; k++)
+    for (int i = 0; i < 3; i++) W[3 * k + i] = dot6(Y + 6 * k, X + 6 * i);
+  double LX[18];
+  for (int i = 0; i < 3; i++) m6v(LX + 6 * i, Lam, X + 6 * i);
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) G[3 * i + j] = dot6(X + 6 * i, LX + 6 * j);
+}
+
+void ss_art_dof_jacobian(const ssModel *m, ssData *d, int s, int dof,
+                         double *J, double *W, double G[9])
+{
+  ssArtWork *w = d->art[s];
+  int n = w->nv, k = dof - w->v0;
+  memset(J, 0, 3 * (size_t)n * sizeof(double));
+  J[k] = 1;
+  double *col = w->x;
+  memset(col, 0, (size_t)n * sizeof(double));
+  col[k] = 1;
+  ltdl_solve(w, col);
+  project(w, col);
+  memset(W, 0, 3 * (size_t)n * sizeof(double));
+  for (int i = 0; i < n; i++) W[3 * i] = col[i];
+  memset(G, 0, 9 * sizeof(double));
+  G[0] = col[k];
+}
+
+void ss_art_point_velocity(const ssModel *m, const ssData *d, int b,
+                           const double p[3], double v[3])
+{
+  ssArtWork *w = d->art[m->body_sys[b]];
+  const double *u = d->qvel + w->v0;
+  double sv[6] = {0, 0, 0, 0, 0, 0};
+  for (int a = b; a >= 0; a = m->body_parent[a]) {
+    int nd = m->body_ndof[a];
+    if (!nd) continue;
+    int k0 = m->body_dofadr[a] - w->v0;
+    for (int k = k0; k < k0 + nd; k++)
+      for (int i = 0; i < 6; i++) sv[i] += w->S[6 * k + i] * u[k];
+  }
+  double wp[3];
+  ss_v3_cross(wp, sv, p);
+  ss_v3_add(v, sv + 3, wp);
+}
+
+/* q <- q (+) s du, joint by joint */
+static void advance(const ssModel *m, ssData *d, const ssArtWork *w,
+                    const double *du, double s)
+{
+  for (int lb = 0; lb < w->nb; lb++) {
+    int b = w->b0 + lb, nd = m->body_ndof[b];
+    if (!nd) continue;
+    double *q = d->qpos + m->body_qadr[b];
+    const double *v = du + m->body_dofadr[b] - w->v0;
+    switch (m->body_jnttype[b]) {
+    case SS_JOINT_REVOLUTE:
+    case SS_JOINT_PRISMATIC:
+      q[0] += s * v[0];
+      break;
+    case SS_JOINT_SPHERICAL: {
+      double rv[3], dq[4];
+      ss_v3_scale(rv, v, s);
+      ss_quat_from_rotvec(dq, rv);
+      ss_quat_mul(q, q, dq); /* local angular velocity */
+      ss_quat_normalize(q);
+      break;
+    }
+    case SS_JOINT_FLOATING: {
+      double rv[3], dq[4];
+      ss_v3_addscl(q, v, s);
+      ss_v3_scale(rv, v + 3, s);
+      ss_quat_from_rotvec(dq, rv);
+      ss_quat_mul(q + 3, dq, q + 3); /* world angular velocity */
+      ss_quat_normalize(q + 3);
+      break;
+    }
+    default:
+      break;
+    }
+  }
+}
+
+double ss_art_closure_error(const ssModel *m, ssData *d, int s)
+{
+  ssArtWork *w = d->art[s];
+  if (!w->nrow) return 0;
+  ss_art_forward(m, d, s);
+  closures(m, d, w);
+  double e = 0;
+  for (int r = 0; r < w->nrow; r++) e = fmax(e, fabs(w->phi[r]));
+  return e;
+}
+
+void ss_art_integrate(const ssModel *m, ssData *d, int s)
+{
+  ssArtWork *w = d->art[s];
+  advance(m, d, w, d->qvel + w->v0, m->opt.timestep);
+  if (!w->nrow) return;
+  /* remove closure drift: Newton steps du = -M'^-1 K^T A^-1 phi with K and
+   * A at the current configuration, M' of this step */
+  double err = 0, z[64], *zz = w->nrow <= 64 ? z : malloc((size_t)w->nrow * sizeof(double));
+  if (!zz) return;
+  for (int it = 0; it < 8; it++) {
+    ss_art_forward(m, d, s);
+    closures(m, d, w);
+    err = 0;
+    for (int r = 0; r < w->nrow; r++) err = fmax(err, fabs(w->phi[r]));
+    if (err < 1e-13) break;
+    factor_closures(w);
+    memcpy(zz, w->phi, (size_t)w->nrow * sizeof(double));
+    closure_solve(w, zz);
+    double *du = w->rhs;
+    for (int k = 0; k < w->nv; k++) {
+      double t = 0;
+      for (int r = 0; r < w->nrow; r++) t += w->MiKT[(size_t)k * w->nrow + r] * zz[r];
+      du[k] = -t;
+    }
+    advance(m, d, w, du, 1);
+  }
+  if (err > d->closure_error) d->closure_error = err;
+  if (zz != z) free(zz);
+}
+
+/* ---------------------------------------------------------------------- */
+/* building from a URDF                                                    */
+
+ssArtDef ss_art_def_default(void)
+{
+  ssArtDef a;
+  memset(&a, 0, sizeof a);
+  a.quat[0] = 1;
+  a.fixed_base = -1;
+  return a;
+}
+
+int ss_model_find_body(const ssModel *m, int s, const char *name)
+{
+  for (int b = m->sys_bodyadr[s]; b < m->sys_bodyadr[s] + m->sys_nbody[s]; b++)
+    if (!strcmp(m->body_name[b], name)) return b;
+  return -1;
+}
+
+static void rot_inertia(double out[9], const double q[4], const double v[6])
+{
+  double I[9] = {v[0], v[1], v[2], v[1], v[3], v[4], v[2], v[4], v[5]};
+  double R[9], Rt[9], T[9];
+  ss_quat_to_mat(R, q);
+  ss_m3_transpose(Rt, R);
+  ss_m3_mul(T, R, I);
+  ss_m3_mul(out, T, Rt);
+}
+
+/* each mesh geom loads its own copy: scale is baked into the vertices */
+static int load_mesh(ssModel *m, const ssUrdfGeom *g, ssError *err)
+{
+  ssMesh *mesh = NULL;
+  if (ss_mesh_load(g->mesh_path, g->mesh_scale, &mesh, err) != SS_OK) return -1;
+  int k = ss_model_push_mesh(m, mesh, g->mesh_path, err);
+  if (k < 0) ss_mesh_free(mesh);
+  return k;
+}
+
+int ss_model_add_articulated(ssModel *m, const ssUrdf *u, const ssArtDef *def,
+                             ssError *err)
+{
+  const char *f = m->source_path;
+  int line = def->line;
+  /* the scene decides the base; without a word from it a URDF rooted at a
+   * "world" link does; otherwise it floats.  A URDF's world pose of the
+   * root is composed with the scene's placement. */
+  int fixed = def->fixed_base >= 0 ? def->fixed_base : u->world_base == SS_URDF_BASE_FIXED;
+  double base_pos[3], base_quat[4];
+  memcpy(base_pos, def->pos, sizeof base_pos);
+  memcpy(base_quat, def->quat, sizeof base_quat);
+  ss_quat_normalize(base_quat);
+  if (u->world_base != SS_URDF_BASE_NONE) {
+    double R[9], off[3];
+    ss_quat_to_mat(R, base_quat);
+    ss_m3_mulv(off, R, u->base_pos);
+    ss_v3_add(base_pos, base_pos, off);
+    ss_quat_mul(base_quat, base_quat, u->base_quat);
+    ss_quat_normalize(base_quat);
+  }
+  /* coordinates: the base, then every joint in the URDF's order */
+  int nq = fixed ? 0 : 7, nv = fixed ? 0 : 6;
+  for (int j = 0; j < u->njoint; j++) {
+    switch (u->joint[j].type) {
+    case SS_JOINT_REVOLUTE:
+    case SS_JOINT_PRISMATIC: nq += 1; nv += 1; break;
+    case SS_JOINT_SPHERICAL: nq += 4; nv += 3; break;
+    case SS_JOINT_FIXED: break;
+    default:
+      ss_error_set(err, SS_ERR_UNSUPPORTED, u->path, u->joint[j].line,
+                   "joint '%s': a floating joint is only allowed at the root",
+                   u->joint[j].name);
+      return -1;
+    }
+  }
+  if (def->qpos && def->nqpos != nq) {
+    ss_error_set(err, SS_ERR_VALUE, f, line,
+                 "articulated_system '%s': qpos has %d values, expected %d",
+                 def->name, def->nqpos, nq);
+    return -1;
+  }
+  if (def->qvel && def->nqvel != nv) {
+    ss_error_set(err, SS_ERR_VALUE, f, line,
+                 "articulated_system '%s': qvel has %d values, expected %d",
+                 def->name, def->nqvel, nv);
+    return -1;
+  }
+  int mat = ss_model_material(m, def->material);
+  int s = ss_model_push_sys(m, def->name, SS_SYS_ARTICULATED, nq, nv, line, err);
+  if (s < 0 || mat < 0) return -1;
+  m->sys_fixed[s] = fixed;
+  free(m->sys_source[s]);
+  free(m->sys_resdir[s]);
+  m->sys_source[s] = strdup(def->urdf_path ? def->urdf_path : u->path);
+  m->sys_resdir[s] = strdup(def->res_dir ? def->res_dir : "");
+  if (!m->sys_source[s] || !m->sys_resdir[s]) {
+    ss_error_set(err, SS_ERR_NOMEM, f, line, "out of memory");
+    return -1;
+  }
+  int *body_of = malloc((size_t)u->nlink * sizeof(int));
+  if (!body_of) {
+    ss_error_set(err, SS_ERR_NOMEM, f, line, "out of memory");
+    return -1;
+  }
+  for (int i = 0; i < u->nlink; i++) body_of[i] = -1;
+  int qa = m->sys_qadr[s], va = m->sys_vadr[s];
+  double *q0 = m->qpos0 + m->sys_qadr[s];
+
+  /* bodies: the root, then each joint's child (parents come first) */
+  for (int j = -1; j < u->njoint; j++) {
+    const ssUrdfJoint *J = j >= 0 ? &u->joint[j] : NULL;
+    int li = J ? J->child : u->root;
+    const ssUrdfLink *L = &u->link[li];
+    int parent = J ? body_of[J->parent] : -1;
+    int b = ss_model_push_body(m, s, L->name, J ? J->name : "", parent, err);
+    if (b < 0) goto fail;
+    body_of[li] = b;
+    m->body_mass[b] = L->mass;
+    rot_inertia(m->body_inertia + 9 * b, L->com_quat, L->inertia);
+    memcpy(m->body_ipos + 3 * b, L->com, 3 * sizeof(double));
+    if (!J) {
+      m->body_jnttype[b] = fixed ? SS_JOINT_FIXED : SS_JOINT_FLOATING;
+      memcpy(m->body_jntpos + 3 * b, base_pos, 3 * sizeof(double));
+      memcpy(m->body_jntquat + 4 * b, base_quat, 4 * sizeof(double));
+      if (!fixed) {
+        m->body_qadr[b] = qa;
+        m->body_dofadr[b] = va;
+        m->body_ndof[b] = 6;
+        memcpy(q0, base_pos, 3 * sizeof(double));
+        memcpy(q0 + 3, m->body_jntquat + 4 * b, 4 * sizeof(double));
+        qa += 7;
+        va += 6;
+      }
+    } else {
+      m->body_jnttype[b] = J->type;
+      memcpy(m->body_jntpos + 3 * b, J->pos, 3 * sizeof(double));
+      memcpy(m->body_jntquat + 4 * b, J->quat, 4 * sizeof(double));
+      memcpy(m->body_jntaxis + 3 * b, J->axis, 3 * sizeof(double));
+      m->body_jntdamping[b] = J->damping;
+      m->body_jntstiffness[b] = J->stiffness;
+      m->body_jntref[b] = J->spring_mount;
+      m->body_jntlimited[b] = J->limited;
+      m->body_jntrange[2 * b] = J->lower;
+      m->body_jntrange[2 * b + 1] = J->upper;
+      int nd = J->type == SS_JOINT_SPHERICAL ? 3 : J->type == SS_JOINT_FIXED ? 0 : 1;
+      if (nd) {
+        m->body_qadr[b] = qa;
+        m->body_dofadr[b] = va;
+        m->body_ndof[b] = nd;
+        if (nd == 3) m->qpos0[qa] = 1; /* identity quaternion */
+        qa += nd == 3 ? 4 : 1;
+        va += nd;
+      }
+    }
+    /* colliders and visuals */
+    for (int g = 0; g < L->ngeom; g++) {
+      const ssUrdfGeom *G = &L->geom[g];
+      int mesh = -1;
+      double size[3];
+      memcpy(size, G->size, sizeof size);
+      if (G->type == SS_GEOM_MESH) {
+        if ((mesh = load_mesh(m, G, err)) < 0) {
+          ssError me = *err;
+          ss_error_set(err, me.code, u->path, G->line, "link '%s': mesh %s: %s",
+                       L->name, G->mesh_path, me.message);
+          goto fail;
+        }
+        const ssMesh *me = m->mesh[mesh];
+        for (int k = 0; k < 3; k++) size[k] = me->hi[k] - me->lo[k];
+      }
+      if (ss_model_push_geom(m, b, G->type, size, G->pos, G->quat, mat, G->rgba,
+                             G->collision ? 1 : 2, mesh, err) < 0)
+        goto fail;
+    }
+  }
+  if (def->qpos) memcpy(q0, def->qpos, (size_t)nq * sizeof(double));
+  if (def->qvel) memcpy(m->qvel0 + m->sys_vadr[s], def->qvel, (size_t)nv * sizeof(double));
+
+  /* closures and springs: implicit anchors and lengths come from the
+   * initial configuration */
+  double *xp = malloc((size_t)m->sys_nbody[s] * 7 * sizeof(double));
+  if (!xp) {
+    ss_error_set(err, SS_ERR_NOMEM, f, line, "out of memory");
+    goto fail;
+  }
+  double *xq = xp + 3 * m->sys_nbody[s];
+  kinematics(m, s, m->qpos0, xp, xq);
+  int b0 = m->sys_bodyadr[s];
+#define WORLD_POINT(b, local, out)                                             \
+  do {                                                                         \
+    double R_[9];                                                              \
+    ss_quat_to_mat(R_, xq + 4 * ((b) - b0));                                   \
+    ss_m3_mulv(out, R_, local);                                                \
+    ss_v3_add(out, out, xp + 3 * ((b) - b0));                                  \
+  } while (0)
+#define LOCAL_POINT(b, world, out)                                             \
+  do {                                                                         \
+    double R_[9], d_[3];                                                       \
+    ss_quat_to_mat(R_, xq + 4 * ((b) - b0));                                   \
+    ss_v3_sub(d_, world, xp + 3 * ((b) - b0));                                 \
+    ss_m3_mulvT(out, R_, d_);                                                  \
+  } while (0)
+  for (int c = 0; c < u->nclosure; c++) {
+    const ssUrdfClosure *C = &u->closure[c];
+    double an[6] = {0, 0, 0, 0, 0, 0}, data[2] = {0, 0};
+    int b1, b2;
+    char name[64];
+    snprintf(name, sizeof name, "closure%d", c);
+    if (C->type == SS_CLOSURE_EQUALITY) {
+      b1 = body_of[u->joint[C->joint1].child];
+      b2 = body_of[u->joint[C->joint2].child];
+      data[0] = C->ratio;
+      data[1] = C->offset;
+    } else {
+      b1 = body_of[C->body1];
+      b2 = body_of[C->body2];
+      memcpy(an, C->anchor1, 3 * sizeof(double));
+      double p1[3], p2[3];
+      WORLD_POINT(b1, an, p1);
+      if (C->has_anchor2) {
+        memcpy(an + 3, C->anchor2, 3 * sizeof(double));
+      } else if (C->type == SS_CLOSURE_PIN) {
+        LOCAL_POINT(b2, p1, an + 3);
+      }
+      WORLD_POINT(b2, an + 3, p2);
+      double dv[3];
+      ss_v3_sub(dv, p1, p2);
+      data[0] = C->type == SS_CLOSURE_DISTANCE && C->length < 0 ? ss_v3_norm(dv) : C->length;
+    }
+    if (ss_model_push_eq(m, name, C->type, s, b1, b2, an, data, C->line, err) < 0) {
+      free(xp);
+      goto fail;
+    }
+  }
+  for (int k = 0; k < u->nspring; k++) {
+    const ssUrdfSpring *S = &u->spring[k];
+    int b1 = body_of[S->body1], b2 = body_of[S->body2];
+    double an[6], p1[3], p2[3], dv[3];
+    memcpy(an, S->anchor1, 3 * sizeof(double));
+    memcpy(an + 3, S->anchor2, 3 * sizeof(double));
+    WORLD_POINT(b1, an, p1);
+    WORLD_POINT(b2, an + 3, p2);
+    ss_v3_sub(dv, p1, p2);
+    double par[3] = {S->stiffness, S->damping,
+                     S->rest_length < 0 ? ss_v3_norm(dv) : S->rest_length};
+    if (ss_model_push_spring(m, S->name, b1, b2, an, par, err) < 0) {
+      free(xp);
+      goto fail;
+    }
+  }
+#undef WORLD_POINT
+#undef LOCAL_POINT
+  free(xp);
+  free(body_of);
+  return s;
+fail:
+  free(body_of);
+  return -1;
+}
+
+int ss_model_add_pd(ssModel *m, int s, const char *joint, double kp, double kd,
+                    double qt, double vt, double effort, int line, ssError *err)
+{
+  int b = -1;
+  for (int k = m->sys_bodyadr[s]; k < m->sys_bodyadr[s] + m->sys_nbody[s]; k++)
+    if (!strcmp(m->body_jntname[k], joint)) b = k;
+  if (b < 0) {
+    ss_error_set(err, SS_ERR_NOTFOUND, m->source_path, line,
+                 "pd: articulated_system '%s' has no joint named '%s'",
+                 m->sys_name[s], joint);
+    return -1;
+  }
+  if (m->body_ndof[b] != 1) {
+    ss_error_set(err, SS_ERR_VALUE, m->source_path, line,
+                 "pd: joint '%s' must be revolute, continuous or prismatic",
+                 joint);
+    return -1;
+  }
+  if (!isfinite(kp) || kp < 0 || !isfinite(kd) || kd < 0 || !isfinite(qt) ||
+      !isfinite(vt) || !isfinite(effort) || effort < 0) {
+    ss_error_set(err, SS_ERR_VALUE, m->source_path, line,
+                 "pd on joint '%s': gains and effort_limit must be finite and "
+                 ">= 0, targets finite", joint);
+    return -1;
+  }
+  double gain[3] = {kp, kd, effort}, target[2] = {qt, vt};
+  return ss_model_push_pd(m, b, gain, target, err);
+}
+
+/* One bounded implicit row per PD controller and one unilateral row per
+ * joint at (or within a step of) its limit. */
+ssStatus ss_art_rows(const ssModel *m, ssData *d, ssError *err)
+{
+  const double dt = m->opt.timestep;
+  for (int k = 0; k < m->npd; k++) {
+    int b = m->pd_body[k], s = m->body_sys[b];
+    if (!d->sys_active[s]) continue;
+    int nv = m->sys_nv[s], dof = m->body_dofadr[b];
+    ssContact *c = ss_contact_new(d, nv);
+    if (!c) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
+    const double *g = m->pd_gain + 3 * k, *t = d->pd_target + 2 * k;
+    double q = d->qpos[m->body_qadr[b]];
+    /* tau(u) = kp (qt - q - dt u) + kd (ut - u), as an impulse over dt */
+    c->type = SS_CONTACT_PD;
+    c->sys = s;
+    c->vadr = m->sys_vadr[s];
+    c->geom = -1;
+    c->hfield = -1;
+    c->vertex = -1;
+    c->dof = dof;
+    c->row_a = dt * (g[0] * (t[0] - q) + g[1] * t[1]);
+    c->row_b = dt * (g[1] + dt * g[0]);
+    c->row_bound = g[2] > 0 ? g[2] * dt : INFINITY;
+    ss_art_dof_jacobian(m, d, s, dof, d->jac + c->jadr, d->jac + c->jadr + 3 * nv, c->G);
+  }
+  for (int b = 0; b < m->nbody; b++) {
+    int s = m->body_sys[b];
+    if (!m->body_jntlimited[b] || m->body_ndof[b] != 1 || !d->sys_active[s]) continue;
+    if (m->sys_type[s] != SS_SYS_ARTICULATED) continue;
+    double q = d->qpos[m->body_qadr[b]], u = d->qvel[m->body_dofadr[b]];
+    const double *r = m->body_jntrange + 2 * b;
+    for (int side = 0; side < 2; side++) {
+      /* gap to the limit, positive inside the range */
+      double gap = side == 0 ? q - r[0] : r[1] - q;
+      double vin = side == 0 ? u : -u;
+      if (gap + dt * vin > 0 && gap > 0) continue;
+      int nv = m->sys_nv[s];
+      ssContact *c = ss_contact_new(d, nv);
+      if (!c) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
+      c->type = SS_CONTACT_LIMIT;
+      c->sys = s;
+      c->vadr = m->sys_vadr[s];
+      c->geom = -1;
+      c->hfield = -1;
+      c->vertex = -1;
+      c->dof = m->body_dofadr[b];
+      c->g0 = gap;
+      c->vn_target = gap >= 0 ? -gap / dt : -m->opt.rigid_erp * gap / dt;
+      double *J = d->jac + c->jadr, *W = J + 3 * nv;
+      ss_art_dof_jacobian(m, d, s, c->dof, J, W, c->G);
+      if (side == 1) {
+        for (int i = 0; i < nv; i++) {
+          J[i] = -J[i];
+          W[3 * i] = -W[3 * i];
+        }
+      }
+    }
+  }
+  return SS_OK;
+}

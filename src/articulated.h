@@ -1,0 +1,86 @@
+/* articulated.h -- articulated systems in reduced coordinates: a floating or
+ * fixed base and a tree of revolute, prismatic, spherical and fixed joints,
+ * with loop closures, joint springs and dampers, point-to-point
+ * spring-dampers and PD controllers (DESIGN 3).
+ *
+ * Spatial vectors are 6-vectors in world coordinates about the world
+ * origin: motion (omega; v_O), force (torque about O; force).  A body's
+ * spatial Jacobian J_b (6 x nv) has the world motion-subspace column of
+ * every degree of freedom on its path to the root.  The step solves
+ *   M' (u_new - u) = dt (tau - c) + J^T lambda + K^T mu,   K u_new = 0
+ * where M' is the CRBA mass matrix plus the implicit terms of joint
+ * dampers/springs and coil-overs, factored with Featherstone's LTDL (which
+ * keeps the tree's sparsity), and the loop closures K are eliminated by
+ * projection in the M' metric.  Contacts see the projected response
+ * W = P M'^-1 J^T through a per-body six-component reduction
+ * Y_b = P M'^-1 J_b^T, so a contact costs O(nv) however many share a link. */
+#ifndef SS_ARTICULATED_H
+#define SS_ARTICULATED_H
+
+#include "soilsim.h"
+#include "urdf.h"
+
+typedef struct ssArtWork ssArtWork;
+
+/* How a scene instantiates a URDF. */
+typedef struct ssArtDef {
+  const char *name;
+  int fixed_base;        /* 1: the root is welded to the world at pos/quat;
+                            0: floating; -1 (default): as the URDF's "world"
+                            link says, else floating */
+  double pos[3];         /* root pose (floating: initial; fixed: weld) */
+  double quat[4];
+  const double *qpos;    /* optional full initial qpos (nq), NULL = URDF zero
+                            pose placed at pos/quat */
+  int nqpos;
+  const double *qvel;    /* optional (nv) */
+  int nqvel;
+  const char *material;  /* rigid material of all colliders */
+  const char *urdf_path; /* recorded for export */
+  const char *res_dir;
+  int line;
+} ssArtDef;
+
+ssArtDef ss_art_def_default(void);
+
+/* Add an articulated system built from a parsed URDF.  Loads meshes,
+ * resolves closures at the initial configuration and checks that they are
+ * independent.  Returns the system index or -1 with err set. */
+int ss_model_add_articulated(ssModel *m, const ssUrdf *u, const ssArtDef *def,
+                             ssError *err);
+/* A joint PD controller on the joint named joint of system sys. */
+int ss_model_add_pd(ssModel *m, int sys, const char *joint, double p_gain,
+                    double d_gain, double position_target,
+                    double velocity_target, double effort_limit, int line,
+                    ssError *err);
+/* Body index of a link of system sys by name, or -1. */
+int ss_model_find_body(const ssModel *m, int sys, const char *name);
+
+ssArtWork *ss_art_work_new(const ssModel *m, int sys);
+void ss_art_work_free(ssArtWork *w);
+
+/* Body poses, centres of mass and motion subspaces from qpos. */
+void ss_art_forward(const ssModel *m, ssData *d, int sys);
+/* qvel <- constrained free velocity; prepares the responses for contacts.
+ * Returns SS_ERR_NUMERIC when the mass matrix is not positive definite. */
+ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int sys,
+                              ssError *err);
+/* Contact rows of a world point on body b: J (3 x nv), W (nv x 3), G. */
+void ss_art_contact_jacobian(const ssModel *m, ssData *d, int b,
+                             const double p[3], const double frame[9],
+                             double *J, double *W, double G[9]);
+/* Row of one degree of freedom (PD, limits): J = e_k, W = P M'^-1 e_k. */
+void ss_art_dof_jacobian(const ssModel *m, ssData *d, int sys, int dof,
+                         double *J, double *W, double G[9]);
+/* Velocity of a world point on body b. */
+void ss_art_point_velocity(const ssModel *m, const ssData *d, int b,
+                           const double p[3], double v[3]);
+/* Positions from velocities, then loop-closure drift removed by projection
+ * (Newton in the M' metric); sets d->closure_error. */
+void ss_art_integrate(const ssModel *m, ssData *d, int sys);
+/* Append the solver rows of PD controllers and active joint limits. */
+ssStatus ss_art_rows(const ssModel *m, ssData *d, ssError *err);
+/* Largest closure violation of a system at the current qpos. */
+double ss_art_closure_error(const ssModel *m, ssData *d, int sys);
+
+#endif /* SS_ARTICULATED_H */

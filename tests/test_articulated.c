@@ -1,0 +1,594 @@
+/* test_articulated.c -- reduced-coordinate dynamics, loop closures, force
+ * elements and PD control against closed forms. */
+#include "articulated.h"
+#include "soilsim.h"
+#include "solver.h"
+#include "ss_math.h"
+#include "tap.h"
+#include "urdf.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static const double G = 9.81;
+
+/* ---------------------------------------------------------------------- */
+/* a tiny in-memory URDF builder                                           */
+
+static ssUrdf *urdf_new(void)
+{
+  ssUrdf *u = calloc(1, sizeof *u);
+  u->link = calloc(64, sizeof *u->link);
+  u->joint = calloc(64, sizeof *u->joint);
+  u->closure = calloc(16, sizeof *u->closure);
+  u->spring = calloc(16, sizeof *u->spring);
+  snprintf(u->path, sizeof u->path, "in-memory.urdf");
+  return u;
+}
+
+static void urdf_free(ssUrdf *u)
+{
+  for (int i = 0; i < u->nlink; i++) free(u->link[i].geom);
+  free(u->link);
+  free(u->joint);
+  free(u->closure);
+  free(u->spring);
+  free(u);
+}
+
+/* a link of mass m with its COM at com and principal inertia (ix, iy, iz) */
+static int add_link(ssUrdf *u, const char *name, double m, const double com[3],
+                    double ix, double iy, double iz)
+{
+  ssUrdfLink *l = &u->link[u->nlink];
+  snprintf(l->name, sizeof l->name, "%s", name);
+  l->mass = m;
+  if (com) memcpy(l->com, com, sizeof l->com);
+  l->com_quat[0] = 1;
+  l->inertia[0] = ix;
+  l->inertia[3] = iy;
+  l->inertia[5] = iz;
+  return u->nlink++;
+}
+
+static void add_box(ssUrdf *u, int link, double x, double y, double z,
+                    const double pos[3])
+{
+  ssUrdfLink *l = &u->link[link];
+  l->geom = realloc(l->geom, (size_t)(l->ngeom + 1) * sizeof *l->geom);
+  ssUrdfGeom *g = &l->geom[l->ngeom++];
+  memset(g, 0, sizeof *g);
+  g->type = SS_GEOM_BOX;
+  g->size[0] = x;
+  g->size[1] = y;
+  g->size[2] = z;
+  if (pos) memcpy(g->pos, pos, sizeof g->pos);
+  g->quat[0] = 1;
+  g->collision = 1;
+}
+
+static int add_joint(ssUrdf *u, const char *name, int type, int parent,
+                     int child, const double pos[3], const double axis[3])
+{
+  ssUrdfJoint *j = &u->joint[u->njoint];
+  snprintf(j->name, sizeof j->name, "%s", name);
+  j->type = type;
+  j->parent = parent;
+  j->child = child;
+  if (pos) memcpy(j->pos, pos, sizeof j->pos);
+  j->quat[0] = 1;
+  if (axis) memcpy(j->axis, axis, sizeof j->axis);
+  else j->axis[0] = 1;
+  return u->njoint++;
+}
+
+typedef struct {
+  ssModel *m;
+  ssData *d;
+  int sys;
+} World;
+
+static World build(const ssUrdf *u, int fixed, const double pos[3])
+{
+  World w;
+  ssError e;
+  w.m = ss_model_new();
+  ssArtDef def = ss_art_def_default();
+  def.name = "robot";
+  def.fixed_base = fixed;
+  if (pos) memcpy(def.pos, pos, 3 * sizeof(double));
+  w.sys = ss_model_add_articulated(w.m, u, &def, &e);
+  if (w.sys < 0) diag("build failed: %s", e.message);
+  w.d = NULL;
+  return w;
+}
+
+static void finish(World *w) { w->d = ss_data_new(w->m); }
+
+static void drop(World *w)
+{
+  ss_data_free(w->d);
+  ss_model_free(w->m);
+}
+
+static int steps(World *w, int n)
+{
+  ssError e;
+  for (int k = 0; k < n; k++)
+    if (ss_step(w->m, w->d, &e) != SS_OK) {
+      diag("step failed: %s", e.message);
+      return 0;
+    }
+  return 1;
+}
+
+static const double Y[3] = {0, 1, 0}, Z[3] = {0, 0, 1}, X[3] = {1, 0, 0};
+
+/* ---------------------------------------------------------------------- */
+
+/* energy of an articulated system from body states */
+static double energy(const World *w)
+{
+  const ssModel *m = w->m;
+  const ssData *d = w->d;
+  double e = 0;
+  for (int b = m->sys_bodyadr[w->sys]; b < m->sys_bodyadr[w->sys] + m->sys_nbody[w->sys]; b++) {
+    double v[3], wv[3], p[3];
+    ss_v3_copy(p, d->body_xipos + 3 * b);
+    ss_art_point_velocity(m, d, b, p, v);
+    /* angular velocity: from two point velocities */
+    double R[9], I[9], Rt[9], T[9], Iw[9];
+    memcpy(R, d->body_xmat + 9 * b, sizeof R);
+    for (int k = 0; k < 3; k++) {
+      double q[3] = {p[0], p[1], p[2]}, vq[3], dv[3];
+      q[(k + 1) % 3] += 1;
+      ss_art_point_velocity(m, d, b, q, vq);
+      ss_v3_sub(dv, vq, v);
+      (void)dv;
+    }
+    /* w from v(p + e_x) - v(p) = w x e_x etc. */
+    double a[3], bq[3], c[3], ex[3] = {p[0] + 1, p[1], p[2]}, ey[3] = {p[0], p[1] + 1, p[2]};
+    ss_art_point_velocity(m, d, b, ex, a);
+    ss_art_point_velocity(m, d, b, ey, bq);
+    ss_v3_sub(a, a, v);   /* w x ex = (0, wz, -wy) */
+    ss_v3_sub(bq, bq, v); /* w x ey = (-wz, 0, wx) */
+    wv[0] = bq[2];
+    wv[1] = -a[2];
+    wv[2] = a[1];
+    (void)c;
+    memcpy(I, m->body_inertia + 9 * b, sizeof I);
+    ss_m3_transpose(Rt, R);
+    ss_m3_mul(T, R, I);
+    ss_m3_mul(Iw, T, Rt);
+    double Iwv[3];
+    ss_m3_mulv(Iwv, Iw, wv);
+    e += 0.5 * m->body_mass[b] * ss_v3_dot(v, v) + 0.5 * ss_v3_dot(wv, Iwv) +
+         m->body_mass[b] * G * p[2];
+  }
+  return e;
+}
+
+static void test_pendulum(void)
+{
+  /* a 2 kg bob 0.5 m below a revolute joint about y */
+  ssUrdf *u = urdf_new();
+  int base = add_link(u, "base", 1, NULL, 0.01, 0.01, 0.01);
+  double com[3] = {0, 0, -0.5};
+  int bob = add_link(u, "bob", 2, com, 0.001, 0.001, 0.001);
+  add_joint(u, "hinge", SS_JOINT_REVOLUTE, base, bob, NULL, Y);
+  World w = build(u, 1, NULL);
+  finish(&w);
+  double q0 = 0.05;
+  w.d->qpos[0] = q0;
+  ss_forward(w.m, w.d);
+  double e0 = energy(&w), emax = 0;
+  /* period from successive upward zero crossings of the angle */
+  double tprev = -1, period = 0, qlast = w.d->qpos[0];
+  int crossings = 0;
+  for (int k = 0; k < 10000; k++) {
+    steps(&w, 1);
+    double q = w.d->qpos[0];
+    if (qlast < 0 && q >= 0) {
+      double t = w.d->time - 1e-3 * q / (q - qlast);
+      if (tprev >= 0) {
+        period += t - tprev;
+        crossings++;
+      }
+      tprev = t;
+    }
+    qlast = q;
+    emax = fmax(emax, fabs(energy(&w) - e0));
+  }
+  period /= crossings;
+  double Ip = 0.001 + 2 * 0.25, want = 2 * M_PI * sqrt(Ip / (2 * G * 0.5));
+  /* finite amplitude lengthens the period by (1 + q0^2/16) */
+  want *= 1 + q0 * q0 / 16;
+  close_enough(period, want, 0.002 * want, "pendulum small-oscillation period");
+  double scale = 2 * G * 0.5 * (1 - cos(q0));
+  ok(emax < 0.02 * scale, "pendulum energy bounded (max drift %.3g of %.3g J)", emax, scale);
+  drop(&w);
+  urdf_free(u);
+
+  /* double pendulum */
+  u = urdf_new();
+  base = add_link(u, "base", 1, NULL, 0.01, 0.01, 0.01);
+  double c1[3] = {0, 0, -0.25};
+  int l1 = add_link(u, "l1", 1, c1, 0.0053, 0.0053, 0.0005);
+  int l2 = add_link(u, "l2", 1, c1, 0.0053, 0.0053, 0.0005);
+  add_joint(u, "j1", SS_JOINT_REVOLUTE, base, l1, NULL, Y);
+  double p2[3] = {0, 0, -0.5};
+  add_joint(u, "j2", SS_JOINT_REVOLUTE, l1, l2, p2, Y);
+
+  /* exact dynamics: at a moving state the energy rate of one step goes to
+   * zero with the step (first order), i.e. M, c and gravity are right */
+  double rate[2];
+  for (int k = 0; k < 2; k++) {
+    w = build(u, 1, NULL);
+    w.m->opt.timestep = k ? 1e-7 : 1e-6;
+    finish(&w);
+    double q[2] = {0.7, -0.4}, v[2] = {3, -5};
+    memcpy(w.d->qpos, q, sizeof q);
+    memcpy(w.d->qvel, v, sizeof v);
+    ss_forward(w.m, w.d);
+    double ea = energy(&w);
+    steps(&w, 1);
+    rate[k] = (energy(&w) - ea) / w.m->opt.timestep;
+    drop(&w);
+  }
+  ok(fabs(rate[1]) < 1e-4 && fabs(rate[0] / rate[1] - 10) < 0.1,
+     "double pendulum: energy rate vanishes linearly with the step (%.3g, %.3g W)",
+     rate[0], rate[1]);
+
+  /* moderate swing: energy bounded over 10 s */
+  w = build(u, 1, NULL);
+  finish(&w);
+  w.d->qpos[0] = 0.5;
+  w.d->qpos[1] = -0.3;
+  ss_forward(w.m, w.d);
+  e0 = energy(&w);
+  emax = 0;
+  double swing = -e0;
+  for (int k = 0; k < 10000; k++) {
+    steps(&w, 1);
+    emax = fmax(emax, fabs(energy(&w) - e0));
+  }
+  ok(emax < 0.01 * swing, "double pendulum energy bounded over 10 s (max drift %.3g of %.3g J)",
+     emax, swing);
+  drop(&w);
+
+  /* chaotic release from 90 degrees: semi-implicit Euler's error is first
+   * order, so ten times smaller steps give several times less drift */
+  double drift[2];
+  for (int k = 0; k < 2; k++) {
+    w = build(u, 1, NULL);
+    w.m->opt.timestep = k ? 1e-4 : 1e-3;
+    finish(&w);
+    w.d->qpos[0] = M_PI / 2;
+    ss_forward(w.m, w.d);
+    e0 = energy(&w);
+    drift[k] = 0;
+    int n = (int)lround(2.0 / w.m->opt.timestep);
+    for (int i = 0; i < n; i++) {
+      steps(&w, 1);
+      drift[k] = fmax(drift[k], fabs(energy(&w) - e0));
+    }
+    drop(&w);
+  }
+  ok(drift[1] < 0.2 * drift[0], "chaotic double pendulum: drift falls with the step (%.3g J -> %.3g J)",
+     drift[0], drift[1]);
+  urdf_free(u);
+}
+
+/* four-bar: ground a = 0.4 (A at origin, D at x = 0.4), crank b = 0.1,
+ * coupler c = 0.35, rocker d = 0.3, all in the x-z plane, joints about y.
+ * Closed by a pin between the coupler end and the rocker end. */
+static double fourbar_output(double th2)
+{
+  /* Freudenstein: rocker angle th4 from crank angle th2 (angles from +x,
+   * counter-clockwise seen from -y, i.e. in the x-z plane) */
+  double a = 0.4, b = 0.1, c = 0.35, dd = 0.3;
+  double Bx = b * cos(th2), Bz = b * sin(th2);
+  /* C lies at distance c from B and dd from D = (a, 0): upper branch */
+  double ex = a - Bx, ez = -Bz, L = hypot(ex, ez);
+  double cosg = (dd * dd + L * L - c * c) / (2 * dd * L);
+  double base_ang = atan2(-ez, -ex); /* direction from D to B */
+  return base_ang - acos(cosg);
+}
+
+static void test_fourbar(void)
+{
+  ssUrdf *u = urdf_new();
+  int ground = add_link(u, "ground", 1, NULL, 0.01, 0.01, 0.01);
+  double cc[3] = {0.05, 0, 0}, cu[3] = {0.175, 0, 0}, cr[3] = {0.15, 0, 0};
+  int crank = add_link(u, "crank", 0.5, cc, 1e-4, 1e-3, 1e-3);
+  int coupler = add_link(u, "coupler", 0.8, cu, 1e-4, 8e-3, 8e-3);
+  int rocker = add_link(u, "rocker", 0.6, cr, 1e-4, 4e-3, 4e-3);
+  double th2 = M_PI / 3, th4 = fourbar_output(th2);
+  double Bx = 0.1 * cos(th2), Bz = 0.1 * sin(th2);
+  double Cx = 0.4 + 0.3 * cos(th4), Cz = 0.3 * sin(th4);
+  double th3 = atan2(Cz - Bz, Cx - Bx);
+  /* joints about -y so that positive angles turn x towards z */
+  double ny[3] = {0, -1, 0}, pB[3] = {0.1, 0, 0}, pD[3] = {0.4, 0, 0};
+  add_joint(u, "crank_joint", SS_JOINT_REVOLUTE, ground, crank, NULL, ny);
+  add_joint(u, "coupler_joint", SS_JOINT_REVOLUTE, crank, coupler, pB, ny);
+  add_joint(u, "rocker_joint", SS_JOINT_REVOLUTE, ground, rocker, pD, ny);
+  ssUrdfClosure *c = &u->closure[u->nclosure++];
+  c->type = SS_CLOSURE_PIN;
+  c->body1 = coupler;
+  c->body2 = rocker;
+  c->anchor1[0] = 0.35;
+  c->anchor2[0] = 0.3;
+  c->has_anchor2 = 1;
+  World w = build(u, 1, NULL);
+  double q[3] = {th2, th3 - th2, th4};
+  memcpy(w.m->qpos0, q, sizeof q);
+  w.m->opt.gravity[2] = 0;
+  ssError e;
+  /* drive the crank at 2 rad/s with a stiff velocity PD */
+  ss_model_add_pd(w.m, 0, "crank_joint", 0, 200, 0, 2.0, 0, 0, &e);
+  finish(&w);
+  close_enough(ss_art_closure_error(w.m, w.d, 0), 0, 1e-12, "four-bar closed at the start");
+  double worst = 0, werr = 0;
+  for (int k = 0; k < 3000; k++) {
+    steps(&w, 1);
+    worst = fmax(worst, w.d->closure_error);
+    double out = fourbar_output(w.d->qpos[0]);
+    double diff = remainder(w.d->qpos[2] - out, 2 * M_PI);
+    werr = fmax(werr, fabs(diff));
+  }
+  ok(w.d->qpos[0] > th2 + 5, "the crank turned (%.2f rad)", w.d->qpos[0] - th2);
+  ok(worst < 1e-6, "four-bar closure error < 1e-6 m (max %.3g)", worst);
+  ok(werr < 1e-6, "rocker follows the analytic output angle (max error %.3g rad)", werr);
+  drop(&w);
+  urdf_free(u);
+}
+
+static void test_pd_and_springs(void)
+{
+  /* a horizontal wheel (inertia 0.5 about z) on a revolute joint */
+  ssUrdf *u = urdf_new();
+  int base = add_link(u, "base", 1, NULL, 0.01, 0.01, 0.01);
+  int wheel = add_link(u, "wheel", 3, NULL, 0.3, 0.3, 0.5);
+  add_joint(u, "axle", SS_JOINT_REVOLUTE, base, wheel, NULL, Z);
+  ssError e;
+
+  World w = build(u, 1, NULL);
+  ss_model_add_pd(w.m, 0, "axle", 400, 40, 1.0, 0, 0, 0, &e);
+  finish(&w);
+  steps(&w, 3000);
+  close_enough(w.d->qpos[0], 1.0, 1e-6, "position PD holds its target");
+  drop(&w);
+
+  w = build(u, 1, NULL);
+  ss_model_add_pd(w.m, 0, "axle", 0, 50, 0, 3.0, 0, 0, &e);
+  finish(&w);
+  steps(&w, 2000);
+  close_enough(w.d->qvel[0], 3.0, 1e-6, "velocity PD reaches its target speed");
+  drop(&w);
+
+  /* effort limit 2 N m: the wheel accelerates at exactly 2 / 0.5 */
+  w = build(u, 1, NULL);
+  ss_model_add_pd(w.m, 0, "axle", 0, 1e4, 0, 100.0, 2.0, 0, &e);
+  finish(&w);
+  steps(&w, 500);
+  close_enough(w.d->qvel[0], 4.0 * 0.5, 1e-9, "effort limit respected: omega = (effort / I) t");
+  drop(&w);
+  urdf_free(u);
+
+  /* a 5 kg slider on a vertical prismatic joint hanging from a coil-over
+   * of 2000 N/m: static deflection m g / k */
+  u = urdf_new();
+  base = add_link(u, "base", 1, NULL, 0.01, 0.01, 0.01);
+  int slider = add_link(u, "slider", 5, NULL, 0.01, 0.01, 0.01);
+  add_joint(u, "slide", SS_JOINT_PRISMATIC, base, slider, NULL, Z);
+  ssUrdfSpring *s = &u->spring[u->nspring++];
+  snprintf(s->name, sizeof s->name, "coil");
+  s->body1 = base;
+  s->body2 = slider;
+  s->anchor1[2] = 0.5;
+  s->stiffness = 2000;
+  s->damping = 150;
+  s->rest_length = 0.5;
+  w = build(u, 1, NULL);
+  finish(&w);
+  steps(&w, 4000);
+  close_enough(-w.d->qpos[0], 5 * G / 2000, 1e-6, "coil-over static deflection = load / stiffness");
+  drop(&w);
+  /* the same with a joint spring (<dynamics stiffness spring_mount>) */
+  u->nspring = 0;
+  u->joint[0].stiffness = 1000;
+  u->joint[0].damping = 100;
+  u->joint[0].spring_mount = 0.1;
+  w = build(u, 1, NULL);
+  finish(&w);
+  steps(&w, 4000);
+  close_enough(w.d->qpos[0], 0.1 - 5 * G / 1000, 1e-6, "joint spring deflection = load / stiffness");
+  drop(&w);
+  urdf_free(u);
+}
+
+/* a free box as a single body and as a one-link floating articulated
+ * system: same trajectory (spin about a non-principal axis + gravity) */
+static void test_free_both_ways(void)
+{
+  ssError e;
+  ssModel *m = ss_model_new();
+  ssBodyDef bd = ss_body_def_default();
+  bd.name = "box";
+  bd.size[0] = 0.3;
+  bd.size[1] = 0.2;
+  bd.size[2] = 0.1;
+  bd.mass = 4;
+  ss_v3_set(bd.pos, 0, 0, 10);
+  ss_v3_set(bd.lin_vel, 1, 0.5, 2);
+  ss_v3_set(bd.ang_vel, 3, -2, 5);
+  ss_model_add_body(m, &bd, &e);
+  ssData *d = ss_data_new(m);
+
+  ssUrdf *u = urdf_new();
+  double ix = 4 * (0.04 + 0.01) / 12, iy = 4 * (0.09 + 0.01) / 12, iz = 4 * (0.09 + 0.04) / 12;
+  int l = add_link(u, "box", 4, NULL, ix, iy, iz);
+  add_box(u, l, 0.3, 0.2, 0.1, NULL);
+  World w = build(u, 0, NULL);
+  double q[7] = {0, 0, 10, 1, 0, 0, 0}, v[6] = {1, 0.5, 2, 3, -2, 5};
+  memcpy(w.m->qpos0, q, sizeof q);
+  memcpy(w.m->qvel0, v, sizeof v);
+  finish(&w);
+  double worst = 0;
+  for (int k = 0; k < 1000; k++) {
+    ss_step(m, d, &e);
+    steps(&w, 1);
+    for (int i = 0; i < 7; i++) worst = fmax(worst, fabs(d->qpos[i] - w.d->qpos[i]));
+  }
+  ok(worst < 1e-9, "free body and one-link articulated system move identically (max diff %.3g)", worst);
+  ss_data_free(d);
+  ss_model_free(m);
+  drop(&w);
+  urdf_free(u);
+}
+
+/* ---------------------------------------------------------------------- */
+/* articulated bodies on soil (DESIGN 8's benchmark bodies)                */
+
+static int add_soil_bed(ssModel *m, double size, double h)
+{
+  ssError e;
+  int n = (int)lround(size / h) + 1;
+  double *z = calloc((size_t)n * n, sizeof(double));
+  ssHfieldDef hd = ss_hfield_def_default();
+  hd.name = "bed";
+  hd.nx = hd.ny = n;
+  hd.x_size = hd.y_size = size;
+  hd.height = z;
+  hd.soil = 1;
+  hd.soilmat.bekker_kc = 0;
+  hd.soilmat.bekker_kphi = 1e5;
+  hd.soilmat.sinkage_exponent = 1;
+  hd.soilmat.elastic_stiffness = 2e6;
+  hd.soilmat.damping = 1e4;
+  int k = ss_model_add_hfield(m, &hd, &e);
+  free(z);
+  return k;
+}
+
+/* mean sinkage over bed vertices inside [x0,x1] x [y0,y1] */
+static double mean_sinkage(const ssModel *m, const ssData *d, double x0,
+                           double x1, double y0, double y1)
+{
+  int n = m->hfield_nx[0];
+  double size = m->hfield_size[0], h = size / (n - 1), sum = 0;
+  int cnt = 0;
+  for (int j = 0; j < n; j++)
+    for (int i = 0; i < n; i++) {
+      double x = -0.5 * size + i * h, y = -0.5 * size + j * h;
+      if (x > x0 && x < x1 && y > y0 && y < y1) {
+        sum += d->soil_sinkage[j * n + i];
+        cnt++;
+      }
+    }
+  return cnt ? sum / cnt : NAN;
+}
+
+/* a chain of revolute links with joint springs, standing on link `on` */
+static int add_mast(ssUrdf *u, int on, int nlinks, double mass, const double at[3])
+{
+  int prev = on;
+  const double *axes[3] = {X, Y, Z};
+  for (int k = 0; k < nlinks; k++) {
+    char name[32];
+    snprintf(name, sizeof name, "mast%d_%d", on, k);
+    double com[3] = {0, 0, 0.01};
+    int l = add_link(u, name, mass, com, 1e-5, 1e-5, 1e-5);
+    double pos[3] = {0, 0, 0.02};
+    if (k == 0) memcpy(pos, at, sizeof pos);
+    int j = add_joint(u, name, SS_JOINT_REVOLUTE, prev, l, pos, axes[k % 3]);
+    u->joint[j].stiffness = 60;
+    u->joint[j].damping = 0.5;
+    prev = l;
+  }
+  return prev;
+}
+
+static void test_on_soil(void)
+{
+  const double s_ref = 8.175e-3;
+  /* 60 DOF: the 0.4 x 0.6 plate as a floating base carrying a 54-joint
+   * sprung mast; 20 kg in all */
+  ssUrdf *u = urdf_new();
+  int plate = add_link(u, "plate", 20 - 54 * 0.02, NULL, 0.6, 0.3, 0.8);
+  add_box(u, plate, 0.4, 0.6, 0.05, NULL);
+  double top[3] = {0, 0, 0.025};
+  add_mast(u, plate, 54, 0.02, top);
+  double pos[3] = {0, 0, 0.025};
+  World w = build(u, 0, pos);
+  add_soil_bed(w.m, 1.2, 0.02);
+  finish(&w);
+  ok(w.m->sys_nv[0] == 60, "plate carrier has 60 DOF");
+  steps(&w, 1500);
+  close_enough(mean_sinkage(w.m, w.d, -0.19, 0.19, -0.29, 0.29), s_ref, 0.01 * s_ref,
+               "60-DOF plate carrier settles at the analytic sinkage");
+  close_enough(-(w.d->qpos[2] - 0.025), s_ref, 0.01 * s_ref, "  its plate sinks 8.175 mm");
+  drop(&w);
+  urdf_free(u);
+
+  /* 64 DOF: a frame on four 0.2 x 0.3 pads, each on x/y/z sliders and a
+   * ball joint, plus a 34-joint mast; 20 kg and 0.24 m^2 in all */
+  u = urdf_new();
+  double pad_mass = 4, slide_mass = 0.05, mast_mass = 0.04;
+  double frame_mass = 20 - 4 * (pad_mass + 3 * slide_mass) - 34 * mast_mass;
+  int frame = add_link(u, "frame", frame_mass, NULL, 0.05, 0.05, 0.08);
+  double cx[4] = {-0.25, 0.25, -0.25, 0.25}, cy[4] = {-0.3, -0.3, 0.3, 0.3};
+  for (int k = 0; k < 4; k++) {
+    char nm[32];
+    int prev = frame;
+    const double *ax[3] = {X, Y, Z};
+    for (int a = 0; a < 3; a++) {
+      snprintf(nm, sizeof nm, "slide%d%c", k, "xyz"[a]);
+      int l = add_link(u, nm, slide_mass, NULL, 1e-4, 1e-4, 1e-4);
+      double p0[3] = {0, 0, 0};
+      if (a == 0) {
+        p0[0] = cx[k];
+        p0[1] = cy[k];
+        p0[2] = -0.1;
+      }
+      int j = add_joint(u, nm, SS_JOINT_PRISMATIC, prev, l, p0, ax[a]);
+      u->joint[j].stiffness = a == 2 ? 2e4 : 5e3;
+      u->joint[j].damping = 200;
+      prev = l;
+    }
+    snprintf(nm, sizeof nm, "pad%d", k);
+    int pad = add_link(u, nm, pad_mass, NULL, 0.03, 0.015, 0.04);
+    add_box(u, pad, 0.2, 0.3, 0.04, NULL);
+    double p0[3] = {0, 0, 0};
+    int j = add_joint(u, nm, SS_JOINT_SPHERICAL, prev, pad, p0, NULL);
+    u->joint[j].damping = 2;
+  }
+  double mtop[3] = {0, 0, 0.02};
+  add_mast(u, frame, 34, mast_mass, mtop);
+  /* pads' bottoms on the surface: frame at 0.1 + 0.02 */
+  double fpos[3] = {0, 0, 0.12};
+  w = build(u, 0, fpos);
+  add_soil_bed(w.m, 1.4, 0.02);
+  finish(&w);
+  ok(w.m->sys_nv[0] == 64, "four-pad body has 64 DOF");
+  steps(&w, 2000);
+  double worst = 0;
+  for (int k = 0; k < 4; k++) {
+    double sk = mean_sinkage(w.m, w.d, cx[k] - 0.09, cx[k] + 0.09, cy[k] - 0.14, cy[k] + 0.14);
+    worst = fmax(worst, fabs(sk - s_ref));
+  }
+  ok(worst < 0.01 * s_ref, "64-DOF four-pad body: every pad at the analytic sinkage (worst error %.3g mm)",
+     worst * 1e3);
+  drop(&w);
+  urdf_free(u);
+}
+
+int main(void)
+{
+  test_pendulum();
+  test_fourbar();
+  test_pd_and_springs();
+  test_free_both_ways();
+  test_on_soil();
+  return done_testing();
+}
