@@ -861,6 +861,61 @@ static int load_mesh(ssModel *m, const ssUrdfGeom *g, ssError *err)
   return k;
 }
 
+/* At the initial configuration, every closure must constrain something
+ * the earlier ones do not: a closure all of whose rows depend on the rows
+ * before it (a duplicate pin, say) is reported.  Rows that are only partly
+ * dependent (the out-of-plane row of a pin in a planar linkage) are fine:
+ * the solver drops them.  Gram-Schmidt on the rows of K. */
+static ssStatus check_closures(ssModel *m, int s, ssError *err)
+{
+  ssData *d = ss_data_new(m);
+  if (!d) return ss_error_set(err, SS_ERR_NOMEM, m->source_path, 0, "out of memory");
+  ssArtWork *w = d->art[s];
+  ssStatus st = SS_OK;
+  if (w->nrow) {
+    ss_forward(m, d);
+    closures(m, d, w);
+    int n = w->nv, r = 0;
+    double *Q = calloc((size_t)w->nrow * (n ? n : 1), sizeof(double));
+    if (!Q) st = ss_error_set(err, SS_ERR_NOMEM, m->source_path, 0, "out of memory");
+    int nq = 0;
+    for (int e = 0; !st && e < w->neq; e++) {
+      int k = w->eq[e], rows = m->eq_type[k] == SS_CLOSURE_PIN ? 3 : 1, added = 0;
+      for (int i = 0; i < rows; i++, r++) {
+        double *v = Q + (size_t)nq * n, norm0 = 0, norm = 0;
+        memcpy(v, w->K + (size_t)r * n, (size_t)n * sizeof(double));
+        for (int j = 0; j < n; j++) norm0 += v[j] * v[j];
+        for (int q = 0; q < nq; q++) {
+          const double *b = Q + (size_t)q * n;
+          double dot = 0;
+          for (int j = 0; j < n; j++) dot += v[j] * b[j];
+          for (int j = 0; j < n; j++) v[j] -= dot * b[j];
+        }
+        for (int j = 0; j < n; j++) norm += v[j] * v[j];
+        if (norm0 > 0 && norm > 1e-16 * norm0) {
+          norm = sqrt(norm);
+          for (int j = 0; j < n; j++) v[j] /= norm;
+          nq++;
+          added++;
+        }
+      }
+      if (!added)
+        st = ss_error_set(err, SS_ERR_VALUE, m->sys_source[s], m->eq_line[k],
+                          "articulated system '%s': loop closure %d (%s between "
+                          "'%s' and '%s', URDF line %d) is redundant: the joints "
+                          "and the closures before it already enforce it",
+                          m->sys_name[s], e,
+                          m->eq_type[k] == SS_CLOSURE_PIN ? "pin" :
+                          m->eq_type[k] == SS_CLOSURE_DISTANCE ? "distance" : "equality",
+                          m->body_name[m->eq_body[2 * k]],
+                          m->body_name[m->eq_body[2 * k + 1]], m->eq_line[k]);
+    }
+    free(Q);
+  }
+  ss_data_free(d);
+  return st;
+}
+
 int ss_model_add_articulated(ssModel *m, const ssUrdf *u, const ssArtDef *def,
                              ssError *err)
 {
@@ -1076,6 +1131,7 @@ int ss_model_add_articulated(ssModel *m, const ssUrdf *u, const ssArtDef *def,
 #undef LOCAL_POINT
   free(xp);
   free(body_of);
+  if (check_closures(m, s, err) != SS_OK) return -1;
   return s;
 fail:
   free(body_of);

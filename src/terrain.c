@@ -16,6 +16,7 @@
 #include "terrain.h"
 #include "collide.h"
 #include "dynamics.h"
+#include "mesh.h"
 #include "solver.h"
 #include "ss_math.h"
 
@@ -43,18 +44,51 @@ static void attach(const ssModel *m, ssData *d, ssContact *c, int sys)
   }
 }
 
-/* the collider of geom g expressed in a frame (R, p) */
+/* the collider of geom g expressed in a frame (R, p); a mesh stands in as
+ * its bounding box for the footprint, the width and the candidates (DESIGN
+ * 2.4), its depth comes from ray casts (mesh_depth) */
 static void shape_in_frame(const ssModel *m, const ssData *d, int g,
                            const double R[9], const double p[3], ssShape *s)
 {
-  double rel[3];
+  double rel[3], c[3] = {0, 0, 0};
   s->type = m->geom_type[g];
   memcpy(s->size, m->geom_size + 3 * g, 3 * sizeof(double));
-  ss_v3_sub(rel, d->geom_xpos + 3 * g, p);
+  if (s->type == SS_GEOM_MESH) {
+    const ssMesh *me = m->mesh[m->geom_mesh[g]];
+    s->type = SS_GEOM_BOX;
+    for (int k = 0; k < 3; k++) {
+      s->size[k] = me->hi[k] - me->lo[k];
+      c[k] = 0.5 * (me->hi[k] + me->lo[k]);
+    }
+  }
+  double cw[3];
+  ss_m3_mulv(cw, d->geom_xmat + 9 * g, c);
+  ss_v3_add(cw, cw, d->geom_xpos + 3 * g);
+  ss_v3_sub(rel, cw, p);
   ss_m3_mulvT(s->pos, R, rel);
   double Rt[9];
   ss_m3_transpose(Rt, R);
   ss_m3_mul(s->R, Rt, d->geom_xmat + 9 * g);
+}
+
+/* lowest point of a mesh geom on the bed-frame vertical line through
+ * (x, y): a ray cast upwards in the mesh frame through the BVH */
+static int mesh_depth(const ssModel *m, const ssData *d, int g,
+                      const double R[9], const double p[3], double x,
+                      double y, double lo_z, double *z)
+{
+  const ssMesh *me = m->mesh[m->geom_mesh[g]];
+  const double *Rg = d->geom_xmat + 9 * g, *pg = d->geom_xpos + 3 * g;
+  double ol[3] = {x, y, lo_z - 1}, ow[3], up[3] = {R[2], R[5], R[8]};
+  ss_m3_mulv(ow, R, ol);
+  ss_v3_add(ow, ow, p);
+  double rel[3], o[3], dir[3], t;
+  ss_v3_sub(rel, ow, pg);
+  ss_m3_mulvT(o, Rg, rel);
+  ss_m3_mulvT(dir, Rg, up);
+  if (!ss_mesh_raycast(me, o, dir, &t)) return 0;
+  *z = lo_z - 1 + t;
+  return 1;
 }
 
 static double geom_radius(const ssModel *m, int g)
@@ -65,6 +99,16 @@ static double geom_radius(const ssModel *m, int g)
   case SS_GEOM_SPHERE: return s[0];
   case SS_GEOM_CYLINDER: return sqrt(s[0] * s[0] + 0.25 * s[1] * s[1]);
   case SS_GEOM_CAPSULE: return s[0] + 0.5 * s[1];
+  case SS_GEOM_MESH: {
+    /* farthest bounding-box corner from the geom's origin */
+    const ssMesh *me = m->mesh[m->geom_mesh[g]];
+    double r2 = 0;
+    for (int k = 0; k < 3; k++) {
+      double a = fmax(fabs(me->lo[k]), fabs(me->hi[k]));
+      r2 += a * a;
+    }
+    return sqrt(r2);
+  }
   default: return s[0];
   }
 }
@@ -157,7 +201,11 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
         qy = y;
       }
       double zl;
-      if (!ss_shape_lowest_z(&s, qx, qy, &zl)) continue;
+      if (m->geom_type[g] == SS_GEOM_MESH) {
+        if (!mesh_depth(m, d, g, R, p, qx, qy, lo[2], &zl)) continue;
+      } else if (!ss_shape_lowest_z(&s, qx, qy, &zl)) {
+        continue;
+      }
       int k = j * nx + i;
       double floor_z = z0[k] - sp[k];
       double g0 = zl - floor_z;
