@@ -902,8 +902,9 @@ static ssStatus check_closures(ssModel *m, int s, ssError *err)
       if (!added)
         st = ss_error_set(err, SS_ERR_VALUE, m->sys_source[s], m->eq_line[k],
                           "articulated system '%s': loop closure %d (%s between "
-                          "'%s' and '%s', URDF line %d) is redundant: the joints "
-                          "and the closures before it already enforce it",
+                          "'%s' and '%s', URDF line %d) is redundant or singular "
+                          "at the initial configuration: the joints and the "
+                          "closures before it already fix what it constrains",
                           m->sys_name[s], e,
                           m->eq_type[k] == SS_CLOSURE_PIN ? "pin" :
                           m->eq_type[k] == SS_CLOSURE_DISTANCE ? "distance" : "equality",

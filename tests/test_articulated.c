@@ -90,7 +90,9 @@ typedef struct {
   int sys;
 } World;
 
-static World build(const ssUrdf *u, int fixed, const double pos[3])
+/* build with an initial configuration (closures are checked there) */
+static World build_q(const ssUrdf *u, int fixed, const double pos[3],
+                     const double *qpos, int nq)
 {
   World w;
   ssError e;
@@ -98,11 +100,18 @@ static World build(const ssUrdf *u, int fixed, const double pos[3])
   ssArtDef def = ss_art_def_default();
   def.name = "robot";
   def.fixed_base = fixed;
+  def.qpos = qpos;
+  def.nqpos = nq;
   if (pos) memcpy(def.pos, pos, 3 * sizeof(double));
   w.sys = ss_model_add_articulated(w.m, u, &def, &e);
   if (w.sys < 0) diag("build failed: %s", e.message);
   w.d = NULL;
   return w;
+}
+
+static World build(const ssUrdf *u, int fixed, const double pos[3])
+{
+  return build_q(u, fixed, pos, NULL, 0);
 }
 
 static void finish(World *w) { w->d = ss_data_new(w->m); }
@@ -125,6 +134,9 @@ static int steps(World *w, int n)
 }
 
 static const double Y[3] = {0, 1, 0}, Z[3] = {0, 0, 1}, X[3] = {1, 0, 0};
+static const double NY[3] = {0, -1, 0};
+/* about -y: a positive angle turns +x towards +z */
+static const double *ny_axis(void) { return NY; }
 
 /* ---------------------------------------------------------------------- */
 
@@ -321,9 +333,8 @@ static void test_fourbar(void)
   c->anchor1[0] = 0.35;
   c->anchor2[0] = 0.3;
   c->has_anchor2 = 1;
-  World w = build(u, 1, NULL);
   double q[3] = {th2, th3 - th2, th4};
-  memcpy(w.m->qpos0, q, sizeof q);
+  World w = build_q(u, 1, NULL, q, 3);
   w.m->opt.gravity[2] = 0;
   ssError e;
   /* drive the crank at 2 rad/s with a stiff velocity PD */
@@ -350,6 +361,8 @@ static void test_fourbar(void)
   ssArtDef def = ss_art_def_default();
   def.name = "twice";
   def.fixed_base = 1;
+  def.qpos = q;
+  def.nqpos = 3;
   int s2 = ss_model_add_articulated(m2, u, &def, &e);
   ok(s2 < 0 && e.line == 42 && strstr(e.message, "redundant"),
      "a duplicate pin is reported as redundant (%s)", e.message);
@@ -597,6 +610,95 @@ static void test_on_soil(void)
   urdf_free(u);
 }
 
+/* the four-bar with its coupler replaced by a distance closure (a massless
+ * link of length c between crank tip and rocker tip): same output angle;
+ * and an equality coupling two wheels, q1 = 2 q2 + 0.1 */
+static void test_distance_equality(void)
+{
+  ssUrdf *u = urdf_new();
+  int ground = add_link(u, "ground", 1, NULL, 0.01, 0.01, 0.01);
+  double cc[3] = {0.05, 0, 0}, cr[3] = {0.15, 0, 0};
+  int crank = add_link(u, "crank", 0.5, cc, 1e-4, 1e-3, 1e-3);
+  int rocker = add_link(u, "rocker", 0.6, cr, 1e-4, 4e-3, 4e-3);
+  double ny[3] = {0, -1, 0}, pD[3] = {0.4, 0, 0};
+  add_joint(u, "crank_joint", SS_JOINT_REVOLUTE, ground, crank, NULL, ny);
+  add_joint(u, "rocker_joint", SS_JOINT_REVOLUTE, ground, rocker, pD, ny);
+  ssUrdfClosure *c = &u->closure[u->nclosure++];
+  c->type = SS_CLOSURE_DISTANCE;
+  c->body1 = crank;
+  c->body2 = rocker;
+  c->anchor1[0] = 0.1;
+  c->anchor2[0] = 0.3;
+  c->has_anchor2 = 1;
+  c->length = 0.35;
+  double th2 = M_PI / 3, q[2] = {th2, fourbar_output(th2)};
+  World w = build_q(u, 1, NULL, q, 2);
+  ok(w.sys == 0, "distance-closed four-bar builds at a regular configuration");
+  w.m->opt.gravity[2] = 0;
+  ssError e;
+  ss_model_add_pd(w.m, 0, "crank_joint", 0, 200, 0, 2.0, 0, 0, &e);
+  finish(&w);
+  double werr = 0, worst = 0;
+  for (int k = 0; k < 5000; k++) {
+    steps(&w, 1);
+    worst = fmax(worst, w.d->closure_error);
+    werr = fmax(werr, fabs(remainder(w.d->qpos[1] - fourbar_output(w.d->qpos[0]), 2 * M_PI)));
+  }
+  ok(worst < 1e-6 && werr < 1e-6,
+     "distance closure as a massless coupler: closure %.3g m, output angle error %.3g rad", worst, werr);
+  drop(&w);
+  urdf_free(u);
+
+  u = urdf_new();
+  int base = add_link(u, "base", 1, NULL, 0.01, 0.01, 0.01);
+  int w1 = add_link(u, "w1", 2, NULL, 0.1, 0.1, 0.2);
+  int w2 = add_link(u, "w2", 1, NULL, 0.05, 0.05, 0.1);
+  add_joint(u, "j1", SS_JOINT_REVOLUTE, base, w1, NULL, Z);
+  double off[3] = {1, 0, 0};
+  add_joint(u, "j2", SS_JOINT_REVOLUTE, base, w2, off, Z);
+  c = &u->closure[u->nclosure++];
+  c->type = SS_CLOSURE_EQUALITY;
+  c->joint1 = 0;
+  c->joint2 = 1;
+  c->ratio = 2;
+  c->offset = 0.1;
+  double qe[2] = {0.1, 0};
+  w = build_q(u, 1, NULL, qe, 2);
+  ss_model_add_pd(w.m, 0, "j2", 0, 20, 0, 1.5, 0, 0, &e);
+  finish(&w);
+  steps(&w, 3000);
+  close_enough(w.d->qpos[0], 2 * w.d->qpos[1] + 0.1, 1e-9, "equality closure q1 = 2 q2 + 0.1 holds");
+  close_enough(w.d->qvel[0], 3.0, 1e-6, "  the coupled wheel turns at twice the driven speed");
+  drop(&w);
+  urdf_free(u);
+}
+
+/* a pendulum released horizontally against a joint limit at -0.5 rad
+ * comes to rest on the limit and never passes it */
+static void test_limit(void)
+{
+  ssUrdf *u = urdf_new();
+  int base = add_link(u, "base", 1, NULL, 0.01, 0.01, 0.01);
+  double com[3] = {0.5, 0, 0};
+  int bob = add_link(u, "bob", 2, com, 0.001, 0.001, 0.001);
+  int j = add_joint(u, "hinge", SS_JOINT_REVOLUTE, base, bob, NULL, ny_axis());
+  u->joint[j].limited = 1;
+  u->joint[j].lower = -0.5;
+  u->joint[j].upper = 0.5;
+  u->joint[j].damping = 0.5;
+  World w = build(u, 1, NULL);
+  finish(&w);
+  double qmin = 0;
+  for (int k = 0; k < 3000; k++) {
+    steps(&w, 1);
+    qmin = fmin(qmin, w.d->qpos[0]);
+  }
+  ok(qmin > -0.5 - 1e-3, "the joint limit holds (lowest angle %.6f rad, limit -0.5)", qmin);
+  close_enough(w.d->qpos[0], -0.5, 1e-4, "  the pendulum rests on its limit");
+  drop(&w);
+  urdf_free(u);
+}
+
 /* a link whose collider is a triangle mesh (a 0.4 x 0.6 x 0.05 box made of
  * 12 triangles): the bounding-box footprint and BVH depths give the same
  * analytic sinkage as the box */
@@ -639,5 +741,7 @@ int main(void)
   test_free_both_ways();
   test_on_soil();
   test_mesh_on_soil();
+  test_distance_equality();
+  test_limit();
   return done_testing();
 }

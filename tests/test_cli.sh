@@ -235,6 +235,15 @@ run "$tmp/a.xml" --steps 0 --export "$tmp/c.xml" --quiet
 check "export, reload with --steps 0, export again: identical files" \
   'rc_is 0 && cmp -s "$tmp/a.xml" "$tmp/c.xml"'
 
+# an articulated system (URDF with a pin closure, a coil-over and a PD) on
+# soil: runs, exports its state, reloads and continues identically
+run "$top_srcdir/scenes/plate_arm.xml" --steps 20 --export "$tmp/arm1.xml" --quiet
+check "articulated scene on soil runs and exports" \
+  'rc_is 0 && grep -q "<articulated_system name=\"carrier\"" "$tmp/arm1.xml" && grep -q "<pd joint=\"arm_a_joint\"" "$tmp/arm1.xml"'
+run "$tmp/arm1.xml" --steps 0 --export "$tmp/arm2.xml" --quiet
+check "articulated export, reload, export again: identical files" \
+  'rc_is 0 && cmp -s "$tmp/arm1.xml" "$tmp/arm2.xml"'
+
 head -n 1 "$tmp/a.csv" >"$tmp/header"
 check "CSV header: the statistics columns, then plate.x,plate.y,plate.z" \
   '[ "$(cat "$tmp/header")" = "step,time,soil_contacts,soil_contact_area,soil_normal_force,sweeps,plate.x,plate.y,plate.z" ]'
