@@ -182,6 +182,9 @@ typedef struct readCtx {
   ssError e;
   int npend, cappend;
   pendingSoil *pend;
+  int nqpend;
+  int qpend_sys[64];
+  double *qpend[64];   /* state qpos applied after the data exists */
   int clock_given;
   double clock_time;
   long clock_step;
@@ -1243,6 +1246,16 @@ static ssStatus read_heightmap(readCtx *c, xmlNodePtr n)
   return st;
 }
 
+static ssStatus pend_qpos(readCtx *c, int sys, double *q, int line)
+{
+  if (c->nqpend == 64)
+    return fail(c, SS_ERR_VALUE, line, "at most 64 articulated systems with a "
+                "reference_qpos per scene");
+  c->qpend_sys[c->nqpend] = sys;
+  c->qpend[c->nqpend++] = q;
+  return SS_OK;
+}
+
 /* <articulated_system name urdf_path res_dir base material> with optional
  * <state qpos qvel pos quat> and any number of <pd joint p_gain d_gain
  * position_target velocity_target effort_limit> */
@@ -1274,8 +1287,8 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
               "%s: base = '%s' (allowed: floating, fixed)", e.label, base);
   ssArtDef def = ss_art_def_default();
   def.line = e.line;
-  double *qpos = NULL, *qvel = NULL;
-  int nqpos = 0, nqvel = 0, seen_state = 0, npd = 0;
+  double *qpos = NULL, *qvel = NULL, *ref = NULL;
+  int nqpos = 0, nqvel = 0, nref = 0, seen_state = 0, npd = 0;
   pendingPd pd[64];
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
     if (k->type != XML_ELEMENT_NODE) {
@@ -1285,7 +1298,8 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
     char kn[NAME_CAP];
     norm_name((const char *)k->name, kn);
     if (!strcmp(kn, "state")) {
-      static const char *const sa[] = {"qpos", "qvel", "pos", "quat", NULL};
+      static const char *const sa[] = {"qpos", "qvel", "pos", "quat",
+                                       "reference_qpos", NULL};
       xEl se;
       st = open_leaf(c, k, e.label, sa, &se);
       if (!st) st = once(c, &seen_state, &se);
@@ -1297,6 +1311,10 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
       if (!st && (v = el_find(&se, "qvel"))) {
         nqvel = (int)vec_count(v);
         st = get_array(c, &se, "qvel", nqvel, "as many", 0, &qvel);
+      }
+      if (!st && (v = el_find(&se, "reference_qpos"))) {
+        nref = (int)vec_count(v);
+        st = get_array(c, &se, "reference_qpos", nref, "as many", 0, &ref);
       }
       if (!st) st = get_vec(c, &se, "pos", 3, 0, def.pos);
       if (!st) st = get_vec(c, &se, "quat", 4, 0, def.quat);
@@ -1347,8 +1365,11 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
     def.name = name;
     def.fixed_base = base ? !strcmp(base, "fixed") : -1;
     def.material = mat;
-    def.qpos = qpos;
-    def.nqpos = nqpos;
+    /* closures and springs derive their implicit anchors and lengths from
+     * the reference configuration (an export writes the one the original
+     * scene started from), then the state moves to qpos */
+    def.qpos = ref ? ref : qpos;
+    def.nqpos = ref ? nref : nqpos;
     def.qvel = qvel;
     def.nqvel = nqvel;
     def.urdf_path = path;
@@ -1371,9 +1392,19 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
       }
     }
   }
+  if (!st && ref && qpos) {
+    int sys = c->m->nsys - 1;
+    if (nqpos != c->m->sys_nq[sys])
+      st = fail(c, SS_ERR_VALUE, e.line, "%s: qpos has %d values, expected %d",
+                e.label, nqpos, c->m->sys_nq[sys]);
+    else
+      st = pend_qpos(c, sys, qpos, e.line);
+    if (!st) qpos = NULL; /* owned by the pending list */
+  }
   ss_urdf_free(u);
   free(qpos);
   free(qvel);
+  free(ref);
   el_free(&e);
   return st;
 }
@@ -1814,6 +1845,8 @@ static void this_dir(const char *path, char *dir, size_t cap)
 static void ctx_free(readCtx *c)
 {
   for (int i = 0; i < c->npend; i++) pending_free(&c->pend[i]);
+  for (int i = 0; i < c->nqpend; i++) free(c->qpend[i]);
+  c->nqpend = 0;
   free(c->pend);
   c->pend = NULL;
   c->npend = 0;
@@ -1857,6 +1890,12 @@ static ssStatus load(const char *buf, size_t len, const char *path,
                           &e2) != SS_OK)
       st = fail(&c, e2.code, p->line, "heightmap '%s': %s",
                 c.m->hfield_name[p->hfield], e2.message);
+  }
+  for (int i = 0; !st && i < c.nqpend; i++) {
+    int sys = c.qpend_sys[i];
+    memcpy(d->qpos + c.m->sys_qadr[sys], c.qpend[i],
+           (size_t)c.m->sys_nq[sys] * sizeof(double));
+    ss_forward(c.m, d);
   }
   if (!st && c.clock_given) {
     d->time = c.clock_time;

@@ -309,7 +309,12 @@ static void write_articulated(wBuf *w, const ssModel *m, const ssData *d, int s)
     a_vec(w, "pos", m->body_jntpos + 3 * b0, 3);
     a_vec(w, "quat", m->body_jntquat + 4 * b0, 4);
   }
-  if (m->sys_nq[s]) a_vec(w, "qpos", d->qpos + m->sys_qadr[s], m->sys_nq[s]);
+  if (m->sys_nq[s]) {
+    a_vec(w, "qpos", d->qpos + m->sys_qadr[s], m->sys_nq[s]);
+    /* the configuration closures and springs took their implicit anchors
+     * and lengths from, so a reload derives exactly the same ones */
+    a_vec(w, "reference_qpos", m->qpos0 + m->sys_qadr[s], m->sys_nq[s]);
+  }
   if (m->sys_nv[s]) a_vec(w, "qvel", d->qvel + m->sys_vadr[s], m->sys_nv[s]);
   w_s(w, "/>\n");
   for (int k = 0; k < m->npd; k++) {
