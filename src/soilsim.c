@@ -12,6 +12,7 @@
 
 #include <errno.h>
 #include <limits.h>
+#include <math.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -26,6 +27,13 @@ enum { EXIT_RUN_FAILED = 1, EXIT_USAGE = 2 };
 #define DEFAULT_STEPS 1000L
 #define DEFAULT_RENDER_EVERY 20L
 #define MAX_IMAGE_SIDE 16384L
+
+/* One --checkpoint FILE@STEP request. */
+typedef struct CheckpointReq {
+  const char *arg; /* the argument as given, for messages */
+  char *path;      /* output file (owned) */
+  long step;       /* written after this step (and its removals) */
+} CheckpointReq;
 
 /* One --remove NAME@STEP request. */
 typedef struct Removal {
@@ -47,6 +55,13 @@ typedef struct Options {
   int quiet;
   Removal *removal;
   int nremoval;
+  CheckpointReq *ckpt;
+  int nckpt;
+  const char *restore;      /* --restore FILE */
+  /* solver overrides of the scene's <contact_solver>; < 0 / 0: not given */
+  double solver_tolerance;
+  long max_sweeps;
+  int warm_start;           /* -1 not given, 0 off, 1 on */
 } Options;
 
 /* The progress line on stderr (only on a terminal, without --quiet and CI). */
@@ -79,6 +94,11 @@ static void usage(FILE *out)
 "  --render-every K     render every K steps (default %ld; needs --render)\n"
 "  --size WxH           image size for --render and --rut-map (default %dx%d)\n"
 "  --rut-map FILE.png   write a top-down map of the final plastic sinkage\n"
+"  --checkpoint FILE@STEP  write a binary checkpoint after STEP (repeatable)\n"
+"  --restore FILE       start from a checkpoint written for the same scene\n"
+"  --solver-tolerance X  override the scene's solver tolerance, 0 < X < 1\n"
+"  --max-sweeps N       override the scene's Gauss-Seidel sweep cap (1..1000000)\n"
+"  --warm-start on|off  override the scene's terrain_warm_start\n"
 "  -q, --quiet          no progress line and no summary; errors only\n"
 "  -h, --help           show this help and exit\n"
 "  -V, --version        show the version and exit\n"
@@ -156,7 +176,8 @@ static int parse_size(const char *s, int *w, int *h)
 
 enum {
   OPT_STEPS, OPT_EXPORT, OPT_CSV, OPT_REMOVE, OPT_RENDER, OPT_RENDER_EVERY,
-  OPT_SIZE, OPT_RUT_MAP, OPT_QUIET, OPT_HELP, OPT_VERSION
+  OPT_SIZE, OPT_RUT_MAP, OPT_QUIET, OPT_HELP, OPT_VERSION, OPT_CHECKPOINT,
+  OPT_RESTORE, OPT_SOLVER_TOLERANCE, OPT_MAX_SWEEPS, OPT_WARM_START
 };
 
 static const struct OptionSpec {
@@ -175,6 +196,11 @@ static const struct OptionSpec {
   {"quiet", OPT_QUIET, 0},
   {"help", OPT_HELP, 0},
   {"version", OPT_VERSION, 0},
+  {"checkpoint", OPT_CHECKPOINT, 1},
+  {"restore", OPT_RESTORE, 1},
+  {"solver-tolerance", OPT_SOLVER_TOLERANCE, 1},
+  {"max-sweeps", OPT_MAX_SWEEPS, 1},
+  {"warm-start", OPT_WARM_START, 1},
 };
 
 static void options_free(Options *o)
@@ -183,6 +209,56 @@ static void options_free(Options *o)
   free(o->removal);
   o->removal = NULL;
   o->nremoval = 0;
+  for (int i = 0; i < o->nckpt; i++) free(o->ckpt[i].path);
+  free(o->ckpt);
+  o->ckpt = NULL;
+  o->nckpt = 0;
+}
+
+/* A plain decimal number (digits, point, exponent; no hex, NaN or Inf),
+ * finite, strictly between lo and hi. */
+static int parse_fraction(const char *s, double lo, double hi, double *out)
+{
+  if (!s || !*s || strspn(s, "0123456789.eE+-") != strlen(s)) return 0;
+  char *end;
+  errno = 0;
+  double v = strtod(s, &end);
+  if (errno || end == s || *end || !isfinite(v) || !(v > lo && v < hi))
+    return 0;
+  *out = v;
+  return 1;
+}
+
+static int add_checkpoint(Options *o, const char *arg)
+{
+  const char *at = strrchr(arg, '@');
+  long step;
+  if (!at || at == arg || !parse_long(at + 1, 0, LONG_MAX, &step))
+    return usage_error("invalid --checkpoint value '%s': expected FILE@STEP "
+                       "with STEP an integer >= 0", arg);
+  size_t n = (size_t)(at - arg);
+  for (int i = 0; i < o->nckpt; i++)
+    if (strlen(o->ckpt[i].path) == n && !memcmp(o->ckpt[i].path, arg, n))
+      return usage_error("--checkpoint writes '%.*s' twice ('%s' and '%s')",
+                         (int)n, arg, o->ckpt[i].arg, arg);
+  CheckpointReq *c = realloc(o->ckpt, (size_t)(o->nckpt + 1) * sizeof *c);
+  if (!c) {
+    fputs("soilsim: error: out of memory\n", stderr);
+    return EXIT_RUN_FAILED;
+  }
+  o->ckpt = c;
+  char *path = malloc(n + 1);
+  if (!path) {
+    fputs("soilsim: error: out of memory\n", stderr);
+    return EXIT_RUN_FAILED;
+  }
+  memcpy(path, arg, n);
+  path[n] = 0;
+  c[o->nckpt].arg = arg;
+  c[o->nckpt].path = path;
+  c[o->nckpt].step = step;
+  o->nckpt++;
+  return -1;
 }
 
 static int add_removal(Options *o, const char *arg)
@@ -225,6 +301,8 @@ static int parse_args(int argc, char **argv, Options *o)
   memset(o, 0, sizeof *o);
   o->steps = DEFAULT_STEPS;
   o->render_every = DEFAULT_RENDER_EVERY;
+  o->solver_tolerance = -1;
+  o->warm_start = -1;
 
   for (int i = 1; i < argc; i++) {
     const char *a = argv[i];
@@ -307,6 +385,31 @@ static int parse_args(int argc, char **argv, Options *o)
       size_given = 1;
       break;
     case OPT_RUT_MAP: o->rut_map = value; break;
+    case OPT_CHECKPOINT: {
+      int rc = add_checkpoint(o, value);
+      if (rc >= 0) return rc;
+      break;
+    }
+    case OPT_RESTORE: o->restore = value; break;
+    case OPT_SOLVER_TOLERANCE:
+      if (!parse_fraction(value, 0, 1, &o->solver_tolerance))
+        return usage_error("invalid --solver-tolerance value '%s': expected a "
+                           "number between 0 and 1 (exclusive)", value);
+      break;
+    case OPT_MAX_SWEEPS:
+      if (!parse_long(value, 1, 1000000, &o->max_sweeps))
+        return usage_error("invalid --max-sweeps value '%s': expected an "
+                           "integer from 1 to 1000000", value);
+      break;
+    case OPT_WARM_START:
+      if (!strcmp(value, "on"))
+        o->warm_start = 1;
+      else if (!strcmp(value, "off"))
+        o->warm_start = 0;
+      else
+        return usage_error("invalid --warm-start value '%s': expected 'on' "
+                           "or 'off'", value);
+      break;
     case OPT_QUIET: o->quiet = 1; break;
     case OPT_HELP:
       usage(stdout);
@@ -329,6 +432,12 @@ static int parse_args(int argc, char **argv, Options *o)
                          o->removal[i].step, o->steps,
                          steps_given ? "" : ", the default");
 
+  for (int i = 0; i < o->nckpt; i++)
+    if (o->ckpt[i].step > o->steps)
+      return usage_error("--checkpoint %s: step %ld is after the last step "
+                         "(--steps %ld%s)", o->ckpt[i].arg, o->ckpt[i].step,
+                         o->steps, steps_given ? "" : ", the default");
+
   /* two outputs on one path would overwrite each other */
   const char *out[3] = {o->export_path, o->csv_path, o->rut_map};
   const char *flag[3] = {"--export", "--csv", "--rut-map"};
@@ -337,6 +446,11 @@ static int parse_args(int argc, char **argv, Options *o)
       if (out[i] && out[j] && !strcmp(out[i], out[j]))
         return usage_error("%s and %s both write '%s'", flag[i], flag[j],
                            out[i]);
+  for (int i = 0; i < 3; i++)
+    for (int k = 0; k < o->nckpt; k++)
+      if (out[i] && !strcmp(out[i], o->ckpt[k].path))
+        return usage_error("%s and --checkpoint %s both write '%s'", flag[i],
+                           o->ckpt[k].arg, out[i]);
   return -1;
 }
 
@@ -577,12 +691,49 @@ static ssStatus apply_removals(const Options *o, const ssModel *m, ssData *d,
   return SS_OK;
 }
 
+/* Checkpoints scheduled for step k, written after its removals: the state
+ * step k + 1 starts from. */
+static ssStatus write_checkpoints(const Options *o, const ssModel *m,
+                                  const ssData *d, long k, int *nwritten,
+                                  ssError *err)
+{
+  for (int i = 0; i < o->nckpt; i++) {
+    if (o->ckpt[i].step != k) continue;
+    if (ss_checkpoint_save(m, d, o->ckpt[i].path, err) != SS_OK) return err->code;
+    (*nwritten)++;
+  }
+  return SS_OK;
+}
+
+/* --restore: the checkpoint's solver configuration becomes the world's
+ * (it is part of the saved world), then its state replaces the scene's. */
+static ssStatus restore(const Options *o, ssModel *m, ssData *d,
+                        ssCheckpointInfo *info, ssError *err)
+{
+  ssStatus st = ss_checkpoint_info(o->restore, info, err);
+  if (st != SS_OK) return st;
+  ss_option_copy_solver(&m->opt, &info->opt);
+  return ss_checkpoint_load(m, d, o->restore, err);
+}
+
+/* --solver-tolerance, --max-sweeps, --warm-start over the scene's (or the
+ * checkpoint's) <contact_solver>. */
+static void apply_solver_overrides(const Options *o, ssModel *m)
+{
+  if (o->solver_tolerance > 0) m->opt.solver_tolerance = o->solver_tolerance;
+  if (o->max_sweeps > 0) m->opt.solver_max_sweeps = (int)o->max_sweeps;
+  if (o->warm_start >= 0) m->opt.terrain_warm_start = o->warm_start;
+}
+
 static void print_summary(const Options *o, const ssModel *m, const ssData *d,
                           long steps, double wall, long nframes,
-                          long unconverged)
+                          long unconverged, const ssCheckpointInfo *restored)
 {
   double sim = (double)steps * m->opt.timestep;
   printf("scene       %s\n", o->scene);
+  if (restored)
+    printf("restored    %s (step %ld, t = %.6g s)\n", o->restore,
+           restored->step, restored->time);
   printf("steps       %ld (dt %g s)\n", steps, m->opt.timestep);
   double gap = d->time - sim;
   if (gap > 0.5 * m->opt.timestep || gap < -0.5 * m->opt.timestep)
@@ -605,6 +756,9 @@ static void print_summary(const Options *o, const ssModel *m, const ssData *d,
   if (o->render_dir)
     printf("frames      %s/frame_*.png (%ld)\n", o->render_dir, nframes);
   if (o->rut_map) printf("rut map     %s\n", o->rut_map);
+  for (int i = 0; i < o->nckpt; i++)
+    printf("checkpoint  %s (after step %ld)\n", o->ckpt[i].path,
+           o->ckpt[i].step);
 }
 
 static int run(const Options *o)
@@ -616,6 +770,8 @@ static int run(const Options *o)
   ssAtomicFile csv;
   int csv_open = 0, status = EXIT_RUN_FAILED;
   long nframes = 0, unconverged = 0, done = 0;
+  int nckpt = 0;
+  ssCheckpointInfo restored;
   double t0, wall;
   ssRenderOptions ropt = ss_render_options_default();
   Progress prog;
@@ -629,6 +785,12 @@ static int run(const Options *o)
     goto fail;
   }
   if (check_removals(o, m, &err) != SS_OK) goto fail;
+  /* the solver configuration: the scene's, or the checkpoint's when
+   * restoring, then the command line's overrides */
+  if (o->restore && restore(o, m, d, &restored, &err) != SS_OK) goto fail;
+  apply_solver_overrides(o, m);
+  for (int i = 0; i < o->nckpt; i++)
+    if (check_output(o->ckpt[i].path, "--checkpoint", &err) != SS_OK) goto fail;
   if (o->rut_map && first_soil_bed(m) < 0) {
     ss_error_set(&err, SS_ERR_VALUE, o->scene, 0,
                  "--rut-map: the scene has no soil bed");
@@ -688,6 +850,7 @@ static int run(const Options *o)
         render_step(r, o, m, d, k, &nframes, &err) != SS_OK)
       goto fail;
     if (apply_removals(o, m, d, k, &err) != SS_OK) goto fail;
+    if (write_checkpoints(o, m, d, k, &nckpt, &err) != SS_OK) goto fail;
     if (prog.on) {
       double now = now_seconds();
       if (now - prog.last >= 0.1 || k == o->steps)
@@ -697,8 +860,13 @@ static int run(const Options *o)
   wall = now_seconds() - t0;
   if (g_signal) {
     progress_clear(&prog);
-    fprintf(stderr, "soilsim: interrupted after step %ld; no output files "
-            "written\n", done);
+    if (nckpt)
+      fprintf(stderr, "soilsim: interrupted after step %ld; only the %d "
+              "checkpoint%s of earlier steps written\n", done, nckpt,
+              nckpt == 1 ? "" : "s");
+    else
+      fprintf(stderr, "soilsim: interrupted after step %ld; no output files "
+              "written\n", done);
     g_interrupted = 1;
     goto cleanup;
   }
@@ -715,7 +883,9 @@ static int run(const Options *o)
     csv_open = 0;
     if (ss_atomic_commit(&csv, &err) != SS_OK) goto fail;
   }
-  if (!o->quiet) print_summary(o, m, d, done, wall, nframes, unconverged);
+  if (!o->quiet)
+    print_summary(o, m, d, done, wall, nframes, unconverged,
+                  o->restore ? &restored : NULL);
   status = 0;
   goto cleanup;
 

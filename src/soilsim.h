@@ -543,6 +543,62 @@ ssStatus ss_render_rut_map(const ssModel *m, const ssData *d, int hfield,
                            const char *png_path, ssError *err);
 
 /* ---------------------------------------------------------------------- */
+/* checkpoints (DESIGN 5)                                                  */
+
+/* A checkpoint is a versioned, checksummed binary file holding everything
+ * in an ssData that the next step reads: time and step count, qpos, qvel,
+ * which systems are in the world, controller targets, bed poses, the soil
+ * state of every bed, the solver's warm-start cache, the solver options and
+ * the last step's statistics (without the stage wall times).  Restoring it
+ * and stepping gives bit-identical results to stepping on from the moment it
+ * was written.  The model is not in the file: a checkpoint is restored into
+ * a data made for the same world (same counts, masses, joints, colliders,
+ * heights, soil materials, time step, gravity, ...), which a fingerprint of
+ * the model checks.  The layout is described in checkpoint.c. */
+
+/* What a checkpoint says about itself. */
+typedef struct ssCheckpointInfo {
+  int version;        /* format version */
+  double time;        /* simulated time when it was written (s) */
+  long step;          /* completed steps when it was written */
+  ssOption opt;       /* the options of the world that wrote it */
+  char source[512];   /* that model's source_path ("" if built in code) */
+  size_t bytes;       /* size of the checkpoint */
+} ssCheckpointInfo;
+
+/* Write the state of d, atomically (temporary file, then rename).  Only
+ * between steps. */
+ssStatus ss_checkpoint_save(const ssModel *m, const ssData *d,
+                            const char *path, ssError *err);
+/* Restore a checkpoint into d, which must have been made for m
+ * (ss_data_new(m)), and recompute the derived kinematics.  Refused with a
+ * clear message, leaving d unchanged, when the file is not a checkpoint, is
+ * truncated or corrupted (checksum), has an unknown version, was written for
+ * a different world, or when its solver options (max_sweeps, tolerance,
+ * scalar_tolerance, terrain_warm_start, contact_margin, rigid_erp) differ
+ * from m->opt: the options are part of the world and the model is const
+ * here, so a caller that wants them applies them to its model first with
+ * ss_checkpoint_info and ss_option_copy_solver.  Only between steps. */
+ssStatus ss_checkpoint_load(const ssModel *m, ssData *d, const char *path,
+                            ssError *err);
+/* The same in memory: *buf is malloc'd (release it with free()). */
+ssStatus ss_checkpoint_save_buffer(const ssModel *m, const ssData *d,
+                                   unsigned char **buf, size_t *len,
+                                   ssError *err);
+ssStatus ss_checkpoint_load_buffer(const ssModel *m, ssData *d,
+                                   const void *buf, size_t len, ssError *err);
+/* Verify a checkpoint (signature, version, size, checksum) and describe it
+ * without a model. */
+ssStatus ss_checkpoint_info(const char *path, ssCheckpointInfo *info,
+                            ssError *err);
+ssStatus ss_checkpoint_info_buffer(const void *buf, size_t len,
+                                   ssCheckpointInfo *info, ssError *err);
+/* Copy the solver configuration (max_sweeps, tolerance, scalar_tolerance,
+ * terrain_warm_start, contact_margin, rigid_erp) from src to dst; the time
+ * step and gravity, which define the world, stay as they are. */
+void ss_option_copy_solver(ssOption *dst, const ssOption *src);
+
+/* ---------------------------------------------------------------------- */
 /* atomic output files (temporary file in the same folder, then rename)    */
 
 typedef struct ssAtomicFile {

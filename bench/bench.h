@@ -1,0 +1,9 @@
+/* bench.h -- the benchmark program's cases (DESIGN 8). */
+#ifndef SS_BENCH_H
+#define SS_BENCH_H
+
+/* `benchmarks --bench render [options]`: milliseconds per frame of a scene
+ * (default: the buggy on its bed at 1280x720).  Returns the exit status. */
+int bench_render(int argc, char **argv);
+
+#endif

@@ -1,0 +1,32 @@
+/* benchmarks.c -- the benchmark program of DESIGN 8: dispatches to the
+ * named cases.  Timings are reported, never asserted. */
+#include "bench.h"
+
+#include <stdio.h>
+#include <string.h>
+
+static void usage(FILE *f)
+{
+  fprintf(f, "usage: benchmarks --bench NAME [-- options]\n"
+             "cases:\n"
+             "  render              milliseconds per rendered frame\n");
+}
+
+int main(int argc, char **argv)
+{
+  for (int i = 1; i < argc; i++) {
+    if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+      usage(stdout);
+      return 0;
+    }
+    if (!strcmp(argv[i], "--bench") && i + 1 < argc) {
+      const char *name = argv[i + 1];
+      if (!strcmp(name, "render")) return bench_render(argc - i - 2, argv + i + 2);
+      fprintf(stderr, "benchmarks: unknown case '%s'\n", name);
+      usage(stderr);
+      return 2;
+    }
+  }
+  usage(stderr);
+  return 2;
+}

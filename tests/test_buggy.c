@@ -1,0 +1,321 @@
+/* test_buggy.c -- the 896 kg double-wishbone buggy of DESIGN 7
+ * (assets/buggy, scenes/buggy*.xml): statics on rigid ground, loop
+ * closure, a 20 s drive on soil (speed, slip, ruts, recovery after
+ * removal), steering and determinism. */
+#include "soilsim.h"
+#include "solver.h"
+#include "ss_math.h"
+#include "tap.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static const char *top(void)
+{
+  const char *t = getenv("top_srcdir");
+  return t && *t ? t : ".";
+}
+
+static int load(const char *rel, ssModel **m, ssData **d)
+{
+  char path[1024];
+  ssError e;
+  snprintf(path, sizeof path, "%s/%s", top(), rel);
+  if (ss_scene_load(path, m, d, &e) != SS_OK) {
+    diag("%s:%d: %s", e.file, e.line, e.message);
+    return 0;
+  }
+  return 1;
+}
+
+static int run(const ssModel *m, ssData *d, int n, double *closure)
+{
+  ssError e;
+  for (int k = 0; k < n; k++) {
+    if (ss_step(m, d, &e) != SS_OK) {
+      diag("step failed: %s", e.message);
+      return 0;
+    }
+    if (closure && d->closure_error > *closure) *closure = d->closure_error;
+  }
+  return 1;
+}
+
+static int body(const ssModel *m, const char *name)
+{
+  int s = ss_model_find_sys(m, "buggy");
+  for (int b = m->sys_bodyadr[s]; b < m->sys_bodyadr[s] + m->sys_nbody[s]; b++)
+    if (!strcmp(m->body_name[b], name)) return b;
+  return -1;
+}
+
+static double total_mass(const ssModel *m)
+{
+  int s = ss_model_find_sys(m, "buggy");
+  double mass = 0;
+  for (int b = m->sys_bodyadr[s]; b < m->sys_bodyadr[s] + m->sys_nbody[s]; b++)
+    mass += m->body_mass[b];
+  return mass;
+}
+
+/* normal force carried by the contacts of one body's colliders (N) */
+static double wheel_load(const ssModel *m, const ssData *d, int b)
+{
+  double f = 0;
+  for (int i = 0; i < d->ncontact; i++) {
+    const ssContact *c = &d->contact[i];
+    if ((c->type == SS_CONTACT_RIGID || c->type == SS_CONTACT_SOIL) && m->geom_body[c->geom] == b)
+      f += c->lambda[0] * c->frame[2];
+  }
+  return f / m->opt.timestep;
+}
+
+static void set_drive(const ssModel *m, ssData *d, double wheel_speed)
+{
+  for (int k = 0; k < m->npd; k++)
+    if (strstr(m->body_jntname[m->pd_body[k]], "wheel")) d->pd_target[2 * k + 1] = wheel_speed;
+}
+
+static void world_point(const ssData *d, int b, const double local[3], double p[3])
+{
+  ss_m3_mulv(p, d->body_xmat + 9 * b, local);
+  ss_v3_add(p, p, d->body_xpos + 3 * b);
+}
+
+static const char *corner[4] = {"fl", "fr", "rl", "rr"};
+
+/* statics on rigid ground: the wheel loads carry m g; each coil-over's
+ * force (its rate times its deflection) carries the corner's sprung load
+ * through the motion ratio of its linkage */
+static void test_statics(void)
+{
+  ssModel *m;
+  ssData *d;
+  if (!load("scenes/buggy_rigid.xml", &m, &d)) {
+    ok(0, "buggy_rigid.xml loads");
+    return;
+  }
+  ok(fabs(total_mass(m) - 896) < 1e-9, "the buggy weighs 896 kg (%.6g)", total_mass(m));
+  set_drive(m, d, 0);
+  double closure = 0;
+  run(m, d, 3000, &closure);
+  double sum = 0, load[4];
+  char name[32];
+  for (int k = 0; k < 4; k++) {
+    snprintf(name, sizeof name, "wheel_%s", corner[k]);
+    load[k] = wheel_load(m, d, body(m, name));
+    sum += load[k];
+  }
+  double mg = 896 * 9.81;
+  close_enough(sum, mg, 0.005 * mg, "rigid ground: the four wheel loads sum to m g");
+  diag("wheel loads fl %.0f fr %.0f rl %.0f rr %.0f N", load[0], load[1], load[2], load[3]);
+  ok(fabs(load[0] - load[1]) < 0.01 * load[0] && fabs(load[2] - load[3]) < 0.01 * load[2],
+     "left and right loads agree");
+  ok(load[2] > load[0], "the rear (engine) axle carries more");
+
+  /* virtual work: a small heave of the corner moves the spring by MR times
+   * the wheel travel; measure MR from the linkage itself by perturbing the
+   * lower arm joint and following the upright's ball joint */
+  for (int k = 0; k < 4; k++) {
+    int sp = -1;
+    snprintf(name, sizeof name, "coilover_%s", corner[k]);
+    for (int i = 0; i < m->nspring; i++)
+      if (!strcmp(m->spring_name[i], name)) sp = i;
+    int b1 = m->spring_body[2 * sp], b2 = m->spring_body[2 * sp + 1];
+    const double *an = m->spring_anchor + 6 * sp, *par = m->spring_param + 3 * sp;
+    double p1[3], p2[3], dv[3];
+    world_point(d, b1, an, p1);
+    world_point(d, b2, an + 3, p2);
+    ss_v3_sub(dv, p1, p2);
+    double L = ss_v3_norm(dv), F = par[0] * (par[2] - L);
+    /* motion ratio: rotate the lower arm about its joint by a small angle */
+    snprintf(name, sizeof name, "lower_arm_%s", corner[k]);
+    int la = body(m, name);
+    snprintf(name, sizeof name, "upright_%s", corner[k]);
+    int up = body(m, name);
+    double h = 1e-6, R[9], axis[3], piv[3], ball[3];
+    ss_v3_copy(piv, d->body_xpos + 3 * la);
+    ss_m3_mulv(axis, d->body_xmat + 9 * la, m->body_jntaxis + 3 * la);
+    ss_v3_copy(ball, d->body_xpos + 3 * up);
+    double q[4];
+    ss_quat_from_axis_angle(q, axis, h);
+    ss_quat_to_mat(R, q);
+    double r2[3], p2n[3], balln[3], t[3];
+    ss_v3_sub(r2, p2, piv);
+    ss_m3_mulv(t, R, r2);
+    ss_v3_add(p2n, piv, t);
+    ss_v3_sub(r2, ball, piv);
+    ss_m3_mulv(t, R, r2);
+    ss_v3_add(balln, piv, t);
+    double dvn[3];
+    ss_v3_sub(dvn, p1, p2n);
+    double mr = fabs((ss_v3_norm(dvn) - L) / (balln[2] - ball[2]));
+    /* sprung share of the corner: the wheel load less the weight of what
+     * hangs below the spring (wheel, hub, upright, half the wishbones) */
+    double unsprung = (20 + 3 + 6 + 0.5 * (4 + 3)) * 9.81;
+    double want = (load[k] - unsprung) / mr;
+    char what[96];
+    snprintf(what, sizeof what, "%s coil-over: rate x deflection = sprung load / MR (MR %.3f)",
+             corner[k], mr);
+    close_enough(F, want, 0.05 * want, what);
+  }
+  ok(closure < 1e-6, "rigid ground: loop closure error < 1e-6 m (max %.3g)", closure);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
+/* 20 s on soil (the 4 cm test copy of scenes/buggy.xml), then removal */
+static void test_drive(void)
+{
+  ssModel *m;
+  ssData *d;
+  if (!load("tests/data/buggy_4cm.xml", &m, &d)) {
+    ok(0, "buggy_4cm.xml loads");
+    return;
+  }
+  int chassis = body(m, "chassis"), wrl = body(m, "wheel_rl");
+  double x0 = d->body_xipos[3 * chassis], closure = 0, slip_sum = 0;
+  int slip_n = 0;
+  ssError e;
+  for (int k = 0; k < 20000; k++) {
+    if (!run(m, d, 1, &closure)) break;
+    if (k > 2000 && k % 100 == 0) {
+      /* slip ratio of the rear wheel: 1 - v / (omega r) */
+      double w = d->qvel[m->body_dofadr[wrl]], v = d->qvel[m->body_dofadr[chassis]];
+      slip_sum += 1 - v / (w * 0.3611);
+      slip_n++;
+    }
+  }
+  double x1 = d->body_xipos[3 * chassis], speed = (x1 - x0) / 20;
+  ok(speed > 0.5 && speed < 0.9, "on soil the chassis advances at %.3f m/s over 20 s (0.5-0.9)", speed);
+  double slip = slip_sum / slip_n;
+  ok(slip > 0.02 && slip < 0.5, "the driven rear wheels slip (mean slip ratio %.3f)", slip);
+  ok(closure < 1e-6, "loop closure error < 1e-6 m over the whole drive (max %.3g)", closure);
+
+  /* ruts: permanent sinkage under the wheel tracks, none away from them */
+  int h = 0, nx = m->hfield_nx[h], ny = m->hfield_ny[h];
+  double dx = m->hfield_size[0] / (nx - 1), dy = m->hfield_size[1] / (ny - 1);
+  double track_max = 0, off_track = 0;
+  for (int j = 0; j < ny; j++) {
+    double y = -3 + j * dy;
+    for (int i = 0; i < nx; i++) {
+      double x = -8 + i * dx, sp = d->soil_plastic[j * nx + i];
+      int in_x = x > x0 - 1.5 && x < x1 + 1.5;
+      int on = fabs(fabs(y) - 0.75) < 0.12 || fabs(fabs(y) - 0.78) < 0.12;
+      if (in_x && on) track_max = fmax(track_max, sp);
+      if (fabs(y) < 0.5 || fabs(y) > 1.1 || x < x0 - 1.5 || x > x1 + 1.5)
+        off_track = fmax(off_track, fabs(d->soil_sinkage[j * nx + i]));
+    }
+  }
+  /* the typical rut: the median of the deepest point across the rear
+   * right track, over the straight part of the drive (the start, where
+   * the wheels spin up from rest, digs deepest) */
+  double *prof = malloc((size_t)nx * sizeof(double));
+  int np = 0;
+  for (int i = 0; i < nx; i++) {
+    double x = -8 + i * dx, deep = 0;
+    if (x < x0 + 2 || x > x1 - 1) continue;
+    for (int j = 0; j < ny; j++) {
+      double y = -3 + j * dy;
+      if (fabs(y + 0.78) < 0.12) deep = fmax(deep, d->soil_plastic[j * nx + i]);
+    }
+    prof[np++] = deep;
+  }
+  for (int a = 1; a < np; a++)
+    for (int b = a; b > 0 && prof[b - 1] > prof[b]; b--) {
+      double t = prof[b];
+      prof[b] = prof[b - 1];
+      prof[b - 1] = t;
+    }
+  double median = np ? prof[np / 2] : 0;
+  free(prof);
+  ok(median > 0.02 && median < 0.10,
+     "ruts of several centimetres under the tracks (median %.1f mm along the rear track, deepest %.1f mm)",
+     median * 1e3, track_max * 1e3);
+  ok(off_track == 0, "the soil outside the tracks is untouched (max %.3g m)", off_track);
+
+  /* remove the car: the elastic part recovers, the ruts remain */
+  int n = m->nhfielddata;
+  double *s_before = malloc(n * sizeof(double)), *p_before = malloc(n * sizeof(double));
+  memcpy(s_before, d->soil_sinkage, n * sizeof(double));
+  memcpy(p_before, d->soil_plastic, n * sizeof(double));
+  ss_remove(m, d, "buggy", &e);
+  run(m, d, 1, NULL);
+  double risen = 0, rut_kept = 1;
+  int loaded = 0;
+  for (int k = 0; k < n; k++) {
+    if (d->soil_plastic[k] != p_before[k]) rut_kept = 0;
+    if (s_before[k] > p_before[k]) {
+      loaded++;
+      risen = fmax(risen, s_before[k] - d->soil_sinkage[k]);
+      if (d->soil_sinkage[k] != d->soil_plastic[k]) rut_kept = 0;
+    }
+  }
+  ok(loaded > 0 && risen > 0, "after removal the surface rose by the elastic part (%.3f mm at most, %d vertices)",
+     risen * 1e3, loaded);
+  ok(rut_kept, "after removal the ruts remain (plastic sinkage unchanged)");
+  free(s_before);
+  free(p_before);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
+/* steering: the rack held to the left turns the car to the left */
+static void test_steering(void)
+{
+  ssModel *m;
+  ssData *d;
+  if (!load("tests/data/buggy_turn_4cm.xml", &m, &d)) {
+    ok(0, "buggy_turn_4cm.xml loads");
+    return;
+  }
+  int chassis = body(m, "chassis");
+  double closure = 0;
+  run(m, d, 6000, &closure);
+  const double *R = d->body_xmat + 9 * chassis;
+  double yaw = atan2(R[3], R[0]);
+  ok(yaw > 0.1, "a rack offset to the left turns the buggy left (yaw %.3f rad)", yaw);
+  ok(d->body_xipos[3 * chassis + 1] > 0.05, "  and it drifts to +y (%.3f m)", d->body_xipos[3 * chassis + 1]);
+  ok(closure < 1e-6, "  the tie rods stay closed (max error %.3g m)", closure);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
+/* the same scene run twice exports identical files */
+static void test_determinism(void)
+{
+  char out[2][256];
+  for (int k = 0; k < 2; k++) {
+    ssModel *m;
+    ssData *d;
+    ssError e;
+    if (!load("tests/data/buggy_4cm.xml", &m, &d)) return;
+    run(m, d, 300, NULL);
+    snprintf(out[k], sizeof out[k], "/tmp/soilsim-buggy-%ld-%d.xml", (long)getpid(), k);
+    ss_scene_export(m, d, out[k], &e);
+    ss_data_free(d);
+    ss_model_free(m);
+  }
+  FILE *a = fopen(out[0], "rb"), *b = fopen(out[1], "rb");
+  int same = a && b;
+  while (same) {
+    int ca = fgetc(a), cb = fgetc(b);
+    if (ca != cb) same = 0;
+    if (ca == EOF || cb == EOF) break;
+  }
+  if (a) fclose(a);
+  if (b) fclose(b);
+  ok(same, "the same buggy scene run twice exports identical files");
+  remove(out[0]);
+  remove(out[1]);
+}
+
+int main(void)
+{
+  test_statics();
+  test_steering();
+  test_determinism();
+  test_drive();
+  return done_testing();
+}
