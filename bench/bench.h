@@ -6,4 +6,7 @@
  * (default: the buggy on its bed at 1280x720).  Returns the exit status. */
 int bench_render(int argc, char **argv);
 
+/* `benchmarks --bench deformable_terrain -- [options]` (DESIGN 8). */
+int bench_terrain(int argc, char **argv);
+
 #endif

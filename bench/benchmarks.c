@@ -9,7 +9,8 @@ static void usage(FILE *f)
 {
   fprintf(f, "usage: benchmarks --bench NAME [-- options]\n"
              "cases:\n"
-             "  render              milliseconds per rendered frame\n");
+             "  render              milliseconds per rendered frame\n"
+             "                      [--scene FILE] [--size WxH] [--frames N] [--steps K] [--csv FILE]\n");
 }
 
 int main(int argc, char **argv)
@@ -22,6 +23,7 @@ int main(int argc, char **argv)
     if (!strcmp(argv[i], "--bench") && i + 1 < argc) {
       const char *name = argv[i + 1];
       if (!strcmp(name, "render")) return bench_render(argc - i - 2, argv + i + 2);
+      if (!strcmp(name, "deformable_terrain")) return bench_terrain(argc - i - 2, argv + i + 2);
       fprintf(stderr, "benchmarks: unknown case '%s'\n", name);
       usage(stderr);
       return 2;

@@ -8,6 +8,7 @@
 #include "ss_math.h"
 #include "tap.h"
 #include "urdf.h"
+#include "worlds.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -16,73 +17,6 @@ static const double G = 9.81;
 
 /* ---------------------------------------------------------------------- */
 /* a tiny in-memory URDF builder                                           */
-
-static ssUrdf *urdf_new(void)
-{
-  ssUrdf *u = calloc(1, sizeof *u);
-  u->link = calloc(64, sizeof *u->link);
-  u->joint = calloc(64, sizeof *u->joint);
-  u->closure = calloc(16, sizeof *u->closure);
-  u->spring = calloc(16, sizeof *u->spring);
-  snprintf(u->path, sizeof u->path, "in-memory.urdf");
-  return u;
-}
-
-static void urdf_free(ssUrdf *u)
-{
-  for (int i = 0; i < u->nlink; i++) free(u->link[i].geom);
-  free(u->link);
-  free(u->joint);
-  free(u->closure);
-  free(u->spring);
-  free(u);
-}
-
-/* a link of mass m with its COM at com and principal inertia (ix, iy, iz) */
-static int add_link(ssUrdf *u, const char *name, double m, const double com[3],
-                    double ix, double iy, double iz)
-{
-  ssUrdfLink *l = &u->link[u->nlink];
-  snprintf(l->name, sizeof l->name, "%s", name);
-  l->mass = m;
-  if (com) memcpy(l->com, com, sizeof l->com);
-  l->com_quat[0] = 1;
-  l->inertia[0] = ix;
-  l->inertia[3] = iy;
-  l->inertia[5] = iz;
-  return u->nlink++;
-}
-
-static void add_box(ssUrdf *u, int link, double x, double y, double z,
-                    const double pos[3])
-{
-  ssUrdfLink *l = &u->link[link];
-  l->geom = realloc(l->geom, (size_t)(l->ngeom + 1) * sizeof *l->geom);
-  ssUrdfGeom *g = &l->geom[l->ngeom++];
-  memset(g, 0, sizeof *g);
-  g->type = SS_GEOM_BOX;
-  g->size[0] = x;
-  g->size[1] = y;
-  g->size[2] = z;
-  if (pos) memcpy(g->pos, pos, sizeof g->pos);
-  g->quat[0] = 1;
-  g->collision = 1;
-}
-
-static int add_joint(ssUrdf *u, const char *name, int type, int parent,
-                     int child, const double pos[3], const double axis[3])
-{
-  ssUrdfJoint *j = &u->joint[u->njoint];
-  snprintf(j->name, sizeof j->name, "%s", name);
-  j->type = type;
-  j->parent = parent;
-  j->child = child;
-  if (pos) memcpy(j->pos, pos, sizeof j->pos);
-  j->quat[0] = 1;
-  if (axis) memcpy(j->axis, axis, sizeof j->axis);
-  else j->axis[0] = 1;
-  return u->njoint++;
-}
 
 typedef struct {
   ssModel *m;
@@ -133,7 +67,9 @@ static int steps(World *w, int n)
   return 1;
 }
 
-static const double Y[3] = {0, 1, 0}, Z[3] = {0, 0, 1}, X[3] = {1, 0, 0};
+#define X W_X
+#define Y W_Y
+#define Z W_Z
 static const double NY[3] = {0, -1, 0};
 /* about -y: a positive angle turns +x towards +z */
 static const double *ny_axis(void) { return NY; }
@@ -477,27 +413,6 @@ static void test_free_both_ways(void)
 /* ---------------------------------------------------------------------- */
 /* articulated bodies on soil (DESIGN 8's benchmark bodies)                */
 
-static int add_soil_bed(ssModel *m, double size, double h)
-{
-  ssError e;
-  int n = (int)lround(size / h) + 1;
-  double *z = calloc((size_t)n * n, sizeof(double));
-  ssHfieldDef hd = ss_hfield_def_default();
-  hd.name = "bed";
-  hd.nx = hd.ny = n;
-  hd.x_size = hd.y_size = size;
-  hd.height = z;
-  hd.soil = 1;
-  hd.soilmat.bekker_kc = 0;
-  hd.soilmat.bekker_kphi = 1e5;
-  hd.soilmat.sinkage_exponent = 1;
-  hd.soilmat.elastic_stiffness = 2e6;
-  hd.soilmat.damping = 1e4;
-  int k = ss_model_add_hfield(m, &hd, &e);
-  free(z);
-  return k;
-}
-
 /* mean sinkage over bed vertices inside [x0,x1] x [y0,y1] */
 static double mean_sinkage(const ssModel *m, const ssData *d, double x0,
                            double x1, double y0, double y1)
@@ -516,36 +431,11 @@ static double mean_sinkage(const ssModel *m, const ssData *d, double x0,
   return cnt ? sum / cnt : NAN;
 }
 
-/* a chain of revolute links with joint springs, standing on link `on` */
-static int add_mast(ssUrdf *u, int on, int nlinks, double mass, const double at[3])
-{
-  int prev = on;
-  const double *axes[3] = {X, Y, Z};
-  for (int k = 0; k < nlinks; k++) {
-    char name[32];
-    snprintf(name, sizeof name, "mast%d_%d", on, k);
-    double com[3] = {0, 0, 0.01};
-    int l = add_link(u, name, mass, com, 1e-5, 1e-5, 1e-5);
-    double pos[3] = {0, 0, 0.02};
-    if (k == 0) memcpy(pos, at, sizeof pos);
-    int j = add_joint(u, name, SS_JOINT_REVOLUTE, prev, l, pos, axes[k % 3]);
-    u->joint[j].stiffness = 60;
-    u->joint[j].damping = 0.5;
-    prev = l;
-  }
-  return prev;
-}
-
 static void test_on_soil(void)
 {
   const double s_ref = 8.175e-3;
-  /* 60 DOF: the 0.4 x 0.6 plate as a floating base carrying a 54-joint
-   * sprung mast; 20 kg in all */
-  ssUrdf *u = urdf_new();
-  int plate = add_link(u, "plate", 20 - 54 * 0.02, NULL, 0.6, 0.3, 0.8);
-  add_box(u, plate, 0.4, 0.6, 0.05, NULL);
-  double top[3] = {0, 0, 0.025};
-  add_mast(u, plate, 54, 0.02, top);
+  /* 60 DOF: the plate carrier of DESIGN 8 */
+  ssUrdf *u = carrier60();
   double pos[3] = {0, 0, 0.025};
   World w = build(u, 0, pos);
   add_soil_bed(w.m, 1.2, 0.02);
@@ -558,41 +448,9 @@ static void test_on_soil(void)
   drop(&w);
   urdf_free(u);
 
-  /* 64 DOF: a frame on four 0.2 x 0.3 pads, each on x/y/z sliders and a
-   * ball joint, plus a 34-joint mast; 20 kg and 0.24 m^2 in all */
-  u = urdf_new();
-  double pad_mass = 4, slide_mass = 0.05, mast_mass = 0.04;
-  double frame_mass = 20 - 4 * (pad_mass + 3 * slide_mass) - 34 * mast_mass;
-  int frame = add_link(u, "frame", frame_mass, NULL, 0.05, 0.05, 0.08);
-  double cx[4] = {-0.25, 0.25, -0.25, 0.25}, cy[4] = {-0.3, -0.3, 0.3, 0.3};
-  for (int k = 0; k < 4; k++) {
-    char nm[32];
-    int prev = frame;
-    const double *ax[3] = {X, Y, Z};
-    for (int a = 0; a < 3; a++) {
-      snprintf(nm, sizeof nm, "slide%d%c", k, "xyz"[a]);
-      int l = add_link(u, nm, slide_mass, NULL, 1e-4, 1e-4, 1e-4);
-      double p0[3] = {0, 0, 0};
-      if (a == 0) {
-        p0[0] = cx[k];
-        p0[1] = cy[k];
-        p0[2] = -0.1;
-      }
-      int j = add_joint(u, nm, SS_JOINT_PRISMATIC, prev, l, p0, ax[a]);
-      u->joint[j].stiffness = a == 2 ? 2e4 : 5e3;
-      u->joint[j].damping = 200;
-      prev = l;
-    }
-    snprintf(nm, sizeof nm, "pad%d", k);
-    int pad = add_link(u, nm, pad_mass, NULL, 0.03, 0.015, 0.04);
-    add_box(u, pad, 0.2, 0.3, 0.04, NULL);
-    double p0[3] = {0, 0, 0};
-    int j = add_joint(u, nm, SS_JOINT_SPHERICAL, prev, pad, p0, NULL);
-    u->joint[j].damping = 2;
-  }
-  double mtop[3] = {0, 0, 0.02};
-  add_mast(u, frame, 34, mast_mass, mtop);
-  /* pads' bottoms on the surface: frame at 0.1 + 0.02 */
+  /* 64 DOF: the four-pad body; pads' bottoms on the surface: frame at
+   * 0.1 + 0.02 */
+  u = fourpad64();
   double fpos[3] = {0, 0, 0.12};
   w = build(u, 0, fpos);
   add_soil_bed(w.m, 1.4, 0.02);
@@ -601,11 +459,23 @@ static void test_on_soil(void)
   steps(&w, 2000);
   double worst = 0;
   for (int k = 0; k < 4; k++) {
-    double sk = mean_sinkage(w.m, w.d, cx[k] - 0.09, cx[k] + 0.09, cy[k] - 0.14, cy[k] + 0.14);
+    double cx = FOURPAD_CX[k], cy = FOURPAD_CY[k];
+    double sk = mean_sinkage(w.m, w.d, cx - 0.09, cx + 0.09, cy - 0.14, cy + 0.14);
     worst = fmax(worst, fabs(sk - s_ref));
   }
   ok(worst < 0.01 * s_ref, "64-DOF four-pad body: every pad at the analytic sinkage (worst error %.3g mm)",
      worst * 1e3);
+  drop(&w);
+  urdf_free(u);
+
+  /* the carrier with eight joint-coupling relations */
+  u = carrier60_pinned();
+  w = build(u, 0, pos);
+  add_soil_bed(w.m, 1.2, 0.02);
+  finish(&w);
+  ok(w.m->neq == 8, "pinned carrier has eight closures");
+  steps(&w, 1500);
+  close_enough(-(w.d->qpos[2] - 0.025), s_ref, 0.01 * s_ref, "pinned carrier settles at the analytic sinkage");
   drop(&w);
   urdf_free(u);
 }

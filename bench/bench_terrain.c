@@ -1,0 +1,347 @@
+/* bench_terrain.c -- `benchmarks --bench deformable_terrain -- [options]`
+ * (DESIGN 8): the plate and the articulated bodies on soil, the buggy, and
+ * the contact law alone.  Times are reported, never asserted; --verify
+ * turns the correctness checks into the exit status (the test suite runs
+ * short verified runs). */
+#include "bench.h"
+#include "articulated.h"
+#include "soilsim.h"
+#include "solver.h"
+#include "ss_math.h"
+#include "worlds.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+typedef struct Opt {
+  const char *body;     /* rigid, articulated, pinned, multilink, buggy */
+  int warm;             /* 1 warm, 0 cold */
+  int contact_law;
+  int linear;           /* --material=linear (n = 1) */
+  int steps, repeats;
+  int bed_scale;        /* the bed's side times this (area x scale^2) */
+  const char *csv, *scene;
+  int verify;
+} Opt;
+
+static double now(void)
+{
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+  qsort(v, (size_t)n, sizeof *v, cmp_double);
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static void csv_row(const Opt *o, const char *kind, double ms, double ns_point,
+                    double sweeps, double err)
+{
+  if (!o->csv) return;
+  FILE *f = fopen(o->csv, "a");
+  if (!f) return;
+  fprintf(f, "%s,%s,%s,%s,%d,%d,%.6g,%.6g,%.6g,%.6g\n", kind, o->body,
+          o->warm ? "warm" : "cold", o->linear ? "linear" : "nonlinear", o->steps,
+          o->repeats, ms, ns_point, sweeps, err);
+  fclose(f);
+}
+
+/* ---------------------------------------------------------------------- */
+/* bodies on soil                                                          */
+
+typedef struct Run {
+  double seconds, sweeps, points, sinkage, soil_normal, dt;
+  int ok;
+} Run;
+
+/* build the chosen body on its bed (plate soil, 2 cm), or load the buggy */
+static int build(const Opt *o, ssModel **mout, ssData **dout, char *why, size_t cap)
+{
+  ssError e;
+  if (!strcmp(o->body, "buggy")) {
+    const char *tries[] = {o->scene, "scenes/buggy.xml", "../scenes/buggy.xml", NULL};
+    char path[1024];
+    const char *top = getenv("top_srcdir");
+    for (int k = 0; k < 4; k++) {
+      const char *t = k < 3 ? tries[k] : NULL;
+      if (k == 3 && top) {
+        snprintf(path, sizeof path, "%s/scenes/buggy.xml", top);
+        t = path;
+      }
+      if (!t) continue;
+      if (ss_scene_load(t, mout, dout, &e) == SS_OK) return 1;
+    }
+    snprintf(why, cap, "cannot load the buggy scene (give --scene=FILE): %s", e.message);
+    return 0;
+  }
+  ssModel *m = ss_model_new();
+  double bed = 1.2 * o->bed_scale, h = 0.02;
+  int sys;
+  if (!strcmp(o->body, "rigid")) {
+    ssBodyDef bd = ss_body_def_default();
+    bd.name = "plate";
+    bd.size[0] = 0.4;
+    bd.size[1] = 0.6;
+    bd.size[2] = 0.05;
+    bd.mass = 20;
+    bd.pos[2] = 0.025;
+    sys = ss_model_add_body(m, &bd, &e);
+  } else {
+    ssUrdf *u = !strcmp(o->body, "articulated") ? carrier60()
+              : !strcmp(o->body, "pinned")      ? carrier60_pinned()
+              : !strcmp(o->body, "multilink")   ? fourpad64()
+                                                : NULL;
+    if (!u) {
+      snprintf(why, cap, "unknown --body=%s (rigid, articulated, pinned, multilink, buggy)", o->body);
+      ss_model_free(m);
+      return 0;
+    }
+    ssArtDef def = ss_art_def_default();
+    def.name = o->body;
+    def.fixed_base = 0;
+    def.pos[2] = !strcmp(o->body, "multilink") ? 0.12 : 0.025;
+    if (!strcmp(o->body, "multilink")) bed = 1.4 * o->bed_scale;
+    sys = ss_model_add_articulated(m, u, &def, &e);
+    urdf_free(u);
+  }
+  add_soil_bed(m, bed, h);
+  m->opt.terrain_warm_start = o->warm;
+  if (sys < 0 || !(*dout = ss_data_new(m))) {
+    snprintf(why, cap, "cannot build the %s body: %s", o->body, e.message);
+    ss_model_free(m);
+    return 0;
+  }
+  *mout = m;
+  return 1;
+}
+
+static Run run_body(const Opt *o)
+{
+  Run r = {0, 0, 0, 0, 0, 0, 0};
+  ssModel *m;
+  ssData *d;
+  char why[1200];
+  if (!build(o, &m, &d, why, sizeof why)) {
+    fprintf(stderr, "benchmarks: %s\n", why);
+    return r;
+  }
+  m->opt.terrain_warm_start = o->warm;
+  ssError e;
+  double t0 = now();
+  long sweeps = 0, points = 0;
+  for (int k = 0; k < o->steps; k++) {
+    if (ss_step(m, d, &e) != SS_OK) {
+      fprintf(stderr, "benchmarks: step %d failed: %s\n", k + 1, e.message);
+      ss_data_free(d);
+      ss_model_free(m);
+      return r;
+    }
+    sweeps += d->stats.sweeps;
+    points += d->stats.soil_loaded;
+  }
+  r.seconds = now() - t0;
+  r.sweeps = (double)sweeps / o->steps;
+  r.points = (double)points / o->steps;
+  r.soil_normal = d->stats.soil_normal_force;
+  r.dt = m->opt.timestep;
+  /* the plate's (or pads') sinkage: mean of the loaded soil under them */
+  double sum = 0;
+  int n = 0;
+  for (int k = 0; k < d->nsoil_loaded; k++) {
+    sum += d->soil_sinkage[d->soil_loaded[k]];
+    n++;
+  }
+  r.sinkage = n ? sum / n : 0;
+  r.ok = 1;
+  ss_data_free(d);
+  ss_model_free(m);
+  return r;
+}
+
+static int bench_bodies(const Opt *o)
+{
+  double *ms = calloc((size_t)o->repeats, sizeof(double));
+  Run last = {0, 0, 0, 0, 0, 0, 0};
+  for (int k = 0; k < o->repeats; k++) {
+    last = run_body(o);
+    if (!last.ok) {
+      free(ms);
+      return 1;
+    }
+    ms[k] = 1e3 * last.seconds / o->steps;
+  }
+  double med = median(ms, o->repeats);
+  free(ms);
+  int buggy = !strcmp(o->body, "buggy");
+  double s_ref = 8.175e-3, err = buggy ? 0 : (last.sinkage - s_ref) / s_ref;
+  double ns_point = last.points > 0 ? 1e6 * med / last.points : 0;
+  printf("%-12s %-5s %6d steps x %d: %9.4f ms/step  %8.1f ns/point/step  %6.1f sweeps/step  "
+         "%7.1f loaded points",
+         o->body, o->warm ? "warm" : "cold", o->steps, o->repeats, med, ns_point,
+         last.sweeps, last.points);
+  if (buggy)
+    printf("  real-time factor %.3f\n", last.dt / (1e-3 * med));
+  else
+    printf("  sinkage %.4f mm (analytic 8.175, error %+.3f %%)\n", last.sinkage * 1e3, 100 * err);
+  csv_row(o, "body", med, ns_point, last.sweeps, err);
+  if (o->verify && !buggy) {
+    /* warm and cold starts reach the same converged answer */
+    Opt other = *o;
+    other.warm = !o->warm;
+    Run r2 = run_body(&other);
+    double diff = fabs(r2.sinkage - last.sinkage);
+    int same = r2.ok && diff <= 1e-6 * s_ref;
+    printf("verify: warm and cold sinkage differ by %.3g m: %s\n", diff, same ? "ok" : "FAILED");
+    /* settled bodies sit at the analytic sinkage */
+    int settled = fabs(err) < 0.01;
+    printf("verify: sinkage within 1 %% of 8.175 mm: %s\n", settled ? "ok" : "FAILED");
+    return same && settled ? 0 : 1;
+  }
+  return 0;
+}
+
+/* ---------------------------------------------------------------------- */
+/* the contact law alone: 32 anisotropic points                            */
+
+static unsigned long long lcg = 0x9E3779B97F4A7C15ull;
+static double rnd(void)
+{
+  lcg = lcg * 6364136223846793005ull + 1442695040888963407ull;
+  return (double)(lcg >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static int bench_contact_law(const Opt *o)
+{
+  enum { N = 32 };
+  ssSoilMaterial mat = ss_soil_material_default();
+  if (o->linear) mat.sinkage_exponent = 1;
+  const double dt = 1e-3, tol = 1e-12;
+  ssContact c[N];
+  double v0[N][3];
+  memset(c, 0, sizeof c);
+  lcg = 0x9E3779B97F4A7C15ull;
+  for (int i = 0; i < N; i++) {
+    c[i].type = SS_CONTACT_SOIL;
+    c[i].area = 2e-4 + 4e-4 * rnd();
+    c[i].width = 0.1 + 0.3 * rnd();
+    c[i].sp = 0.02 * rnd();
+    /* fresh, partially and fully mobilized shear */
+    c[i].j = i % 3 == 0 ? 0 : i % 3 == 1 ? mat.shear_displacement : 10 * mat.shear_displacement;
+    c[i].g0 = -0.002 * rnd();
+    /* anisotropic SPD response: A A^T + diag */
+    double A[9];
+    for (int k = 0; k < 9; k++) A[k] = 0.2 * (rnd() - 0.5);
+    for (int r = 0; r < 3; r++)
+      for (int s = 0; s < 3; s++) {
+        double t = 0;
+        for (int k = 0; k < 3; k++) t += A[3 * r + k] * A[3 * s + k];
+        c[i].G[3 * r + s] = t + (r == s ? 0.05 + 0.1 * rnd() : 0);
+      }
+  }
+  long visits = 0;
+  double *ns = calloc((size_t)o->repeats, sizeof(double));
+  int bad_p = 0, bad_bound = 0, bad_align = 0, bad_power = 0;
+  for (int rep = 0; rep < o->repeats; rep++) {
+    double t0 = now();
+    for (int it = 0; it < o->steps; it++) {
+      for (int i = 0; i < N; i++) {
+        /* changing loads and slip speeds */
+        double ph = 0.01 * it + i;
+        v0[i][0] = -0.3 * (1 + sin(ph));
+        v0[i][1] = 0.2 * sin(1.3 * ph) * (i % 4 == 0 ? 1e-4 : 1);
+        v0[i][2] = 0.1 * cos(0.7 * ph);
+        if (!o->warm) c[i].lambda[0] = c[i].lambda[1] = c[i].lambda[2] = 0;
+        ss_solver_soil_point(&mat, dt, &c[i], v0[i], tol);
+      }
+    }
+    double el = now() - t0;
+    visits = (long)o->steps * N;
+    ns[rep] = 1e9 * el / visits;
+    /* verify the last solutions: pressure, feasibility, alignment, power */
+    for (int i = 0; i < N; i++) {
+      const ssContact *p = &c[i];
+      double v[3];
+      for (int k = 0; k < 3; k++)
+        v[k] = v0[i][k] + p->G[3 * k] * p->lambda[0] + p->G[3 * k + 1] * p->lambda[1] +
+               p->G[3 * k + 2] * p->lambda[2];
+      double sc = p->area * dt, delta = -(p->g0 + dt * v[0]);
+      double pn = ss_soil_pressure(&mat, p->width, p->sp + delta, p->sp) + ss_soil_viscous(&mat, -v[0]);
+      if (fabs(p->lambda[0] - sc * pn) > 1e-9 * (sc * pn) + 1e-18) bad_p++;
+      double vt = hypot(v[1], v[2]), lt = hypot(p->lambda[1], p->lambda[2]);
+      double tmax = sc * ss_soil_shear_limit(&mat, p->lambda[0] / sc, p->j + dt * vt);
+      if (lt > tmax * (1 + 1e-9) + 1e-18) bad_bound++;
+      double pw = p->lambda[1] * v[1] + p->lambda[2] * v[2];
+      if (pw > 1e-12 * lt * (vt + 1e-12)) bad_power++;
+      if (vt > 1e-9 && lt > 0 && 1 + pw / (lt * vt) > 1e-6) bad_align++;
+    }
+  }
+  double med = median(ns, o->repeats);
+  free(ns);
+  printf("contact law  %-9s %-4s %d contacts x %d iterations x %d: %7.1f ns per contact visit\n",
+         o->linear ? "linear" : "nonlinear", o->warm ? "warm" : "cold", N, o->steps, o->repeats, med);
+  int good = !bad_p && !bad_bound && !bad_align && !bad_power;
+  printf("checks: normal pressure %s, shear within tau_max %s, shear opposes slip %s, "
+         "never adds energy %s\n", bad_p ? "FAILED" : "ok", bad_bound ? "FAILED" : "ok",
+         bad_align ? "FAILED" : "ok", bad_power ? "FAILED" : "ok");
+  csv_row(o, "contact_law", 0, med, 0, good ? 0 : 1);
+  return good ? 0 : 1;
+}
+
+int bench_terrain(int argc, char **argv)
+{
+  Opt o = {"rigid", 1, 0, 0, 0, 5, 1, NULL, NULL, 0};
+  for (int i = 0; i < argc; i++) {
+    const char *a = argv[i];
+    if (!strcmp(a, "--")) continue;
+    if (!strncmp(a, "--body=", 7)) o.body = a + 7;
+    else if (!strcmp(a, "--start=warm")) o.warm = 1;
+    else if (!strcmp(a, "--start=cold")) o.warm = 0;
+    else if (!strcmp(a, "--contact-law")) o.contact_law = 1;
+    else if (!strcmp(a, "--material=linear")) o.linear = 1;
+    else if (!strcmp(a, "--material=nonlinear")) o.linear = 0;
+    else if (!strncmp(a, "--steps=", 8)) o.steps = atoi(a + 8);
+    else if (!strncmp(a, "--repeats=", 10)) o.repeats = atoi(a + 10);
+    else if (!strncmp(a, "--bed-scale=", 12)) o.bed_scale = atoi(a + 12);
+    else if (!strncmp(a, "--csv=", 6)) o.csv = a + 6;
+    else if (!strncmp(a, "--scene=", 8)) o.scene = a + 8;
+    else if (!strcmp(a, "--verify")) o.verify = 1;
+    else if (!strcmp(a, "--raisim") || !strcmp(a, "--soilsim")) continue;
+    else {
+      fprintf(stderr, "benchmarks: unknown option '%s'\n"
+                      "options: --body=rigid|articulated|pinned|multilink|buggy "
+                      "--start=warm|cold --contact-law --material=linear|nonlinear "
+                      "--steps=N --repeats=R --bed-scale=K --csv=FILE --scene=FILE --verify\n", a);
+      return 2;
+    }
+  }
+  if (o.repeats < 1 || o.bed_scale < 1) {
+    fprintf(stderr, "benchmarks: --repeats and --bed-scale must be >= 1\n");
+    return 2;
+  }
+  if (!o.steps) o.steps = o.contact_law ? 2000 : !strcmp(o.body, "buggy") ? 2000 : 1500;
+  if (o.csv) {
+    FILE *f = fopen(o.csv, "r");
+    if (!f) {
+      f = fopen(o.csv, "w");
+      if (f) {
+        fprintf(f, "case,body,start,material,steps,repeats,ms_per_step,ns_per_point,"
+                   "sweeps_per_step,error\n");
+        fclose(f);
+      }
+    } else {
+      fclose(f);
+    }
+  }
+  return o.contact_law ? bench_contact_law(&o) : bench_bodies(&o);
+}

@@ -1,0 +1,27 @@
+#!/bin/sh
+# test_bench.sh -- the benchmark program's own checks on short runs
+# (correctness only, never timing): the contact-law checks for both
+# materials, warm and cold starts reaching the same converged answer, and
+# the bodies of DESIGN 8 settling at the analytic sinkage.
+top_builddir=${top_builddir:-.}
+BENCH="$top_builddir/benchmarks"
+n=0
+nfail=0
+check() {
+  n=$((n + 1))
+  if out=$("$BENCH" --bench deformable_terrain -- "$@" 2>&1); then
+    echo "ok $n - benchmarks $*"
+  else
+    echo "not ok $n - benchmarks $*"
+    nfail=$((nfail + 1))
+  fi
+  printf '%s\n' "$out" | sed 's/^/# /'
+}
+check --contact-law --material=linear --steps=300 --repeats=1
+check --contact-law --material=nonlinear --steps=300 --repeats=1
+check --contact-law --material=nonlinear --start=cold --steps=300 --repeats=1
+check --body=rigid --steps=1500 --repeats=1 --verify
+check --body=articulated --steps=1500 --repeats=1 --verify
+check --body=multilink --steps=1500 --repeats=1 --verify
+echo "1..$n"
+[ "$nfail" -eq 0 ]

@@ -1,0 +1,32 @@
+/* worlds.h -- worlds built in code for the tests and the benchmarks. */
+#ifndef SS_TEST_WORLDS_H
+#define SS_TEST_WORLDS_H
+
+#include "soilsim.h"
+#include "urdf.h"
+
+extern const double W_X[3], W_Y[3], W_Z[3];
+/* pad centres of fourpad64(), frame coordinates */
+extern const double FOURPAD_CX[4], FOURPAD_CY[4];
+
+/* an in-memory URDF (room for 64 links/joints, 16 closures and springs) */
+ssUrdf *urdf_new(void);
+void urdf_free(ssUrdf *u);
+int add_link(ssUrdf *u, const char *name, double m, const double com[3],
+             double ix, double iy, double iz);
+void add_box(ssUrdf *u, int link, double x, double y, double z,
+             const double pos[3]);
+int add_joint(ssUrdf *u, const char *name, int type, int parent, int child,
+              const double pos[3], const double axis[3]);
+/* a flat size x size soil bed at spacing h with the soil of DESIGN 2.7
+ * (k_c 0, k_phi 1e5, n 1, K_e 2e6) and D = 1e4 so the plate settles
+ * without overshoot */
+int add_soil_bed(ssModel *m, double size, double h);
+/* a chain of nlinks sprung revolute joints standing on link `on` */
+int add_mast(ssUrdf *u, int on, int nlinks, double mass, const double at[3]);
+/* the articulated bodies of DESIGN 8, each 20 kg on 0.24 m^2 */
+ssUrdf *carrier60(void);
+ssUrdf *carrier60_pinned(void);
+ssUrdf *fourpad64(void);
+
+#endif
