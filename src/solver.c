@@ -27,16 +27,18 @@ static double soil_pressure(const ssSoilMaterial *mat, const ssContact *c,
     *dP = 0;
     return 0;
   }
-  double s = c->sp + delta;
-  double pe = mat->elastic_stiffness * delta;
-  double py = ss_soil_envelope(mat, c->width, s);
+  double s = c->sp + delta, n = mat->sinkage_exponent;
+  double k = (c->width > 0 ? mat->bekker_kc / c->width : 0) + mat->bekker_kphi;
+  /* one power for the envelope and its slope: s^n = s s^(n-1) */
+  double sn1 = n == 1.0 ? 1.0 : pow(s, n - 1);
+  double pe = mat->elastic_stiffness * delta, py = k * s * sn1;
   double p, slope;
   if (pe <= py) {
     p = pe;
     slope = mat->elastic_stiffness;
   } else {
     p = py;
-    slope = ss_soil_envelope_slope(mat, c->width, s);
+    slope = k * n * sn1;
   }
   double dpdv = -dt * slope;
   if (vn < 0) {
