@@ -12,15 +12,17 @@
  * Format, version 1.  Every integer is little-endian; every double is its
  * IEEE-754 bit pattern as a little-endian 64-bit integer (bit-exact).
  *
- *   header (32 bytes)
+ *   header (32 bytes; the same layout in every version)
  *     0   8  magic "SOILCKPT"
  *     8   4  u32 format version (1)
  *    12   4  u32 header size (32)
  *    16   8  u64 file size in bytes, trailer included
  *    24   4  u32 number of sections
- *    28   4  u32 reserved (0)
- *   sections, each: 4-byte ASCII tag, u32 reserved (0), u64 payload size,
- *   then the payload
+ *    28   4  u32 CRC-32 of bytes 0-27 (so that a damaged size field is
+ *              told from a truncated file)
+ *   sections, each a 4-byte ASCII tag, a u32 reserved word (0), the u64
+ *   payload size and the payload; written in this order, read in any order
+ *   but each exactly once:
  *     MODL  the model's fingerprint: u32 count of counts, the counts (u32
  *           each: nq nv nsys nbody ngeom nhfield nhfielddata npd neq nspring
  *           nplane nxforce nmaterial npair nmesh), u32 count of hashes, the
@@ -43,12 +45,14 @@
  *   trailer (8 bytes): "CRC " and the u32 CRC-32 (IEEE 802.3, as zlib's
  *   crc32) of every byte before the CRC itself.
  *
- * Reading checks, in order: signature, version, header, file size, checksum,
- * section table, model fingerprint, solver configuration, then every value
- * (finite, soil state consistent, indices in range, caches sorted).  Sizes
- * read from the file are compared with the model's counts before anything is
- * allocated, and the data is written only once everything has been read into
- * temporaries, so a refused file leaves the data as it was. */
+ * Reading checks, in order: signature, header checksum, version, file
+ * size, file checksum, section table, model fingerprint, solver
+ * configuration, then every value (finite, soil state consistent, indices
+ * in range, caches sorted).  Sizes read from the file are compared with the
+ * model's counts before anything is allocated, and the data is written only
+ * once everything has been read into temporaries (and the data's caches
+ * have room), so a refused file leaves the data as it was.  The contacts of
+ * the last step are not saved: the next step rebuilds them. */
 #include "soilsim.h"
 #include "mesh.h"
 #include "scene.h"
@@ -188,8 +192,14 @@ static void fingerprint(const ssModel *m, Fingerprint *f)
   hash_ints(&h, m->body_sys, m->nbody);
   hash_ints(&h, m->body_parent, m->nbody);
   hash_ints(&h, m->body_jnttype, m->nbody);
-  hash_doubles(&h, m->body_jntpos, 3L * m->nbody);
-  hash_doubles(&h, m->body_jntquat, 4L * m->nbody);
+  /* a floating root's joint frame is only where the scene placed it (qpos
+   * holds its pose), and an export places it elsewhere: left out */
+  for (int b = 0; b < m->nbody; b++) {
+    int placement = m->body_parent[b] < 0 && m->body_jnttype[b] == SS_JOINT_FLOATING;
+    static const double none[7] = {0, 0, 0, 0, 0, 0, 0};
+    hash_doubles(&h, placement ? none : m->body_jntpos + 3 * b, 3);
+    hash_doubles(&h, placement ? none + 3 : m->body_jntquat + 4 * b, 4);
+  }
   hash_doubles(&h, m->body_jntaxis, 3L * m->nbody);
   hash_ints(&h, m->body_qadr, m->nbody);
   hash_ints(&h, m->body_dofadr, m->nbody);
@@ -401,7 +411,7 @@ ssStatus ss_checkpoint_save_buffer(const ssModel *m, const ssData *d,
   hd = w.n;
   w_u64(&w, 0); /* file size, patched below */
   w_u32(&w, NTAG);
-  w_u32(&w, 0);
+  w_u32(&w, 0); /* header checksum, patched below */
 
   s = section_begin(&w, S_MODL);
   w_u32(&w, NCOUNT);
@@ -478,7 +488,10 @@ ssStatus ss_checkpoint_save_buffer(const ssModel *m, const ssData *d,
   section_end(&w, s);
 
   w_bytes(&w, "CRC ", 4);
-  if (!w.oom) put_le(w.p + hd, (uint64_t)(w.n + 4), 8);
+  if (!w.oom) {
+    put_le(w.p + hd, (uint64_t)(w.n + 4), 8);
+    put_le(w.p + 28, crc32_bytes(w.p, 28), 4);
+  }
   if (!w.oom) w_u32(&w, crc32_bytes(w.p, w.n));
   if (w.oom) {
     free(w.p);
@@ -584,8 +597,6 @@ static void r_options(Reader *r, ssOption *o)
   o->rigid_erp = r_f64(r);
 }
 
-
-
 /* sizes of the fixed-size sections (bytes) */
 #define OPTS_BYTES (8u * 4 + 4 + 8 + 8 + 4 + 8 + 8)
 #define CLCK_BYTES 24u
@@ -619,10 +630,16 @@ static ssStatus parse_frame(const unsigned char *p, size_t len,
   if (memcmp(p, CKPT_MAGIC, nm))
     return ss_error_set(err, SS_ERR_PARSE, path, 0,
                         "not a soilsim checkpoint (no SOILCKPT signature)");
-  if (len < CKPT_HEADER + CKPT_TRAILER)
+  if (len < CKPT_HEADER)
     return ss_error_set(err, SS_ERR_PARSE, path, 0,
                         "checkpoint is truncated: %zu bytes, shorter than "
-                        "its header and trailer", len);
+                        "its header", len);
+  uint32_t hstored = (uint32_t)get_le(p + 28, 4), hcrc = crc32_bytes(p, 28);
+  if (hstored != hcrc)
+    return ss_error_set(err, SS_ERR_PARSE, path, 0,
+                        "checkpoint is corrupted: header checksum mismatch "
+                        "(stored %08lx, computed %08lx)",
+                        (unsigned long)hstored, (unsigned long)hcrc);
   uint32_t version = (uint32_t)get_le(p + 8, 4);
   if (version != CKPT_VERSION)
     return ss_error_set(err, SS_ERR_UNSUPPORTED, path, 0,
@@ -630,6 +647,9 @@ static ssStatus parse_frame(const unsigned char *p, size_t len,
                         "(this build reads version %u)",
                         (unsigned long)version, CKPT_VERSION);
   uint64_t size = get_le(p + 16, 8);
+  if (get_le(p + 12, 4) != CKPT_HEADER || size < CKPT_HEADER + CKPT_TRAILER)
+    return ss_error_set(err, SS_ERR_PARSE, path, 0,
+                        "checkpoint is corrupted: bad header");
   if (size > len)
     return ss_error_set(err, SS_ERR_PARSE, path, 0,
                         "checkpoint is truncated: %zu bytes, its header says "
@@ -637,7 +657,7 @@ static ssStatus parse_frame(const unsigned char *p, size_t len,
   if (size < len)
     return ss_error_set(err, SS_ERR_PARSE, path, 0,
                         "checkpoint is corrupted: %zu bytes, its header says "
-                        "%llu", len, (unsigned long long)size);
+                        "%llu (data appended?)", len, (unsigned long long)size);
   uint32_t stored = (uint32_t)get_le(p + len - 4, 4);
   uint32_t crc = crc32_bytes(p, len - 4);
   if (stored != crc || memcmp(p + len - CKPT_TRAILER, "CRC ", 4))
@@ -646,10 +666,7 @@ static ssStatus parse_frame(const unsigned char *p, size_t len,
                         "%08lx, computed %08lx)", (unsigned long)stored,
                         (unsigned long)crc);
   /* from here on the bytes are as written; what follows guards against a
-   * file written by something else that got its checksum right */
-  if (get_le(p + 12, 4) != CKPT_HEADER || get_le(p + 28, 4) != 0)
-    return ss_error_set(err, SS_ERR_PARSE, path, 0,
-                        "checkpoint is corrupted: bad header");
+   * file written by something else that got its checksums right */
   uint64_t nsec = get_le(p + 24, 4);
   size_t at = CKPT_HEADER, end = len - CKPT_TRAILER;
   int seen[NTAG] = {0};
@@ -941,6 +958,17 @@ static void *alloc0(size_t n, size_t size)
   return calloc(n ? n : 1, size);
 }
 
+/* Whether soil vertex v (an index into the soil arrays) lies on a soil bed
+ * rather than on a rigid height map. */
+static int soil_vertex(const ssModel *m, int v)
+{
+  for (int h = 0; h < m->nhfield; h++) {
+    int a = m->hfield_adr[h], n = m->hfield_nx[h] * m->hfield_ny[h];
+    if (v >= a && v < a + n) return m->hfield_soil[h];
+  }
+  return 0;
+}
+
 static ssStatus parse_state(const ssModel *m, const Parsed *f, const char *path,
                             State *s, ssError *err)
 {
@@ -994,20 +1022,25 @@ static ssStatus parse_state(const ssModel *m, const Parsed *f, const char *path,
     s->active[k] = *r_take(&r, 1);
     if (s->active[k] > 1) return corrupt(err, path, "bad section 'SYSA'");
   }
+  /* bed orientations are unit quaternions (ss_hfield_set_pose) */
   for (size_t h = 0; h < nh; h++) {
     const double *q = s->hquat + 4 * h;
-    if (!(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] > 0))
+    if (!(fabs(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] - 1) <= 1e-6))
       return corrupt(err, path, "bad section 'HQUA'");
   }
-  for (size_t k = 0; k < nhd; k++)
+  for (size_t k = 0; k < nhd; k++) {
+    if (!soil_vertex(m, (int)k) && (s->sink[k] != 0 || s->plas[k] != 0 || s->shea[k] != 0))
+      return corrupt(err, path, "soil state on a rigid height map");
     if (!(s->plas[k] >= 0 && s->sink[k] >= s->plas[k] && s->shea[k] >= 0))
       return corrupt(err, path, "soil state out of range (need 0 <= "
                      "plastic_sinkage <= sinkage, shear >= 0)");
+  }
 
   r = section(f, S_LOAD);
   for (int k = 0; k < s->nloaded; k++) {
     int v = r_i32(&r);
-    if (v < 0 || (size_t)v >= nhd || (k && v <= s->loaded[k - 1]))
+    if (v < 0 || (size_t)v >= nhd || (k && v <= s->loaded[k - 1]) ||
+        !soil_vertex(m, v))
       return corrupt(err, path, "bad loaded-vertex list");
     s->loaded[k] = v;
   }
@@ -1019,7 +1052,8 @@ static ssStatus parse_state(const ssModel *m, const Parsed *f, const char *path,
     e->geom = r_i32(&r);
     r_f64s(&r, e->traction, 3);
     int key_ok = e->geom >= 0
-                     ? (size_t)e->vertex < nhd && e->vertex >= 0 && e->geom < m->ngeom
+                     ? (size_t)e->vertex < nhd && e->vertex >= 0 &&
+                           e->geom < m->ngeom && soil_vertex(m, e->vertex)
                      : (e->geom == -2 || e->geom == -3) && e->vertex >= 0 &&
                            (size_t)e->vertex < 2 * nv;
     if (!key_ok || !isfinite(e->traction[0]) || !isfinite(e->traction[1]) ||

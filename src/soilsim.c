@@ -94,11 +94,13 @@ static void usage(FILE *out)
 "  --render-every K     render every K steps (default %ld; needs --render)\n"
 "  --size WxH           image size for --render and --rut-map (default %dx%d)\n"
 "  --rut-map FILE.png   write a top-down map of the final plastic sinkage\n"
-"  --checkpoint FILE@STEP  write a binary checkpoint after STEP (repeatable)\n"
-"  --restore FILE       start from a checkpoint written for the same scene\n"
-"  --solver-tolerance X  override the scene's solver tolerance, 0 < X < 1\n"
-"  --max-sweeps N       override the scene's Gauss-Seidel sweep cap (1..1000000)\n"
-"  --warm-start on|off  override the scene's terrain_warm_start\n"
+"  --checkpoint FILE@STEP\n"
+"                       write a binary checkpoint after step STEP (repeatable)\n"
+"  --restore FILE       start from a checkpoint of this scene's world\n"
+"  --solver-tolerance X\n"
+"                       solver tolerance, 0 < X < 1 (overrides the scene)\n"
+"  --max-sweeps N       Gauss-Seidel sweep cap, 1..1000000 (overrides the scene)\n"
+"  --warm-start on|off  terrain warm start (overrides the scene)\n"
 "  -q, --quiet          no progress line and no summary; errors only\n"
 "  -h, --help           show this help and exit\n"
 "  -V, --version        show the version and exit\n"
@@ -420,6 +422,9 @@ static int parse_args(int argc, char **argv, Options *o)
     }
   }
 
+  if (!o->scene && o->restore)
+    return usage_error("--restore needs the scene file as well: a checkpoint "
+                       "holds the state of a world, not the world");
   if (!o->scene) return usage_error("no scene file given");
   if (o->render_every_given && !o->render_dir)
     return usage_error("--render-every needs --render DIR");

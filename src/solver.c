@@ -423,7 +423,7 @@ static ssStatus store_warm(const ssModel *m, ssData *d, ssError *err)
       e->traction[1] = e->traction[2] = 0;
     }
   }
-  qsort(d->warm, (size_t)n, sizeof *d->warm, cmp_warm);
+  if (n) qsort(d->warm, (size_t)n, sizeof *d->warm, cmp_warm);
   d->nwarm = n;
   return SS_OK;
 }

@@ -404,7 +404,7 @@ void ss_terrain_update(const ssModel *m, ssData *d)
     const ssContact *c = d->contact + i;
     if (c->type == SS_CONTACT_SOIL && c->loaded) d->soil_loaded[n++] = c->vertex;
   }
-  qsort(d->soil_loaded, (size_t)n, sizeof(int), cmp_int);
+  if (n) qsort(d->soil_loaded, (size_t)n, sizeof(int), cmp_int);
   int u = 0;
   for (int i = 0; i < n; i++)
     if (u == 0 || d->soil_loaded[u - 1] != d->soil_loaded[i])

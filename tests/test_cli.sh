@@ -345,5 +345,141 @@ run "$tmp/nosoil.xml" --steps 2000000000 --rut-map "$tmp/none.png"
 check "--rut-map on a scene without a soil bed: exit 1 before stepping" \
   'rc_is 1 && err_has "soil" && no_file "$tmp/none.png"'
 
+# ---------------------------------------------------------------------
+# checkpoints (DESIGN 5) and solver options from the command line
+
+run --help
+check "--help lists --checkpoint, --restore and the solver options" \
+  'rc_is 0 && out_has "--checkpoint" && out_has "--restore" &&
+   out_has "--solver-tolerance" && out_has "--max-sweeps" && out_has "--warm-start"'
+
+for v in x @5 x@ x@-1 x@1.5 x@y "x@ 5"; do
+  run "$PLATE" --steps 10 --checkpoint "$v"
+  check "--checkpoint '$v' is rejected (exit 2)" 'usage_error && err_has "--checkpoint"'
+done
+run "$PLATE" --steps 10 --checkpoint "$tmp/k.ckpt@11"
+check "--checkpoint after the last step: exit 2" \
+  'usage_error && err_has "k.ckpt@11" && no_file "$tmp/k.ckpt"'
+run "$PLATE" --steps 10 --checkpoint "$tmp/k.ckpt@3" --checkpoint "$tmp/k.ckpt@5"
+check "--checkpoint writing one file twice: exit 2" 'usage_error && no_file "$tmp/k.ckpt"'
+run "$PLATE" --steps 10 --checkpoint "$tmp/k.xml@3" --export "$tmp/k.xml"
+check "--checkpoint and --export on one path: exit 2" 'usage_error && no_file "$tmp/k.xml"'
+run "$PLATE" --steps 10 --restore
+check "--restore without a value: exit 2" 'usage_error && err_has "--restore"'
+run --restore "$tmp/k.ckpt" --steps 10
+check "--restore without a scene: exit 2, the scene is needed" \
+  'usage_error && err_has "needs the scene"'
+for v in 0 1 -0.1 1e0 abc nan inf 0x1p-3 1e-3x ""; do
+  run "$PLATE" --steps 10 --solver-tolerance "$v"
+  check "--solver-tolerance '$v' is rejected (exit 2)" 'usage_error && err_has "--solver-tolerance"'
+done
+for v in 0 -1 1000001 2.5 x; do
+  run "$PLATE" --steps 10 --max-sweeps "$v"
+  check "--max-sweeps '$v' is rejected (exit 2)" 'usage_error && err_has "--max-sweeps"'
+done
+for v in yes 1 ON true ""; do
+  run "$PLATE" --steps 10 --warm-start "$v"
+  check "--warm-start '$v' is rejected (exit 2)" 'usage_error && err_has "--warm-start"'
+done
+run "$PLATE" --steps 2000000000 --checkpoint /nonexistent/dir/k.ckpt@5
+check "unwritable --checkpoint path: exit 1 before stepping, names the path" \
+  'rc_is 1 && err_has "/nonexistent/dir/k.ckpt"'
+
+# the solver options from the command line reach the export
+run "$PLATE" --steps 5 --max-sweeps 7 --solver-tolerance 1e-6 --warm-start off \
+  --export "$tmp/opt.xml" --quiet
+check "--max-sweeps, --solver-tolerance, --warm-start override <contact_solver> in the export" \
+  'rc_is 0 && grep -q "<contact_solver max_sweeps=\"7\" tolerance=\"1e-06\"" "$tmp/opt.xml" &&
+   grep -q "terrain_warm_start=\"false\"" "$tmp/opt.xml"'
+
+# N steps straight = K steps, checkpoint, restore, N - K steps: identical
+# exports, identical final checkpoints, identical CSV rows
+roundtrip() { # SCENE N K NAME [EXTRA OPTIONS...]
+  rt_scene=$1 rt_n=$2 rt_k=$3 rt_name=$4
+  shift 4
+  rm -f "$tmp/$rt_name".*
+  run "$rt_scene" --steps "$rt_n" --export "$tmp/$rt_name.a.xml" --csv "$tmp/$rt_name.a.csv" \
+    --checkpoint "$tmp/$rt_name.k.ckpt@$rt_k" --checkpoint "$tmp/$rt_name.n.ckpt@$rt_n" --quiet "$@"
+  rt_rc1=$rc
+  run "$rt_scene" --steps $((rt_n - rt_k)) --restore "$tmp/$rt_name.k.ckpt" \
+    --export "$tmp/$rt_name.b.xml" --csv "$tmp/$rt_name.b.csv" \
+    --checkpoint "$tmp/$rt_name.m.ckpt@$((rt_n - rt_k))" --quiet "$@"
+  [ "$rt_rc1" -eq 0 ] && rc_is 0 && cmp -s "$tmp/$rt_name.a.xml" "$tmp/$rt_name.b.xml"
+}
+csv_tail_same() { # NAME K: rows after step K of the straight run = the restored run's rows
+  sed "1,$(($2 + 1))d" "$tmp/$1.a.csv" | cut -d, -f2- >"$tmp/$1.ta"
+  sed 1d "$tmp/$1.b.csv" | cut -d, -f2- >"$tmp/$1.tb"
+  [ -s "$tmp/$1.ta" ] && cmp -s "$tmp/$1.ta" "$tmp/$1.tb"
+}
+check "plate: 100 steps = 40, --checkpoint, --restore, 60: byte-identical exports" \
+  'roundtrip "$PLATE" 100 40 plate'
+check "plate: the final checkpoints of both runs are byte-identical" \
+  'cmp -s "$tmp/plate.n.ckpt" "$tmp/plate.m.ckpt"'
+check "plate: the restored run's CSV rows (time continuing from 0.04 s) equal rows 41..100" \
+  'csv_tail_same plate 40 && sed -n 2p "$tmp/plate.b.csv" | grep -q "^1,0\.041"'
+check "plate with --warm-start off: byte-identical exports after a restore" \
+  'roundtrip "$PLATE" 80 30 platecold --warm-start off && csv_tail_same platecold 30'
+check "plate_arm (articulated, PD, closure): 40 steps = 15 + restore + 25, identical exports" \
+  'roundtrip "$top_srcdir/scenes/plate_arm.xml" 40 15 arm && csv_tail_same arm 15'
+check "plate_arm with --warm-start off: identical exports after a restore" \
+  'roundtrip "$top_srcdir/scenes/plate_arm.xml" 30 10 armcold --warm-start off'
+# a plate dragged by a horizontal force through the soil
+sed -e 's|<state pos="0 0 0.025" quat="1 0 0 0" lin_vel="0 0 0" ang_vel="0 0 0"/>|&<external_force force="120 0 0" torque="0 0 0" start="0.02"/>|' \
+  "$PLATE" >"$tmp/dragged.xml"
+check "dragged plate: 120 steps = 70 + restore + 50, identical exports" \
+  'grep -q external_force "$tmp/dragged.xml" && roundtrip "$tmp/dragged.xml" 120 70 drag &&
+   csv_tail_same drag 70'
+check "the buggy (closures, coil-overs, PD drive on soil): 60 steps = 25 + restore + 35" \
+  'roundtrip "$top_srcdir/scenes/buggy.xml" 60 25 buggy && csv_tail_same buggy 25'
+# the same world as an export: a checkpoint restores into it
+run "$top_srcdir/scenes/plate_arm.xml" --steps 10 --export "$tmp/armx.xml" \
+  --checkpoint "$tmp/armx.ckpt@10" --quiet
+run "$tmp/armx.xml" --steps 5 --restore "$tmp/armx.ckpt" --export "$tmp/armx1.xml" --quiet
+rc1=$rc
+run "$top_srcdir/scenes/plate_arm.xml" --steps 15 --export "$tmp/armx2.xml" --quiet
+check "a checkpoint restores into an export of its world (plate_arm): identical to 15 steps straight" \
+  '[ "$rc1" -eq 0 ] && rc_is 0 && cmp -s "$tmp/armx1.xml" "$tmp/armx2.xml"'
+run "$PLATE" --steps 0 --checkpoint "$tmp/zero.ckpt@0" --export "$tmp/zero0.xml" --quiet
+run "$PLATE" --steps 0 --restore "$tmp/zero.ckpt" --export "$tmp/zero1.xml" --quiet
+check "--checkpoint FILE@0 holds the initial state; restoring it changes nothing" \
+  'rc_is 0 && cmp -s "$tmp/zero0.xml" "$tmp/zero1.xml"'
+
+# the checkpoint carries the solver configuration; the command line still wins
+run "$PLATE" --steps 10 --max-sweeps 7 --checkpoint "$tmp/opt.ckpt@10" --quiet
+run "$PLATE" --steps 5 --restore "$tmp/opt.ckpt" --export "$tmp/opt1.xml" --quiet
+check "restoring applies the checkpoint's solver options (max_sweeps 7 in the export)" \
+  'rc_is 0 && grep -q "max_sweeps=\"7\"" "$tmp/opt1.xml"'
+run "$PLATE" --steps 5 --restore "$tmp/opt.ckpt" --max-sweeps 9 --export "$tmp/opt2.xml" --quiet
+check "--max-sweeps given with --restore overrides the checkpoint's" \
+  'rc_is 0 && grep -q "max_sweeps=\"9\"" "$tmp/opt2.xml"'
+
+# damaged, foreign and mismatched checkpoints: exit 1, a clear message, no outputs
+ck="$tmp/plate.k.ckpt"
+corrupt_at() { # OFFSET OUT: a copy of $ck with one byte changed
+  cp "$ck" "$2" && printf 'Z' | dd of="$2" bs=1 seek="$1" conv=notrunc 2>/dev/null
+}
+size=$(wc -c <"$ck" | tr -d ' ')
+for off in 0 9 17 40 100 5000 $((size / 2)) $((size - 6)) $((size - 2)); do
+  corrupt_at "$off" "$tmp/bad.ckpt"
+  rm -f "$tmp/bad.xml"
+  run "$PLATE" --steps 5 --restore "$tmp/bad.ckpt" --export "$tmp/bad.xml"
+  check "a checkpoint with byte $off of $size changed: exit 1, clear message, no export" \
+    'rc_is 1 && err_has "bad.ckpt" && err_has "error:" &&
+     { err_has "corrupted" || err_has "not a soilsim checkpoint" || err_has "version"; } &&
+     no_file "$tmp/bad.xml" && no_tmp "$tmp"'
+done
+head -c $((size - 100)) "$ck" >"$tmp/short.ckpt"
+run "$PLATE" --steps 5 --restore "$tmp/short.ckpt" --export "$tmp/bad.xml"
+check "a truncated checkpoint: exit 1, 'truncated'" \
+  'rc_is 1 && err_has "short.ckpt" && err_has "truncated" && no_file "$tmp/bad.xml"'
+run "$PLATE" --steps 5 --restore "$PLATE"
+check "a scene file given to --restore: exit 1, 'not a soilsim checkpoint'" \
+  'rc_is 1 && err_has "not a soilsim checkpoint"'
+run "$top_srcdir/scenes/plate_arm.xml" --steps 5 --restore "$ck" --export "$tmp/bad.xml"
+check "a checkpoint of another scene: exit 1, 'written for a different world'" \
+  'rc_is 1 && err_has "written for a different world" && no_file "$tmp/bad.xml"'
+run "$PLATE" --steps 5 --restore "$tmp/no-such.ckpt"
+check "a missing checkpoint: exit 1 naming it" 'rc_is 1 && err_has "no-such.ckpt"'
+
 echo "1..$n"
 [ "$nfail" -eq 0 ]
