@@ -13,7 +13,7 @@
 set -e
 
 PACKAGES="build-essential autoconf automake pkg-config libxml2-dev \
-libassimp-dev libpng-dev libosmesa6-dev libfreetype-dev fonts-dejavu-core"
+libassimp-dev libpng-dev libosmesa6-dev libegl-dev libfreetype-dev fonts-dejavu-core"
 
 say() { printf 'setup: %s\n' "$*"; }
 die() { printf 'setup: error: %s\n' "$*" >&2; exit 1; }

@@ -13,12 +13,15 @@
 #include "png_io.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <png.h>
 #include <setjmp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 /* 2^28 pixels: a 16384 x 16384 image, the largest we ever need to read. */
 #define SS_PNG_MAX_PIXELS (1L << 28)
@@ -132,10 +135,27 @@ static ssStatus read_png(pngCtx *c, const char *path, ssError *err)
   memset(c, 0, sizeof *c);
   c->path = path;
   if (!path) return ss_error_set(err, SS_ERR_VALUE, "", 0, "no PNG path given");
-  c->fp = fopen(path, "rb");
-  if (!c->fp)
+  /* O_NONBLOCK: opening a FIFO must not wait for a writer (it would hang
+   * for ever); anything but a regular file is refused */
+  int fd = open(path, O_RDONLY | O_NONBLOCK);
+  if (fd < 0)
     return ss_error_set(err, SS_ERR_IO, path, 0, "cannot open PNG file: %s",
                         strerror(errno));
+  struct stat sb;
+  if (fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) {
+    close(fd);
+    return ss_error_set(err, SS_ERR_IO, path, 0,
+                        "cannot read PNG file: not a regular file");
+  }
+  int fl = fcntl(fd, F_GETFL);
+  if (fl != -1) fcntl(fd, F_SETFL, fl & ~O_NONBLOCK);
+  c->fp = fdopen(fd, "rb");
+  if (!c->fp) {
+    int e = errno;
+    close(fd);
+    return ss_error_set(err, SS_ERR_IO, path, 0, "cannot open PNG file: %s",
+                        strerror(e));
+  }
 
   unsigned char sig[8];
   size_t got = fread(sig, 1, sizeof sig, c->fp);
@@ -298,12 +318,20 @@ static int encode_png(pngWriteCtx *c, FILE *fp, int w, int h,
 {
   if (setjmp(png_jmpbuf(c->png))) return 1;
   png_init_io(c->png, fp);
+  /* opaque images (every rendered frame) are stored as RGB: a quarter less
+   * to compress and to store; they decode to the same RGBA pixels */
+  int opaque = 1;
+  size_t n = (size_t)w * (size_t)h;
+  for (size_t k = 0; k < n && opaque; k++) opaque = rgba[4 * k + 3] == 255;
   png_set_IHDR(c->png, c->info, (png_uint_32)w, (png_uint_32)h, 8,
-               PNG_COLOR_TYPE_RGB_ALPHA, PNG_INTERLACE_NONE,
-               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+               opaque ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGB_ALPHA,
+               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+               PNG_FILTER_TYPE_DEFAULT);
   /* fast, still well compressed: rendered frames are written often */
   png_set_compression_level(c->png, 3);
   png_write_info(c->png, c->info);
+  /* the rows stay RGBA in memory; libpng drops the fourth byte */
+  if (opaque) png_set_filler(c->png, 0, PNG_FILLER_AFTER);
   for (int y = 0; y < h; y++)
     png_write_row(c->png, (png_const_bytep)(rgba + (size_t)y * (size_t)w * 4));
   png_write_end(c->png, NULL);
@@ -339,10 +367,17 @@ ssStatus ss_png_write_rgba(const char *path, int w, int h,
     return ss_error_set(err, SS_ERR_NOMEM, path, 0,
                         "out of memory starting the PNG encoder");
   }
+  errno = 0;
   int rc = encode_png(&c, (FILE *)af.fp, w, h, rgba);
+  /* libpng says only "Write Error" when fwrite fails: the system's reason
+   * (a full disk, say) is in errno */
+  int write_errno = rc != 0 && ferror((FILE *)af.fp) ? errno : 0;
   png_destroy_write_struct(&c.png, &c.info);
   if (rc != 0) {
     ss_atomic_abort(&af);
+    if (write_errno)
+      return ss_error_set(err, SS_ERR_IO, path, 0, "cannot write PNG file: %s",
+                          strerror(write_errno));
     return ss_error_set(err, SS_ERR_IO, path, 0, "cannot write PNG file: %s",
                         c.msg[0] ? c.msg : "encoder error");
   }

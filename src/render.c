@@ -5,18 +5,24 @@
  * on llvmpipe) with client-side vertex arrays.  A bed is cut into tiles of
  * SS_TILE cells; tiles outside the view frustum are neither updated nor
  * drawn, so a camera following a vehicle over a large bed only pays for
- * what it sees.  Overlays (caption, colour bar) are drawn in software on
- * the frame read back from GL, with the same code the rut map uses.
+ * what it sees.  Bodies are drawn from their visual geoms (primitives
+ * tessellated, meshes from the model's ssMesh), or from their colliders
+ * when they have no visual; all of a frame's bodies are placed in world
+ * coordinates on the CPU and drawn in one call.  Overlays (caption, colour
+ * bar) are drawn in software on the frame read back from GL, with the same
+ * code the rut map uses.
  *
  * The rut map needs no GL: it is rasterized in software, one bilinear
  * sample of the vertex values per pixel. */
 #include "render.h"
 
+#include "mesh.h"
 #include "png_io.h"
 #include "ss_math.h"
 
 #include <GL/gl.h>
 #include <float.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -34,6 +40,9 @@
 /* Side of the square drawn for a rigid ground plane: at least this, or
  * several times the scene's extent (m). */
 #define SS_PLANE_MIN_SIZE 200.0
+/* Visual meshes (mesh_prepare): faces more than 40 degrees apart meet at a
+ * sharp edge. */
+#define SS_CREASE_COS 0.76604444311897804
 
 /* ---------------------------------------------------------------------- */
 /* colour map: a reversed inferno-like ramp, pale yellow -> dark violet,
@@ -321,6 +330,10 @@ struct ssRenderer {
   bedCache *bed;          /* (nhfield) */
   unitMesh box, sphere, cyl;
   geomBatch *solid, *glass; /* bodies of this frame: opaque, translucent */
+  int nmesh;              /* model meshes prepared for drawing */
+  unitMesh *vmesh;        /* (nmesh) one vertex per triangle corner */
+  unsigned char *body_vis; /* (nbody) 1: the body has a visual geom */
+  int cap_body;
   /* camera source */
   int cam_mode;           /* 0: automatic, 1: options, 2: model */
   int follow_body;        /* -1: none */
@@ -574,6 +587,177 @@ static ssStatus bed_build(bedCache *b, const ssModel *m, int h, ssError *err)
   return SS_OK;
 }
 
+/* A model mesh ready for batch_add: one vertex per triangle corner.  An
+ * ssMesh's vertex normals are smoothed across every edge (assimp's or
+ * mesh.c's area-weighted average), which is right for a lathed wheel and
+ * wrong at a box's corners.  So a vertex where faces meet at a sharp edge
+ * (more than the crease angle, SS_CREASE_COS, apart) gets, at each corner,
+ * the area-weighted normal of the faces around it within the crease angle
+ * of that corner's face; a vertex with no sharp edge keeps the mesh's own
+ * normal.  A flat face thus shows exactly its lit colour, and round shapes
+ * stay smooth. */
+static int mesh_prepare(unitMesh *u, const ssMesh *me)
+{
+  memset(u, 0, sizeof *u);
+  if (!me || me->ntri <= 0 || me->nvert <= 0 || !me->vert || !me->tri) return 1;
+  if (me->ntri > INT_MAX / 3) return 0;
+  int nt = me->ntri, nv = me->nvert;
+  for (int i = 0; i < 3 * nt; i++)
+    if (me->tri[i] < 0 || me->tri[i] >= nv) return 1; /* not drawable */
+  double *fn = malloc(sizeof(double) * 3 * (size_t)nt);
+  int *start = calloc((size_t)nv + 1, sizeof(int));
+  int *adj = malloc(sizeof(int) * 3 * (size_t)nt);
+  int ok = fn && start && adj && mesh_alloc(u, 3 * nt, 3 * nt);
+  if (ok) {
+    /* area-weighted face normals (length = twice the area) */
+    for (int t = 0; t < nt; t++) {
+      const int *f = me->tri + 3 * t;
+      double e1[3], e2[3];
+      ss_v3_sub(e1, me->vert + 3 * f[1], me->vert + 3 * f[0]);
+      ss_v3_sub(e2, me->vert + 3 * f[2], me->vert + 3 * f[0]);
+      ss_v3_cross(fn + 3 * t, e1, e2);
+    }
+    /* triangles around each vertex */
+    for (int i = 0; i < 3 * nt; i++) start[me->tri[i] + 1]++;
+    for (int v = 0; v < nv; v++) start[v + 1] += start[v];
+    int *fill = malloc(sizeof(int) * (size_t)nv);
+    if (!fill) {
+      ok = 0;
+    } else {
+      memcpy(fill, start, sizeof(int) * (size_t)nv);
+      for (int i = 0; i < 3 * nt; i++) adj[fill[me->tri[i]]++] = i / 3;
+      free(fill);
+    }
+  }
+  if (!ok) {
+    free(fn);
+    free(start);
+    free(adj);
+    mesh_free(u);
+    return 0;
+  }
+  for (int t = 0; t < nt; t++) {
+    const int *f = me->tri + 3 * t;
+    double ft[3];
+    ss_v3_copy(ft, fn + 3 * t);
+    int has_face = ss_v3_normalize(ft) > 0;
+    for (int k = 0; k < 3; k++) {
+      int o = 3 * t + k, v = f[k];
+      const double *p = me->vert + 3 * v;
+      double n[3] = {0, 0, 0};
+      int sharp = 0;
+      if (has_face) {
+        for (int a = start[v]; a < start[v + 1]; a++) {
+          const double *g = fn + 3 * adj[a];
+          double gl = ss_v3_norm(g);
+          if (!(gl > 0)) continue;
+          if (ss_v3_dot(g, ft) >= SS_CREASE_COS * gl) ss_v3_add(n, n, g);
+          else sharp = 1;
+        }
+        if (!(ss_v3_normalize(n) > 0)) ss_v3_copy(n, ft);
+      }
+      const double *mn = me->normal ? me->normal + 3 * v : NULL;
+      if (mn && (!has_face || !sharp)) ss_v3_copy(n, mn);
+      if (!(ss_v3_norm(n) > 0.5)) ss_v3_set(n, 0, 0, 1);
+      put3(u->v, o, p[0], p[1], p[2]);
+      put3(u->n, o, n[0], n[1], n[2]);
+      u->idx[o] = (unsigned)o;
+    }
+  }
+  free(fn);
+  free(start);
+  free(adj);
+  return 1;
+}
+
+/* Prepare every mesh of the model (replacing what was there). */
+static ssStatus meshes_build(ssRenderer *r, const ssModel *m, ssError *err)
+{
+  for (int k = 0; k < r->nmesh; k++) mesh_free(&r->vmesh[k]);
+  free(r->vmesh);
+  r->vmesh = NULL;
+  r->nmesh = 0;
+  if (m->nmesh <= 0 || !m->mesh) return SS_OK;
+  r->vmesh = calloc((size_t)m->nmesh, sizeof *r->vmesh);
+  if (!r->vmesh)
+    return ss_error_set(err, SS_ERR_NOMEM, "", 0, "out of memory for meshes");
+  r->nmesh = m->nmesh;
+  for (int k = 0; k < m->nmesh; k++)
+    if (!mesh_prepare(&r->vmesh[k], m->mesh[k]))
+      return ss_error_set(err, SS_ERR_NOMEM, "", 0,
+                          "out of memory for drawing mesh %s",
+                          m->mesh_path && m->mesh_path[k] ? m->mesh_path[k] : "");
+  return SS_OK;
+}
+
+/* Which bodies have a visual geom (group bit 2): their collision-only
+ * geoms are hidden.  A body without one shows its colliders instead. */
+static ssStatus visibility_update(ssRenderer *r, const ssModel *m, ssError *err)
+{
+  if (m->nbody > r->cap_body) {
+    unsigned char *v = realloc(r->body_vis, (size_t)m->nbody);
+    if (!v) return ss_error_set(err, SS_ERR_NOMEM, "", 0, "out of memory");
+    r->body_vis = v;
+    r->cap_body = m->nbody;
+  }
+  if (m->nbody > 0) memset(r->body_vis, 0, (size_t)m->nbody);
+  for (int g = 0; g < m->ngeom; g++) {
+    int b = m->geom_body[g];
+    if (b >= 0 && b < m->nbody && m->geom_group && (m->geom_group[g] & 2))
+      r->body_vis[b] = 1;
+  }
+  return SS_OK;
+}
+
+/* Is geom g in this frame?  Its body's system is in the world, its pose
+ * is finite, and it is a visual geom, or a collider of a body without
+ * visual geoms (see visibility_update). */
+static int geom_drawn(const ssRenderer *r, const ssModel *m, const ssData *d,
+                      int g)
+{
+  int b = m->geom_body[g];
+  if (b < 0 || b >= m->nbody || b >= r->cap_body) return 0;
+  int grp = m->geom_group ? m->geom_group[g] : 3;
+  if (!(grp & (r->body_vis[b] ? 2 : 1))) return 0;
+  if (m->geom_type[g] == SS_GEOM_MESH) {
+    int k = m->geom_mesh ? m->geom_mesh[g] : -1;
+    if (k < 0 || k >= r->nmesh || r->vmesh[k].nv == 0) return 0;
+  }
+  int s = m->body_sys[b];
+  if (d->sys_active && !d->sys_active[s]) return 0;
+  for (int i = 0; i < 3; i++)
+    if (!isfinite(d->geom_xpos[3 * g + i])) return 0;
+  for (int i = 0; i < 9; i++)
+    if (!isfinite(d->geom_xmat[9 * g + i])) return 0;
+  return 1;
+}
+
+/* Radius of a sphere about the geom's origin that holds the whole geom. */
+static double geom_radius(const ssModel *m, int g)
+{
+  const double *s = m->geom_size + 3 * g;
+  switch (m->geom_type[g]) {
+  case SS_GEOM_BOX: return 0.5 * sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+  case SS_GEOM_SPHERE: return s[0];
+  case SS_GEOM_CYLINDER: return sqrt(s[0] * s[0] + 0.25 * s[1] * s[1]);
+  case SS_GEOM_MESH: {
+    int k = m->geom_mesh ? m->geom_mesh[g] : -1;
+    if (k < 0 || k >= m->nmesh || !m->mesh[k]) break;
+    const ssMesh *me = m->mesh[k];
+    double rad = 0;
+    for (int c = 0; c < 8; c++) {
+      double q[3] = {(c & 1) ? me->hi[0] : me->lo[0], (c & 2) ? me->hi[1] : me->lo[1],
+                     (c & 4) ? me->hi[2] : me->lo[2]};
+      double n = ss_v3_norm(q);
+      if (n > rad && isfinite(n)) rad = n;
+    }
+    return rad;
+  }
+  default: break;
+  }
+  return s[0] + 0.5 * s[1];
+}
+
 void ss_render_free(ssRenderer *r)
 {
   if (!r) return;
@@ -585,6 +769,9 @@ void ss_render_free(ssRenderer *r)
   mesh_free(&r->box);
   mesh_free(&r->sphere);
   mesh_free(&r->cyl);
+  for (int k = 0; k < r->nmesh; k++) mesh_free(&r->vmesh[k]);
+  free(r->vmesh);
+  free(r->body_vis);
   if (r->solid) batch_free(r->solid);
   if (r->glass) batch_free(r->glass);
   free(r->solid);
@@ -700,6 +887,10 @@ ssRenderer *ss_render_new(const ssModel *m, const ssRenderOptions *opt,
     ss_render_free(r);
     return NULL;
   }
+  if (meshes_build(r, m, err) != SS_OK || visibility_update(r, m, err) != SS_OK) {
+    ss_render_free(r);
+    return NULL;
+  }
   r->frame = malloc((size_t)r->w * (size_t)r->h * 4);
   r->solid = calloc(1, sizeof *r->solid);
   r->glass = calloc(1, sizeof *r->glass);
@@ -771,8 +962,8 @@ static double soil_value(const ssModel *m, const ssData *d, int h, size_t k,
 /* Overview of the first soil bed (else the first height map, else the
  * bodies): seen from its long side, 35 degrees above the horizon, at the
  * distance where its bounding box fills the view. */
-static void camera_auto(const ssModel *m, const ssData *d, double aspect,
-                        double fovy, camera *c)
+static void camera_auto(const ssRenderer *r, const ssModel *m,
+                        const ssData *d, double aspect, double fovy, camera *c)
 {
   int h = -1;
   for (int k = 0; k < m->nhfield && h < 0; k++)
@@ -812,10 +1003,8 @@ static void camera_auto(const ssModel *m, const ssData *d, double aspect,
     double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
     int any = 0;
     for (int g = 0; g < m->ngeom; g++) {
-      if (!d->sys_active[m->body_sys[m->geom_body[g]]]) continue;
-      const double *s = m->geom_size + 3 * g;
-      double rad = fmax(fmax(s[0], s[1]), s[2]);
-      if (m->geom_type[g] == SS_GEOM_CAPSULE) rad = s[0] + 0.5 * s[1];
+      if (!geom_drawn(r, m, d, g)) continue;
+      double rad = geom_radius(m, g);
       for (int i = 0; i < 3; i++) {
         lo[i] = fmin(lo[i], d->geom_xpos[3 * g + i] - rad);
         hi[i] = fmax(hi[i], d->geom_xpos[3 * g + i] + rad);
@@ -872,7 +1061,7 @@ static void camera_for_frame(const ssRenderer *r, const ssModel *m,
   if (!(fov_deg > 1 && fov_deg < 179)) fov_deg = 45;
   double fovy = fov_deg * SS_PI / 180;
   if (r->cam_mode == 0) {
-    camera_auto(m, d, aspect, fovy, c);
+    camera_auto(r, m, d, aspect, fovy, c);
   } else {
     const double *cp = r->cam_mode == 1 ? r->opt.camera_pos : m->camera_pos;
     const double *cl = r->cam_mode == 1 ? r->opt.camera_look_at : m->camera_look_at;
@@ -1134,7 +1323,14 @@ static int batch_geom(const ssRenderer *r, const ssModel *m, const ssData *d,
            batch_add(b, &r->sphere, R, p, sr, 0.5 * s[1], rgba) &&
            batch_add(b, &r->sphere, R, p, sr, -0.5 * s[1], rgba);
   }
-  default: /* meshes: a later issue */
+  case SS_GEOM_MESH: {
+    /* the mesh's vertices are already in the geom frame, scaled */
+    int k = m->geom_mesh[g];
+    if (k < 0 || k >= r->nmesh) return 1;
+    double one[3] = {1, 1, 1};
+    return batch_add(b, &r->vmesh[k], R, p, one, 0, rgba);
+  }
+  default:
     return 1;
   }
 }
@@ -1148,21 +1344,10 @@ static void batch_draw(const geomBatch *b)
   glDrawElements(GL_TRIANGLES, b->ni, GL_UNSIGNED_INT, b->idx);
 }
 
-static int geom_drawn(const ssModel *m, const ssData *d, int g)
-{
-  if (m->geom_type[g] == SS_GEOM_MESH) return 0;
-  int b = m->geom_body[g];
-  if (b < 0 || b >= m->nbody) return 0;
-  int s = m->body_sys[b];
-  if (d->sys_active && !d->sys_active[s]) return 0;
-  for (int i = 0; i < 3; i++)
-    if (!isfinite(d->geom_xpos[3 * g + i])) return 0;
-  return 1;
-}
-
 /* Scene bounds (world) for the depth range and the size of ground planes. */
-static void scene_bounds(const ssModel *m, const ssData *d, double smax,
-                         double lo[3], double hi[3])
+static void scene_bounds(const ssRenderer *r, const ssModel *m,
+                         const ssData *d, double smax, double lo[3],
+                         double hi[3])
 {
   for (int i = 0; i < 3; i++) {
     lo[i] = DBL_MAX;
@@ -1194,14 +1379,8 @@ static void scene_bounds(const ssModel *m, const ssData *d, double smax,
     }
   }
   for (int g = 0; g < m->ngeom; g++) {
-    if (!geom_drawn(m, d, g)) continue;
-    const double *s = m->geom_size + 3 * g;
-    double rad;
-    switch (m->geom_type[g]) {
-    case SS_GEOM_BOX: rad = 0.5 * sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]); break;
-    case SS_GEOM_SPHERE: rad = s[0]; break;
-    default: rad = s[0] + 0.5 * s[1]; break;
-    }
+    if (!geom_drawn(r, m, d, g)) continue;
+    double rad = geom_radius(m, g);
     for (int i = 0; i < 3; i++) {
       lo[i] = fmin(lo[i], d->geom_xpos[3 * g + i] - rad);
       hi[i] = fmax(hi[i], d->geom_xpos[3 * g + i] + rad);
@@ -1348,7 +1527,10 @@ ssStatus ss_render_pixels(ssRenderer *r, const ssModel *m, const ssData *d,
       ssStatus st = bed_build(&r->bed[h], m, h, err);
       if (st != SS_OK) return st;
     }
-  ssStatus st = ss_glctx_make_current(r->gl, err);
+  ssStatus st;
+  if (m->nmesh != r->nmesh && (st = meshes_build(r, m, err)) != SS_OK) return st;
+  if ((st = visibility_update(r, m, err)) != SS_OK) return st;
+  st = ss_glctx_make_current(r->gl, err);
   if (st != SS_OK) return st;
 
   /* colour scale: fixed, or the largest value seen so far made nice */
@@ -1366,7 +1548,7 @@ ssStatus ss_render_pixels(ssRenderer *r, const ssModel *m, const ssData *d,
 
   /* depth range from the scene's extent along the view direction */
   double lo[3], hi[3];
-  scene_bounds(m, d, smax_sink, lo, hi);
+  scene_bounds(r, m, d, smax_sink, lo, hi);
   double ext = 0;
   for (int i = 0; i < 3; i++) ext = fmax(ext, hi[i] - lo[i]);
   double plane_half = 0.5 * fmax(SS_PLANE_MIN_SIZE, 6 * ext);
@@ -1417,7 +1599,7 @@ ssStatus ss_render_pixels(ssRenderer *r, const ssModel *m, const ssData *d,
   r->solid->nv = r->solid->ni = 0;
   r->glass->nv = r->glass->ni = 0;
   for (int g = 0; g < m->ngeom; g++) {
-    if (!geom_drawn(m, d, g)) continue;
+    if (!geom_drawn(r, m, d, g)) continue;
     double a = m->geom_rgba[4 * g + 3];
     if (!batch_geom(r, m, d, g, a > 0 && a < 1 ? r->glass : r->solid))
       return ss_error_set(err, SS_ERR_NOMEM, "", 0, "out of memory for bodies");
@@ -1462,6 +1644,11 @@ ssStatus ss_render_frame(ssRenderer *r, const ssModel *m, const ssData *d,
   ssStatus st = ss_render_pixels(r, m, d, r->frame, err);
   if (st != SS_OK) return st;
   return ss_png_write_rgba(png_path, r->w, r->h, r->frame, err);
+}
+
+const char *ss_render_backend_name(const ssRenderer *r)
+{
+  return r ? ss_glctx_backend_name(r->gl) : "none";
 }
 
 /* Continuous pixel coordinates of world point p in the last frame (pixel

@@ -12,6 +12,11 @@
  *    straight up (world +Z) is lit with intensity exactly 1 and shows its
  *    own colour (a box's top face, a flat bed, a flat rut floor); slopes
  *    facing the sun are brighter (clamped), slopes facing away darker;
+ *  - bodies: a geom is drawn when it is a visual (geom_group bit 2), or a
+ *    collider (bit 1) of a body that has no visual geom at all; primitives
+ *    are tessellated, SS_GEOM_MESH geoms drawn from m->mesh with normals
+ *    that are smooth except across edges sharper than 40 degrees, so a
+ *    mesh's flat face pointing up shows exactly its geom_rgba colour;
  *  - overlays (caption, colour bar) never touch the outer SS_OVERLAY_MARGIN
  *    pixels of a 3-D frame, so the image corners show the clear colour (or
  *    the scene);
@@ -105,19 +110,36 @@ double ss_nice_ceil(double v);
  * up is world +y. */
 int ss_render_project(const ssRenderer *r, const double p[3], double *col,
                       double *row);
+/* The GL backend a renderer draws with: "OSMesa" or "EGL". */
+const char *ss_render_backend_name(const ssRenderer *r);
 
 /* ---------------------------------------------------------------------- */
-/* GL context (render_context.c): OSMesa today; an EGL surfaceless backend
- * can be added behind the same four calls. */
+/* GL context (render_context.c): OSMesa, or EGL surfaceless (EGL_MESA_
+ * platform_surfaceless, a context without surfaces drawing into a
+ * framebuffer object) where configure found libegl-dev.  The environment
+ * variable SOILSIM_GL=osmesa|egl picks one (and only that one is tried);
+ * otherwise the configure default (--with-gl) is tried first, then the
+ * other.  Both give the same pixels (Mesa's llvmpipe either way). */
 
 typedef struct ssGLContext ssGLContext;
+
+#define SS_GL_ENV "SOILSIM_GL"
 
 /* A context rendering width x height pixels (1 .. SS_RENDER_MAX_SIDE),
  * current on return.  NULL with err filled on failure. */
 ssGLContext *ss_glctx_new(int width, int height, ssError *err);
+/* The same with the backend named ("osmesa" or "egl"; NULL or "" = as
+ * ss_glctx_new: SOILSIM_GL, else the default, else the other). */
+ssGLContext *ss_glctx_new_backend(const char *key, int width, int height,
+                                  ssError *err);
+/* 1 if this build contains the backend ("osmesa", "egl"). */
+int ss_glctx_backend_built(const char *key);
+/* The configure default ("osmesa" or "egl"). */
+const char *ss_glctx_default_backend(void);
 ssStatus ss_glctx_make_current(ssGLContext *c, ssError *err);
 /* glFinish, then copy the frame (width*height*4, row 0 at the top). */
 ssStatus ss_glctx_read_rgba(ssGLContext *c, unsigned char *rgba, ssError *err);
+/* "OSMesa" or "EGL" ("none" for NULL). */
 const char *ss_glctx_backend_name(const ssGLContext *c);
 void ss_glctx_free(ssGLContext *c); /* accepts NULL */
 
