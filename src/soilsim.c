@@ -62,6 +62,10 @@ typedef struct Options {
   double solver_tolerance;
   long max_sweeps;
   int warm_start;           /* -1 not given, 0 off, 1 on */
+  double camera_pos[3], camera_look_at[3], camera_fov; /* 0 fov: default */
+  int camera_pos_given, camera_look_given;
+  const char *camera_follow;
+  int color;                /* 0 default, else ssColorMode + 1 */
 } Options;
 
 /* The progress line on stderr (only on a terminal, without --quiet and CI). */
@@ -94,6 +98,12 @@ static void usage(FILE *out)
 "  --render-every K     render every K steps (default %ld; needs --render)\n"
 "  --size WxH           image size for --render and --rut-map (default %dx%d)\n"
 "  --rut-map FILE.png   write a top-down map of the final plastic sinkage\n"
+"  --camera-pos X,Y,Z   camera position for --render (with --camera-look-at)\n"
+"  --camera-look-at X,Y,Z\n"
+"                       point the camera looks at\n"
+"  --camera-fov DEG     vertical field of view (default 45)\n"
+"  --camera-follow NAME keep the camera's offset to body or system NAME\n"
+"  --color MODE         bed colour: sinkage (default), plastic or soil\n"
 "  --checkpoint FILE@STEP\n"
 "                       write a binary checkpoint after step STEP (repeatable)\n"
 "  --restore FILE       start from a checkpoint of this scene's world\n"
@@ -179,7 +189,8 @@ static int parse_size(const char *s, int *w, int *h)
 enum {
   OPT_STEPS, OPT_EXPORT, OPT_CSV, OPT_REMOVE, OPT_RENDER, OPT_RENDER_EVERY,
   OPT_SIZE, OPT_RUT_MAP, OPT_QUIET, OPT_HELP, OPT_VERSION, OPT_CHECKPOINT,
-  OPT_RESTORE, OPT_SOLVER_TOLERANCE, OPT_MAX_SWEEPS, OPT_WARM_START
+  OPT_RESTORE, OPT_SOLVER_TOLERANCE, OPT_MAX_SWEEPS, OPT_WARM_START,
+  OPT_CAMERA_POS, OPT_CAMERA_LOOK_AT, OPT_CAMERA_FOV, OPT_CAMERA_FOLLOW, OPT_COLOR
 };
 
 static const struct OptionSpec {
@@ -203,6 +214,11 @@ static const struct OptionSpec {
   {"solver-tolerance", OPT_SOLVER_TOLERANCE, 1},
   {"max-sweeps", OPT_MAX_SWEEPS, 1},
   {"warm-start", OPT_WARM_START, 1},
+  {"camera-pos", OPT_CAMERA_POS, 1},
+  {"camera-look-at", OPT_CAMERA_LOOK_AT, 1},
+  {"camera-fov", OPT_CAMERA_FOV, 1},
+  {"camera-follow", OPT_CAMERA_FOLLOW, 1},
+  {"color", OPT_COLOR, 1},
 };
 
 static void options_free(Options *o)
@@ -229,6 +245,22 @@ static int parse_fraction(const char *s, double lo, double hi, double *out)
     return 0;
   *out = v;
   return 1;
+}
+
+/* "x,y,z" or "x y z": three finite numbers */
+static int parse_vec3(const char *s, double v[3])
+{
+  const char *p = s;
+  for (int k = 0; k < 3; k++) {
+    while (*p == ' ' || (k && *p == ',')) p++;
+    char *end;
+    errno = 0;
+    v[k] = strtod(p, &end);
+    if (end == p || errno || !isfinite(v[k])) return 0;
+    p = end;
+  }
+  while (*p == ' ') p++;
+  return *p == 0;
 }
 
 static int add_checkpoint(Options *o, const char *arg)
@@ -387,6 +419,30 @@ static int parse_args(int argc, char **argv, Options *o)
       size_given = 1;
       break;
     case OPT_RUT_MAP: o->rut_map = value; break;
+    case OPT_CAMERA_POS:
+      if (!parse_vec3(value, o->camera_pos))
+        return usage_error("invalid --camera-pos value '%s': expected X,Y,Z", value);
+      o->camera_pos_given = 1;
+      break;
+    case OPT_CAMERA_LOOK_AT:
+      if (!parse_vec3(value, o->camera_look_at))
+        return usage_error("invalid --camera-look-at value '%s': expected X,Y,Z", value);
+      o->camera_look_given = 1;
+      break;
+    case OPT_CAMERA_FOV:
+      if (!parse_fraction(value, 0, 180, &o->camera_fov))
+        return usage_error("invalid --camera-fov value '%s': expected degrees "
+                           "between 0 and 180 (exclusive)", value);
+      break;
+    case OPT_CAMERA_FOLLOW: o->camera_follow = value; break;
+    case OPT_COLOR:
+      if (!strcmp(value, "sinkage")) o->color = SS_COLOR_SINKAGE + 1;
+      else if (!strcmp(value, "plastic")) o->color = SS_COLOR_PLASTIC + 1;
+      else if (!strcmp(value, "soil")) o->color = SS_COLOR_SOIL + 1;
+      else
+        return usage_error("invalid --color value '%s' (allowed: sinkage, "
+                           "plastic, soil)", value);
+      break;
     case OPT_CHECKPOINT: {
       int rc = add_checkpoint(o, value);
       if (rc >= 0) return rc;
@@ -428,6 +484,11 @@ static int parse_args(int argc, char **argv, Options *o)
   if (!o->scene) return usage_error("no scene file given");
   if (o->render_every_given && !o->render_dir)
     return usage_error("--render-every needs --render DIR");
+  if (o->camera_pos_given != o->camera_look_given)
+    return usage_error("--camera-pos and --camera-look-at go together");
+  if ((o->camera_pos_given || o->camera_fov > 0 || o->camera_follow || o->color) &&
+      !o->render_dir)
+    return usage_error("--camera-* and --color need --render DIR");
   if (size_given && !o->render_dir && !o->rut_map)
     return usage_error("--size needs --render or --rut-map");
   for (int i = 0; i < o->nremoval; i++)
@@ -809,6 +870,31 @@ static int run(const Options *o)
     ropt.width = o->width;
     ropt.height = o->height;
   }
+  /* a camera from the command line replaces the scene's <camera> */
+  if (o->camera_pos_given) {
+    ropt.camera_given = 1;
+    memcpy(ropt.camera_pos, o->camera_pos, sizeof ropt.camera_pos);
+    memcpy(ropt.camera_look_at, o->camera_look_at, sizeof ropt.camera_look_at);
+    ropt.camera_fov_deg = o->camera_fov > 0 ? o->camera_fov : 45;
+    if (o->camera_follow)
+      snprintf(ropt.camera_follow, sizeof ropt.camera_follow, "%s", o->camera_follow);
+  } else if (o->camera_fov > 0 || o->camera_follow) {
+    /* adjust the scene's camera (or the automatic one) */
+    if (m->camera_given) {
+      ropt.camera_given = 1;
+      memcpy(ropt.camera_pos, m->camera_pos, sizeof ropt.camera_pos);
+      memcpy(ropt.camera_look_at, m->camera_look_at, sizeof ropt.camera_look_at);
+      ropt.camera_fov_deg = o->camera_fov > 0 ? o->camera_fov : m->camera_fov_deg;
+      snprintf(ropt.camera_follow, sizeof ropt.camera_follow, "%s",
+               o->camera_follow ? o->camera_follow : m->camera_follow);
+    } else if (o->camera_follow) {
+      ss_error_set(&err, SS_ERR_VALUE, o->scene, 0,
+                   "--camera-follow needs a camera: give --camera-pos and "
+                   "--camera-look-at, or a <camera> in the scene");
+      goto fail;
+    }
+  }
+  if (o->color) ropt.color_mode = o->color - 1;
   if (o->render_dir) {
     char probe[2048];
     snprintf(probe, sizeof probe, "%s/frame_probe.png", o->render_dir);

@@ -481,5 +481,23 @@ check "a checkpoint of another scene: exit 1, 'written for a different world'" \
 run "$PLATE" --steps 5 --restore "$tmp/no-such.ckpt"
 check "a missing checkpoint: exit 1 naming it" 'rc_is 1 && err_has "no-such.ckpt"'
 
+
+# a camera from the command line (DESIGN 6): replaces the scene's view
+run "$PLATE" --steps 0 --render "$tmp/camA" --size 160x90 --quiet
+run "$PLATE" --steps 0 --render "$tmp/camB" --size 160x90 --camera-pos 0,0,3 \
+  --camera-look-at 0,0.001,0 --camera-fov 30 --color soil --quiet
+check "--camera-pos/--camera-look-at/--camera-fov/--color render a different view" \
+  'rc_is 0 && [ -s "$tmp/camB/frame_000000.png" ] && ! cmp -s "$tmp/camA/frame_000000.png" "$tmp/camB/frame_000000.png"'
+run "$PLATE" --steps 0 --render "$tmp/camC" --camera-pos 0,0,3
+check "--camera-pos without --camera-look-at: exit 2" 'usage_error'
+run "$PLATE" --steps 0 --camera-fov 30
+check "--camera-fov without --render: exit 2" 'usage_error'
+run "$PLATE" --steps 5 --render "$tmp/camD" --camera-pos 0,0,3 --camera-look-at 0,0.001,0 \
+  --camera-follow nobody
+check "--camera-follow of an unknown body: exit 1 before stepping" \
+  'rc_is 1 && [ ! -e "$tmp/camD/frame_000005.png" ]'
+run "$PLATE" --steps 0 --render "$tmp/camE" --color rainbow
+check "--color with an unknown mode: exit 2" 'usage_error && err_has "rainbow"'
+
 echo "1..$n"
 [ "$nfail" -eq 0 ]
