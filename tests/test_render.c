@@ -936,6 +936,68 @@ static void test_gl_backends(void)
   free_world(&w);
 }
 
+/* the rut map of the plate scene itself (scenes/plate.xml simulated until
+ * the plate has settled): footprint pixels read the analytic 8.175 mm
+ * within the colour bar's resolution, pixels away from it read zero */
+static void test_plate_scene_rut_map(void)
+{
+  const char *top = getenv("top_srcdir");
+  char scene[1024];
+  snprintf(scene, sizeof scene, "%s/scenes/plate.xml", top && *top ? top : ".");
+  ssModel *m;
+  ssData *d;
+  ssError err;
+  ss_error_clear(&err);
+  ssStatus st = ss_scene_load(scene, &m, &d, &err);
+  if (!ok(st == SS_OK, "plate scene loads%s%s", st ? ": " : "", st ? err.message : ""))
+    return;
+  int steps_ok = 1;
+  for (int k = 0; k < 1500 && steps_ok; k++) steps_ok = ss_step(m, d, &err) == SS_OK;
+  int W = 480, H = 400;
+  const char *path = out_path("plate_ruts.png");
+  unsigned char *a = NULL;
+  int w2 = 0, h2 = 0;
+  if (!ok(steps_ok && ss_render_rut_map(m, d, -1, 0, W, H, path, &err) == SS_OK &&
+              ss_png_read_rgba(path, &w2, &h2, &a, &err) == SS_OK && w2 == W && h2 == H,
+          "plate scene: settled, rut map written and decoded at %dx%d", W, H)) {
+    free(a);
+    ss_data_free(d);
+    ss_model_free(m);
+    return;
+  }
+  double xs = m->hfield_size[0], ys = m->hfield_size[1];
+  int n = m->hfield_nx[0];
+  double h = xs / (n - 1), s_ref = 8.175e-3;
+  ssRutMapLayout L;
+  ss_rut_map_layout(W, H, xs, ys, &L);
+  double fs = ss_nice_ceil(s_ref), res = fs / (SS_CMAP_N - 1);
+  long n_in = 0, bad_in = 0, n_out = 0, bad_out = 0;
+  for (int row = L.map_y; row < L.map_y + L.map_h; row++)
+    for (int col = L.map_x; col < L.map_x + L.map_w; col++) {
+      double u = (col - L.map_x + 0.5) / L.map_w, v = 1 - (row - L.map_y + 0.5) / L.map_h;
+      double x = -xs / 2 + xs * u, y = -ys / 2 + ys * v;
+      const unsigned char *p = pix(a, W, col, row);
+      if (fabs(x) < 0.2 - h && fabs(y) < 0.3 - h) {
+        int d2;
+        double val = ss_colormap_inverse(p, &d2) * fs;
+        n_in++;
+        if (fabs(val - s_ref) > res) bad_in++;
+      } else if (fabs(x) > 0.2 + h || fabs(y) > 0.3 + h) {
+        n_out++;
+        if (p[0] != SS_CMAP_ZERO_R || p[1] != SS_CMAP_ZERO_G || p[2] != SS_CMAP_ZERO_B)
+          bad_out++;
+      }
+    }
+  ok(n_in > 1000 && bad_in == 0,
+     "plate scene rut map: %ld footprint pixels read 8.175 mm within %.3f mm (%ld off)",
+     n_in, res * 1e3, bad_in);
+  ok(n_out > 10000 && bad_out == 0, "plate scene rut map: %ld pixels off the plate read zero (%ld off)",
+     n_out, bad_out);
+  free(a);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 static void test_rut_map(void)
 {
   world w;
@@ -1174,6 +1236,7 @@ int main(void)
   test_buggy_visuals();
   test_gl_backends();
   test_rut_map();
+  test_plate_scene_rut_map();
   test_timing();
   if (!(keep && *keep)) {
     /* remove what we wrote */
