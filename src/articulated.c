@@ -966,20 +966,24 @@ int ss_model_add_articulated(ssModel *m, const ssUrdf *u, const ssArtDef *def,
     return -1;
   }
   int mat = ss_model_material(m, def->material);
+  if (mat < 0) {
+    ss_error_set(err, SS_ERR_NOMEM, f, line, "out of memory");
+    return -1;
+  }
+  /* a failure below removes everything this call added */
+  ssModelMark mark = ss_model_mark(m);
   int s = ss_model_push_sys(m, def->name, SS_SYS_ARTICULATED, nq, nv, line, err);
-  if (s < 0 || mat < 0) return -1;
+  if (s < 0) return -1;
   m->sys_fixed[s] = fixed;
   free(m->sys_source[s]);
   free(m->sys_resdir[s]);
   m->sys_source[s] = strdup(def->urdf_path ? def->urdf_path : u->path);
   m->sys_resdir[s] = strdup(def->res_dir ? def->res_dir : "");
-  if (!m->sys_source[s] || !m->sys_resdir[s]) {
-    ss_error_set(err, SS_ERR_NOMEM, f, line, "out of memory");
-    return -1;
-  }
   int *body_of = malloc((size_t)u->nlink * sizeof(int));
-  if (!body_of) {
+  if (!m->sys_source[s] || !m->sys_resdir[s] || !body_of) {
+    free(body_of);
     ss_error_set(err, SS_ERR_NOMEM, f, line, "out of memory");
+    ss_model_rollback(m, &mark);
     return -1;
   }
   for (int i = 0; i < u->nlink; i++) body_of[i] = -1;
@@ -1132,10 +1136,14 @@ int ss_model_add_articulated(ssModel *m, const ssUrdf *u, const ssArtDef *def,
 #undef LOCAL_POINT
   free(xp);
   free(body_of);
-  if (check_closures(m, s, err) != SS_OK) return -1;
+  if (check_closures(m, s, err) != SS_OK) {
+    ss_model_rollback(m, &mark);
+    return -1;
+  }
   return s;
 fail:
   free(body_of);
+  ss_model_rollback(m, &mark);
   return -1;
 }
 

@@ -540,6 +540,41 @@ int ss_model_push_pd(ssModel *m, int body, const double gain[3],
   return m->npd++;
 }
 
+ssModelMark ss_model_mark(const ssModel *m)
+{
+  ssModelMark k = {m->nsys, m->nbody, m->ngeom, m->nq, m->nv, m->neq,
+                   m->nspring, m->npd, m->nmesh};
+  return k;
+}
+
+void ss_model_rollback(ssModel *m, const ssModelMark *k)
+{
+  for (int i = k->nsys; i < m->nsys; i++) {
+    free(m->sys_name[i]);
+    free(m->sys_source[i]);
+    free(m->sys_resdir[i]);
+  }
+  for (int i = k->nbody; i < m->nbody; i++) {
+    free(m->body_name[i]);
+    free(m->body_jntname[i]);
+  }
+  for (int i = k->neq; i < m->neq; i++) free(m->eq_name[i]);
+  for (int i = k->nspring; i < m->nspring; i++) free(m->spring_name[i]);
+  for (int i = k->nmesh; i < m->nmesh; i++) {
+    ss_mesh_free(m->mesh[i]);
+    free(m->mesh_path[i]);
+  }
+  m->nsys = k->nsys;
+  m->nbody = k->nbody;
+  m->ngeom = k->ngeom;
+  m->nq = k->nq;
+  m->nv = k->nv;
+  m->neq = k->neq;
+  m->nspring = k->nspring;
+  m->npd = k->npd;
+  m->nmesh = k->nmesh;
+}
+
 int ss_model_add_body(ssModel *m, const ssBodyDef *def, ssError *err)
 {
   const char *f = m->source_path;
@@ -604,11 +639,15 @@ int ss_model_add_body(ssModel *m, const ssBodyDef *def, ssError *err)
     return -1;
   }
   int nv = def->is_static ? 0 : 6;
+  ssModelMark mark = ss_model_mark(m);
   int s = ss_model_push_sys(m, def->name, def->is_static ? SS_SYS_STATIC : SS_SYS_FREE,
                             7, nv, def->line, err);
   if (s < 0) return -1;
   int b = ss_model_push_body(m, s, def->name, "", -1, err);
-  if (b < 0) return -1;
+  if (b < 0) {
+    ss_model_rollback(m, &mark);
+    return -1;
+  }
   m->body_mass[b] = def->is_static ? 0 : def->mass;
   memcpy(m->body_inertia + 9 * b, I, sizeof I);
   m->body_inertia_given[b] = def->inertia_given;
@@ -620,8 +659,10 @@ int ss_model_add_body(ssModel *m, const ssBodyDef *def, ssError *err)
                     def->shape == SS_GEOM_BOX ? def->size[2] : 0};
   double zero[3] = {0, 0, 0}, ident[4] = {1, 0, 0, 0};
   if (ss_model_push_geom(m, b, def->shape, size, zero, ident, mat, def->rgba, 3,
-                         -1, err) < 0)
+                         -1, err) < 0) {
+    ss_model_rollback(m, &mark);
     return -1;
+  }
   double *q = m->qpos0 + m->sys_qadr[s];
   memcpy(q, def->pos, 3 * sizeof(double));
   memcpy(q + 3, def->quat, 4 * sizeof(double));

@@ -28,4 +28,14 @@ int ss_model_push_spring(ssModel *m, const char *name, int body1, int body2,
 int ss_model_push_pd(ssModel *m, int body, const double gain[3],
                      const double target[2], ssError *err);
 
+/* The builder's counts at one moment; a failed add rolls back to it, so a
+ * model never keeps half an object. */
+typedef struct ssModelMark {
+  int nsys, nbody, ngeom, nq, nv, neq, nspring, npd, nmesh;
+} ssModelMark;
+
+ssModelMark ss_model_mark(const ssModel *m);
+/* Free everything added since the mark and restore its counts. */
+void ss_model_rollback(ssModel *m, const ssModelMark *mark);
+
 #endif

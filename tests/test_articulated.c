@@ -302,6 +302,8 @@ static void test_fourbar(void)
   int s2 = ss_model_add_articulated(m2, u, &def, &e);
   ok(s2 < 0 && e.line == 42 && strstr(e.message, "redundant"),
      "a duplicate pin is reported as redundant (%s)", e.message);
+  ok(m2->nsys == 0 && m2->nbody == 0 && m2->ngeom == 0 && m2->neq == 0 && m2->nq == 0,
+     "  and the failed add leaves nothing half-built in the model");
   ss_model_free(m2);
   urdf_free(u);
 }
