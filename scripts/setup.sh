@@ -13,7 +13,11 @@
 set -e
 
 PACKAGES="build-essential autoconf automake pkg-config libxml2-dev \
-libassimp-dev libpng-dev libosmesa6-dev libegl-dev libfreetype-dev fonts-dejavu-core"
+libassimp-dev libpng-dev libosmesa6-dev libegl-dev libfreetype-dev fonts-dejavu-core \
+clang libclang-rt-14-dev valgrind"
+# clang, libclang-rt-14-dev (sanitizer and libFuzzer runtimes) and valgrind:
+# the fuzz targets, the sanitized suite and the valgrind check that .ci/run
+# runs (README, "Hostile input and faults")
 
 say() { printf 'setup: %s\n' "$*"; }
 die() { printf 'setup: error: %s\n' "$*" >&2; exit 1; }

@@ -184,11 +184,13 @@ ssStatus ss_hfield_read_text(const char *path, int *nx, int *ny,
     int r = ss_scene_parse_long(tb, te, &dims[k]);
     if (r != 0 || dims[k] < 2 || dims[k] > INT_MAX) {
       int n = (int)(te - tb) > 40 ? 40 : (int)(te - tb);
+      /* the message quotes the token, which lives in buf: free it after */
+      ss_error_set(err, SS_ERR_PARSE, path, line,
+                   "bad %s '%.*s' in height-map text file: it must start "
+                   "with the integers nx ny, each >= 2",
+                   k ? "ny" : "nx", n, tb);
       free(buf);
-      return ss_error_set(err, SS_ERR_PARSE, path, line,
-                          "bad %s '%.*s' in height-map text file: it must "
-                          "start with the integers nx ny, each >= 2",
-                          k ? "ny" : "nx", n, tb);
+      return SS_ERR_PARSE;
     }
   }
   if (dims[0] * dims[1] > SS_SOURCE_MAX_VERTICES) {

@@ -35,6 +35,9 @@
 
 /* largest mesh accepted, in triangles */
 #define MESH_MAX_TRIS 10000000L
+/* largest mesh file read (bytes), checked before assimp reads any of it:
+ * room for 10 million triangles as binary STL or as text */
+#define MESH_MAX_BYTES (512LL * 1024 * 1024)
 /* triangles per BVH leaf, at most */
 #define LEAF_MAX 4
 /* BVH depth bound: splits halve the count, so the depth is at most
@@ -345,6 +348,10 @@ ssStatus ss_mesh_load(const char *path, const double scale[3], ssMesh **out,
   if (!S_ISREG(sb.st_mode))
     return ss_error_set(err, SS_ERR_IO, path, 0,
                         "cannot read mesh: not a regular file");
+  if ((long long)sb.st_size > MESH_MAX_BYTES)
+    return ss_error_set(err, SS_ERR_IO, path, 0,
+                        "mesh file is %lld bytes, larger than the limit of "
+                        "%lld", (long long)sb.st_size, MESH_MAX_BYTES);
   if (access(path, R_OK) != 0)
     return ss_error_set(err, SS_ERR_IO, path, 0, "cannot read mesh: %s",
                         strerror(errno));

@@ -376,6 +376,19 @@ static ssStatus get_str(readCtx *c, xEl *e, const char *name, int required,
   return SS_OK;
 }
 
+/* A material name: optional, but never empty (an empty name would be a
+ * material of its own that no <pair_prop> can name). */
+static ssStatus get_material(readCtx *c, xEl *e, const char **out)
+{
+  const char *v = el_find(e, "material");
+  if (v && !*v)
+    return fail(c, SS_ERR_VALUE, e->line,
+                "%s: material is empty (give a material name, or leave the "
+                "attribute out for the default material)", e->label);
+  if (v) *out = v;
+  return SS_OK;
+}
+
 static int is_space(char ch)
 {
   return ch == ' ' || ch == '\t' || ch == '\n' || ch == '\r';
@@ -505,8 +518,9 @@ static ssStatus get_long(readCtx *c, xEl *e, const char *name, int required,
   if (r != 0) {
     int len = (int)strlen(v) > 40 ? 40 : (int)strlen(v);
     return fail(c, SS_ERR_PARSE, e->line,
-                "%s: attribute '%s' is '%.*s', expected an integer", e->label,
-                name, len, v);
+                "%s: attribute '%s' is '%.*s', %s", e->label, name, len, v,
+                r == 2 ? "an integer too large to represent"
+                       : "expected an integer");
   }
   if (x < lo || x > hi)
     return fail(c, SS_ERR_VALUE, e->line,
@@ -713,7 +727,7 @@ static ssStatus read_ground(readCtx *c, xmlNodePtr n)
   if (!st) st = get_str(c, &e, "name", 1, &name);
   if (!st) snprintf(e.label, sizeof e.label, "ground '%s'", name);
   if (!st) st = get_num(c, &e, "height", 0, &h);
-  if (!st) st = get_str(c, &e, "material", 0, &mat);
+  if (!st) st = get_material(c, &e, &mat);
   if (!st && ss_model_add_plane(c->m, name, h, mat, e.line, &c->e) < 0)
     st = fix_error(c, e.line, NULL);
   el_free(&e);
@@ -848,7 +862,7 @@ static ssStatus read_body(readCtx *c, xmlNodePtr n, ssGeomType shape)
     st = fail(c, SS_ERR_VALUE, e.line,
               "%s: mass = %g is invalid: a dynamic body needs a mass > 0 kg",
               e.label, def.mass);
-  if (!st) st = get_str(c, &e, "material", 0, &def.material);
+  if (!st) st = get_material(c, &e, &def.material);
   if (!st && el_find(&e, "rgba")) {
     st = get_vec(c, &e, "rgba", 4, 0, def.rgba);
     for (int k = 0; !st && k < 4; k++)
@@ -1090,7 +1104,7 @@ static ssStatus read_heightmap(readCtx *c, xmlNodePtr n)
   def.line = e.line;
   if (!st) st = get_num(c, &e, "center_x", 0, &def.center_x);
   if (!st) st = get_num(c, &e, "center_y", 0, &def.center_y);
-  if (!st) st = get_str(c, &e, "material", 0, &def.material);
+  if (!st) st = get_material(c, &e, &def.material);
   if (!st) st = get_vec(c, &e, "pos", 3, 0, def.pos);
   if (!st) st = get_vec(c, &e, "quat", 4, 0, def.quat);
   if (!st && quat_is_zero(def.quat))
@@ -1278,7 +1292,7 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
   if (!st) st = get_str(c, &e, "urdf_path", 1, &raw);
   if (!st) st = get_str(c, &e, "res_dir", 0, &res);
   if (!st) st = get_str(c, &e, "base", 0, &base);
-  if (!st) st = get_str(c, &e, "material", 0, &mat);
+  if (!st) st = get_material(c, &e, &mat);
   char path[1024] = "", resdir[1024] = "";
   if (!st) st = resolve_path(c, &e, "urdf_path", raw, path, sizeof path);
   if (!st && res) st = resolve_path(c, &e, "res_dir", res, resdir, sizeof resdir);
@@ -1409,6 +1423,48 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
   return st;
 }
 
+/* RaiSim's granular media (GranularSystem) and deformable objects
+ * (DeformableObject, deformable cloth) have no counterpart here, and a soil
+ * bed cannot be combined with them.  Their elements are recognized (under
+ * the names RaiSim's object classes give them, and short forms) so that
+ * the refusal says why instead of "unknown element". */
+static const char *const media_names[] = {
+  "granular_system", "granular_media", "granular", "deformable_object",
+  "deformable_cloth", "deformable", NULL};
+
+/* 1 if a <heightmap> among the children of n has a <soil> */
+static int has_soil_bed(xmlNodePtr n)
+{
+  for (xmlNodePtr k = n->children; k; k = k->next) {
+    if (k->type != XML_ELEMENT_NODE) continue;
+    char kn[NAME_CAP];
+    norm_name((const char *)k->name, kn);
+    if (strcmp(kn, "heightmap")) continue;
+    for (xmlNodePtr s = k->children; s; s = s->next) {
+      if (s->type != XML_ELEMENT_NODE) continue;
+      norm_name((const char *)s->name, kn);
+      if (!strcmp(kn, "soil")) return 1;
+    }
+  }
+  return 0;
+}
+
+static ssStatus refuse_media(readCtx *c, xmlNodePtr k, const char *kn,
+                             int soil)
+{
+  xmlChar *nm = xmlGetProp(k, BAD_CAST "name");
+  const char *why =
+      soil ? "soil beds cannot be combined with granular media or deformable "
+             "objects (not supported)"
+      : kn[0] == 'g' ? "granular media are not supported"
+                     : "deformable objects are not supported";
+  ssStatus st = fail(c, SS_ERR_UNSUPPORTED, line_of(k), "<%s>%s%.100s%s: %s",
+                     kn, nm ? " '" : "", nm ? (const char *)nm : "",
+                     nm ? "'" : "", why);
+  if (nm) xmlFree(nm);
+  return st;
+}
+
 static ssStatus read_objects(readCtx *c, xmlNodePtr n)
 {
   static const char *const kids[] = {"ground", "box", "sphere", "cylinder",
@@ -1418,6 +1474,7 @@ static ssStatus read_objects(readCtx *c, xmlNodePtr n)
   xEl e;
   ssStatus st = el_open(c, n, NULL, &e);
   if (!st) st = el_allow(c, &e, none);
+  int soil = has_soil_bed(n);
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
     if (k->type != XML_ELEMENT_NODE) {
       st = check_other_node(c, k, &e);
@@ -1439,7 +1496,9 @@ static ssStatus read_objects(readCtx *c, xmlNodePtr n)
                 "box, sphere, cylinder, capsule, heightmap, articulated_system)", kn,
                 nm ? " '" : "", nm ? (const char *)nm : "", nm ? "'" : "");
       if (nm) xmlFree(nm);
-    } else
+    } else if (in_list(kn, media_names))
+      st = refuse_media(c, k, kn, soil);
+    else
       st = unknown_child(c, k, &e, kids);
   }
   el_free(&e);
@@ -1460,6 +1519,9 @@ static ssStatus read_material(readCtx *c, xmlNodePtr n)
   static const char *const none[] = {NULL};
   xEl e;
   int seen_default = 0;
+  /* pairs already given (in either order), for the duplicate check */
+  struct { const char *n1, *n2; int line; } *seen = NULL;
+  int nseen = 0;
   ssStatus st = el_open(c, n, NULL, &e);
   if (!st) st = el_allow(c, &e, none);
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
@@ -1494,6 +1556,23 @@ static ssStatus read_material(readCtx *c, xmlNodePtr n)
         st = fail(c, SS_ERR_VALUE, x.line,
                   "%s: name1 and name2 must be non-empty material names",
                   x.label);
+      for (int i = 0; !st && i < nseen; i++)
+        if ((!strcmp(seen[i].n1, n1) && !strcmp(seen[i].n2, n2)) ||
+            (!strcmp(seen[i].n1, n2) && !strcmp(seen[i].n2, n1)))
+          st = fail(c, SS_ERR_PARSE, x.line,
+                    "%s: the pair '%.100s' / '%.100s' is given twice (first "
+                    "at line %d)", x.label, n1, n2, seen[i].line);
+      if (!st) {
+        void *p = realloc(seen, (size_t)(nseen + 1) * sizeof *seen);
+        if (!p) {
+          st = fail(c, SS_ERR_NOMEM, x.line, "out of memory");
+        } else {
+          seen = p;
+          seen[nseen].n1 = n1;
+          seen[nseen].n2 = n2;
+          seen[nseen++].line = x.line;
+        }
+      }
       if (!st) st = get_num(c, &x, "friction", 1, &f);
       if (!st) st = get_num(c, &x, "restitution", 0, &r);
       if (!st) st = get_num(c, &x, "restitution_threshold", 0, &t);
@@ -1506,6 +1585,7 @@ static ssStatus read_material(readCtx *c, xmlNodePtr n)
       st = unknown_child(c, k, &e, kids);
     }
   }
+  free(seen);
   el_free(&e);
   return st;
 }

@@ -808,10 +808,12 @@ static ssStatus resolve_mesh(uCtx *c, const xEl *e, const char *fn,
                   e->label, fn);
     ncand = 1;
   }
-  int why = 0;
+  int why = 0, access_errno = 0;
   for (int k = 0; k < ncand; k++) {
     int w = 0;
-    if (check_readable(cand[k], &w) == SS_OK) {
+    ssStatus r = check_readable(cand[k], &w);
+    if (r != SS_OK && w == 2) access_errno = errno;
+    if (r == SS_OK) {
       if (strlen(cand[k]) >= cap)
         return fail(c, SS_ERR_VALUE, e->line,
                     "%s: mesh path '%.300s' is too long", e->label, cand[k]);
@@ -820,9 +822,12 @@ static ssStatus resolve_mesh(uCtx *c, const xEl *e, const char *fn,
     }
     if (k == 0 || w > why) why = w;
   }
+  char unreadable[160];
+  snprintf(unreadable, sizeof unreadable, "not readable (%s)",
+           strerror(access_errno ? access_errno : EACCES));
   const char *reason = why == 0   ? "not found"
                        : why == 1 ? "not a regular file"
-                                  : "not readable";
+                                  : unreadable;
   if (ncand == 2)
     return fail(c, SS_ERR_IO, e->line,
                 "%s: mesh file '%.300s' %s (looked for '%.300s' and '%.300s')",
@@ -1289,6 +1294,14 @@ static ssStatus read_joint(uCtx *c, xmlNodePtr n)
     st = fail(c, SS_ERR_PARSE, e.line, "%s: missing <child link=...>", label);
   if (!st) {
     double len = ss_v3_norm(axis);
+    /* huge (1e200) or tiny (1e-320) components over- or underflow the
+     * norm: divide by the largest component first (ordinary axes are left
+     * as they are, bit for bit) */
+    double big = fmax(fabs(axis[0]), fmax(fabs(axis[1]), fabs(axis[2])));
+    if (!(len > 1e-150 && len < 1e150) && big > 0 && isfinite(big)) {
+      for (int a = 0; a < 3; a++) axis[a] /= big;
+      len = ss_v3_norm(axis);
+    }
     if (j->type == SS_JOINT_REVOLUTE || j->type == SS_JOINT_PRISMATIC) {
       if (!(len > 0))
         st = fail(c, SS_ERR_VALUE, axis_line,
