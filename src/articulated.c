@@ -988,7 +988,7 @@ int ss_model_add_articulated(ssModel *m, const ssUrdf *u, const ssArtDef *def,
   }
   for (int i = 0; i < u->nlink; i++) body_of[i] = -1;
   int qa = m->sys_qadr[s], va = m->sys_vadr[s];
-  double *q0 = m->qpos0 + m->sys_qadr[s];
+  double *q0 = nq ? m->qpos0 + m->sys_qadr[s] : NULL;   /* NULL + 0 is UB */
 
   /* bodies: the root, then each joint's child (parents come first) */
   for (int j = -1; j < u->njoint; j++) {

@@ -46,7 +46,10 @@ const char *ss_status_name(ssStatus code)
 }
 
 /* The temporary file lives in the destination folder so that rename() is
- * atomic; its name carries the pid so concurrent writers do not collide. */
+ * atomic; its name carries the pid so concurrent writers do not collide.
+ * O_EXCL | O_NOFOLLOW: a name that exists already (a leftover of a killed
+ * run with the same pid, or a link planted there) is never opened; the
+ * next suffix is tried instead. */
 ssStatus ss_atomic_open(ssAtomicFile *f, const char *path, ssError *err)
 {
   memset(f, 0, sizeof *f);
@@ -55,20 +58,39 @@ ssStatus ss_atomic_open(ssAtomicFile *f, const char *path, ssError *err)
   if (strlen(path) >= sizeof f->path)
     return ss_error_set(err, SS_ERR_IO, path, 0, "output path too long");
   snprintf(f->path, sizeof f->path, "%s", path);
-  snprintf(f->tmp_path, sizeof f->tmp_path, "%s.tmp%ld", path, (long)getpid());
-  int fd = open(f->tmp_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  if (fd < 0)
-    return ss_error_set(err, SS_ERR_IO, path, 0, "cannot write: %s",
-                        strerror(errno));
+  int fd = -1, e = EEXIST;
+  for (int k = 0; k < 100 && fd < 0 && e == EEXIST; k++) {
+    if (k == 0)
+      snprintf(f->tmp_path, sizeof f->tmp_path, "%s.tmp%ld", path, (long)getpid());
+    else
+      snprintf(f->tmp_path, sizeof f->tmp_path, "%s.tmp%ld.%d", path, (long)getpid(), k);
+    fd = open(f->tmp_path, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+    e = fd < 0 ? errno : 0;
+  }
+  if (fd < 0) {
+    f->tmp_path[0] = 0;
+    return ss_error_set(err, SS_ERR_IO, path, 0, "cannot write: %s", strerror(e));
+  }
   FILE *fp = fdopen(fd, "w");
   if (!fp) {
-    int e = errno;
+    e = errno;
     close(fd);
     unlink(f->tmp_path);
+    f->tmp_path[0] = 0;
     return ss_error_set(err, SS_ERR_IO, path, 0, "cannot write: %s", strerror(e));
   }
   f->fp = fp;
   return SS_OK;
+}
+
+int ss_atomic_write(ssAtomicFile *f, const void *buf, size_t n)
+{
+  if (f->error || !f->fp) return -1;
+  if (n == 0) return 0;
+  errno = 0;
+  if (fwrite(buf, 1, n, f->fp) == n) return 0;
+  f->error = errno ? errno : EIO;
+  return -1;
 }
 
 ssStatus ss_atomic_commit(ssAtomicFile *f, ssError *err)
@@ -76,8 +98,14 @@ ssStatus ss_atomic_commit(ssAtomicFile *f, ssError *err)
   FILE *fp = f->fp;
   if (!fp)
     return ss_error_set(err, SS_ERR_STATE, f->path, 0, "output file not open");
-  int bad = ferror(fp) || fflush(fp) != 0;
-  int e = errno;
+  /* the reason is the first failure's errno: a failed write (kept by
+   * ss_atomic_write), else the flush; never an errno left over from
+   * something earlier */
+  int e = f->error;
+  errno = 0;
+  int bad = fflush(fp) != 0;
+  if (bad && !e) e = errno;
+  if (e || ferror(fp)) bad = 1;
   if (!bad && fsync(fileno(fp)) != 0 && errno != EINVAL) {
     bad = 1;
     e = errno;

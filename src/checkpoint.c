@@ -518,12 +518,9 @@ ssStatus ss_checkpoint_save(const ssModel *m, const ssData *d,
   ssAtomicFile f;
   st = ss_atomic_open(&f, path, err);
   if (st == SS_OK) {
-    if (fwrite(buf, 1, len, (FILE *)f.fp) != len) {
-      ss_atomic_abort(&f);
-      st = ss_error_set(err, SS_ERR_IO, path, 0, "cannot write the checkpoint");
-    } else {
-      st = ss_atomic_commit(&f, err);
-    }
+    /* a failed write is reported by the commit, with its reason */
+    ss_atomic_write(&f, buf, len);
+    st = ss_atomic_commit(&f, err);
   }
   free(buf);
   return st;

@@ -163,14 +163,15 @@ void ss_dyn_integrate(const ssModel *m, ssData *d)
 
 int ss_dyn_check_finite(const ssModel *m, const ssData *d)
 {
-  /* 1e8 m/s: far beyond anything physical; a sign the step blew up */
+  /* 1e5 m/s (or rad/s): a hundred times a rifle bullet, far beyond any
+   * vehicle, foot or plate on soil; a sign the step blew up */
   for (int s = 0; s < m->nsys; s++) {
     if (!d->sys_active[s]) continue;
     for (int k = 0; k < m->sys_nq[s]; k++)
       if (!isfinite(d->qpos[m->sys_qadr[s] + k])) return s;
     for (int k = 0; k < m->sys_nv[s]; k++) {
       double v = d->qvel[m->sys_vadr[s] + k];
-      if (!isfinite(v) || fabs(v) > 1e8) return s;
+      if (!isfinite(v) || fabs(v) > 1e5) return s;
     }
   }
   return -1;

@@ -23,7 +23,8 @@ double ss_dyn_geom_speed(const ssModel *m, const ssData *d, int g,
                          double radius);
 /* Positions from velocities (semi-implicit Euler); quaternions exact. */
 void ss_dyn_integrate(const ssModel *m, ssData *d);
-/* First system whose state is non-finite, or -1. */
+/* First system whose coordinates are non-finite or whose velocities are
+ * non-finite or above 1e5 (m/s or rad/s), or -1. */
 int ss_dyn_check_finite(const ssModel *m, const ssData *d);
 
 #endif

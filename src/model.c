@@ -383,8 +383,10 @@ int ss_model_push_sys(ssModel *m, const char *name, int type, int nq, int nv,
   m->sys_nbody[s] = 0;
   m->sys_line[s] = line;
   m->sys_fixed[s] = 0;
-  memset(m->qpos0 + m->nq, 0, (size_t)nq * sizeof(double));
-  memset(m->qvel0 + m->nv, 0, (size_t)nv * sizeof(double));
+  /* a system without coordinates (all links fixed) may leave the arrays
+   * unallocated: NULL + 0 is undefined, so touch them only when needed */
+  if (nq) memset(m->qpos0 + m->nq, 0, (size_t)nq * sizeof(double));
+  if (nv) memset(m->qvel0 + m->nv, 0, (size_t)nv * sizeof(double));
   m->nq += nq;
   m->nv += nv;
   return m->nsys++;

@@ -16,7 +16,7 @@
 #include <string.h>
 
 typedef struct wBuf {
-  FILE *fp;
+  ssAtomicFile *f;
   int bad;
   size_t n;
   char b[1 << 16];
@@ -24,7 +24,7 @@ typedef struct wBuf {
 
 static void w_flush(wBuf *w)
 {
-  if (w->n && !w->bad && fwrite(w->b, 1, w->n, w->fp) != w->n) w->bad = 1;
+  if (w->n && !w->bad && ss_atomic_write(w->f, w->b, w->n) != 0) w->bad = 1;
   w->n = 0;
 }
 
@@ -33,7 +33,7 @@ static void w_put(wBuf *w, const char *s, size_t n)
   if (n > sizeof w->b - w->n) {
     w_flush(w);
     if (n > sizeof w->b) {
-      if (!w->bad && fwrite(s, 1, n, w->fp) != n) w->bad = 1;
+      if (!w->bad && ss_atomic_write(w->f, s, n) != 0) w->bad = 1;
       return;
     }
   }
@@ -481,7 +481,7 @@ ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
     free(w);
     return st;
   }
-  w->fp = (FILE *)f.fp;
+  w->f = &f;
   w->bad = 0;
   w->n = 0;
 
@@ -497,11 +497,7 @@ ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
   write_world(w, m, d);
   w_flush(w);
   if (have_loc) ss_scene_c_locale_pop(&loc);
-  int bad = w->bad;
   free(w);
-  if (bad) {
-    ss_atomic_abort(&f);
-    return ss_error_set(err, SS_ERR_IO, path, 0, "write failed");
-  }
+  /* a failed write is reported by the commit, with its reason */
   return ss_atomic_commit(&f, err);
 }

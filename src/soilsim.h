@@ -603,12 +603,22 @@ void ss_option_copy_solver(ssOption *dst, const ssOption *src);
 
 typedef struct ssAtomicFile {
   void *fp;            /* FILE*, open for writing while active */
+  int error;           /* errno of the first failed write, 0 if none */
   char path[1024];
-  char tmp_path[1040];
+  char tmp_path[1056];
 } ssAtomicFile;
 
+/* Opens a new temporary file PATH.tmpPID (PATH.tmpPID.K when that name is
+ * taken) in the destination folder, created exclusively and never through
+ * a symbolic link, so a file or link planted under that name is neither
+ * followed nor overwritten. */
 ssStatus ss_atomic_open(ssAtomicFile *f, const char *path, ssError *err);
-/* Flush, sync, close and rename over path; on failure the old file stays. */
+/* Writes n bytes; returns 0, or -1 after a failure, whose errno is kept
+ * for the message of ss_atomic_commit (later writes do nothing). */
+int ss_atomic_write(ssAtomicFile *f, const void *buf, size_t n);
+/* Flush, sync, close and rename over path; on failure (including an
+ * earlier failed write, whose reason it reports: "write failed: No space
+ * left on device") the temporary file is removed and the old file stays. */
 ssStatus ss_atomic_commit(ssAtomicFile *f, ssError *err);
 /* Close and delete the temporary file (safe to call after commit). */
 void ss_atomic_abort(ssAtomicFile *f);

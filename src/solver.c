@@ -394,7 +394,7 @@ static int cached(const ssContact *c)
 
 /* keep this step's converged tractions (soil) and impulse rates (joint
  * rows) for the next one */
-static ssStatus store_warm(const ssModel *m, ssData *d, ssError *err)
+ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
 {
   const double dt = m->opt.timestep;
   int n = 0;
@@ -497,5 +497,5 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
     if (c->type == SS_CONTACT_SOIL && !c->loaded)
       c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
   }
-  return store_warm(m, d, err);
+  return SS_OK;
 }

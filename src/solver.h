@@ -55,8 +55,11 @@ struct ssWarmEntry {
 ssContact *ss_contact_new(ssData *d, int nv);
 
 /* Solve all contacts in d->contact; d->qvel holds the free velocity on entry
- * and the end-of-step velocity on return.  Fills d->stats. */
+ * and the end-of-step velocity on return.  Fills d->stats.  The warm-start
+ * cache is not touched: ss_solver_store_warm keeps this step's tractions
+ * once the step has passed its checks. */
 ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err);
+ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err);
 
 /* The per-point soil solve (exposed for tests and benchmarks): given the
  * contact's state and the velocity v0 it would have with lambda = 0 from

@@ -20,10 +20,15 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
 {
   if (d->in_step)
     return ss_error_set(err, SS_ERR_STATE, NULL, 0, "ss_step called re-entrantly");
-  /* keep the velocities so a failed step leaves d where it was */
-  double stack[64], *saved = m->nv <= 64 ? stack : malloc((size_t)m->nv * sizeof(double));
+  /* keep the coordinates and velocities so a failed step leaves d where it
+   * was; the soil state and the warm-start cache are written only once
+   * every check has passed */
+  size_t ns = (size_t)m->nq + (size_t)m->nv;
+  double stack[128], *saved = ns <= 128 ? stack : malloc(ns * sizeof(double));
   if (!saved) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
-  if (m->nv) memcpy(saved, d->qvel, (size_t)m->nv * sizeof(double));
+  if (m->nq) memcpy(saved, d->qpos, (size_t)m->nq * sizeof(double));
+  if (m->nv) memcpy(saved + m->nq, d->qvel, (size_t)m->nv * sizeof(double));
+  double closure0 = d->closure_error;
   d->in_step = 1;
   double *t = d->stats.time_stage, t0 = now(), t1;
   ssStatus st = SS_OK;
@@ -57,15 +62,11 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
     goto fail;
   }
 
-  /* soil sinkage, permanent ruts and shear history */
-  ss_terrain_update(m, d);
-  t1 = now(); t[4] = t1 - t0; t0 = t1;
-
   /* positions from the new velocities; loop-closure drift removed */
   d->closure_error = 0;
   ss_dyn_integrate(m, d);
   ss_forward(m, d);
-  t1 = now(); t[5] = t1 - t0;
+  t1 = now(); t[5] = t1 - t0; t0 = t1;
 
   bad = ss_dyn_check_finite(m, d);
   if (bad >= 0) {
@@ -75,6 +76,13 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
                       m->sys_name[bad]);
     goto fail;
   }
+
+  /* the step stands: this step's tractions seed the next one, and the soil
+   * takes its sinkage, permanent ruts and shear history (neither depends
+   * on the new positions) */
+  if ((st = ss_solver_store_warm(m, d, err))) goto fail;
+  ss_terrain_update(m, d);
+  t1 = now(); t[4] = t1 - t0;
   d->time += m->opt.timestep;
   d->step++;
   d->in_step = 0;
@@ -82,7 +90,10 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
   return SS_OK;
 
 fail:
-  if (m->nv) memcpy(d->qvel, saved, (size_t)m->nv * sizeof(double));
+  if (m->nq) memcpy(d->qpos, saved, (size_t)m->nq * sizeof(double));
+  if (m->nv) memcpy(d->qvel, saved + m->nq, (size_t)m->nv * sizeof(double));
+  d->closure_error = closure0;
+  ss_forward(m, d);
   if (saved != stack) free(saved);
   d->in_step = 0;
   return st;

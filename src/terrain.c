@@ -163,14 +163,13 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
   double dx = xs / (nx - 1), dy = ys / (ny - 1);
   double x0 = m->hfield_center[2 * h] - 0.5 * xs;
   double y0 = m->hfield_center[2 * h + 1] - 0.5 * ys;
-  /* vertices whose cells overlap the bounding box */
-  int i0 = (int)ceil((lo[0] - x0) / dx - 0.5), i1 = (int)floor((hi[0] - x0) / dx + 0.5);
-  int j0 = (int)ceil((lo[1] - y0) / dy - 0.5), j1 = (int)floor((hi[1] - y0) / dy + 0.5);
-  if (i1 < 0 || j1 < 0 || i0 > nx - 1 || j0 > ny - 1) return SS_OK;
-  if (i0 < 0) i0 = 0;
-  if (j0 < 0) j0 = 0;
-  if (i1 > nx - 1) i1 = nx - 1;
-  if (j1 > ny - 1) j1 = ny - 1;
+  /* vertices whose cells overlap the bounding box, clamped in double
+   * before the conversion (a body far from the bed would overflow int) */
+  double fi0 = ceil((lo[0] - x0) / dx - 0.5), fi1 = floor((hi[0] - x0) / dx + 0.5);
+  double fj0 = ceil((lo[1] - y0) / dy - 0.5), fj1 = floor((hi[1] - y0) / dy + 0.5);
+  if (!(fi1 >= 0 && fj1 >= 0 && fi0 <= nx - 1 && fj0 <= ny - 1)) return SS_OK;
+  int i0 = fi0 > 0 ? (int)fi0 : 0, i1 = fi1 < nx - 1 ? (int)fi1 : nx - 1;
+  int j0 = fj0 > 0 ? (int)fj0 : 0, j1 = fj1 < ny - 1 ? (int)fj1 : ny - 1;
 
   ssPoly2 fp;
   ss_shape_footprint(&s, &fp);

@@ -813,6 +813,65 @@ static void remove_tree(const char *dir)
   rmdir(dir);
 }
 
+/* The atomic writer never follows a link or reuses a file planted under
+ * its temporary name, and a failed write is reported with its reason. */
+static void test_atomic(void)
+{
+  char path[512], tmp[600], victim[512], got[64];
+  snprintf(path, sizeof path, "%s/atomic.txt", tmpdir);
+  snprintf(victim, sizeof victim, "%s/victim.txt", tmpdir);
+  snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
+  write_file(victim, "victim\n");
+  int linked = symlink(victim, tmp) == 0;
+  ok(linked, "atomic: a link planted at PATH.tmpPID");
+  ssAtomicFile f;
+  ssError err = {0};
+  ssStatus st = ss_atomic_open(&f, path, &err);
+  ok(st == SS_OK, "atomic: opens beside the planted link (%s)", err.message);
+  if (st != SS_OK) return;
+  ok(strcmp(f.tmp_path, tmp) != 0, "atomic: the temporary file takes another name (%s)",
+     f.tmp_path);
+  ok(ss_atomic_write(&f, "new\n", 4) == 0, "atomic: write");
+  ok(ss_atomic_commit(&f, &err) == SS_OK, "atomic: commit (%s)", err.message);
+  size_t n = 0;
+  char *v = slurp(victim, &n), *p = slurp(path, &n);
+  ok(v && !strcmp(v, "victim\n"), "atomic: the link's target is untouched");
+  ok(p && !strcmp(p, "new\n"), "atomic: the file has the new contents");
+  free(v);
+  free(p);
+  ssize_t k = readlink(tmp, got, sizeof got - 1);
+  ok(k > 0, "atomic: the planted link is left alone, not replaced");
+  unlink(tmp);
+
+  /* a write that fails keeps its errno for the commit's message, and the
+   * old file stays */
+  st = ss_atomic_open(&f, path, &err);
+  ok(st == SS_OK, "atomic: reopen");
+  if (st != SS_OK) return;
+  FILE *real = f.fp;
+  f.fp = fopen("/dev/full", "w");
+  if (f.fp) {
+    setvbuf(f.fp, NULL, _IONBF, 0);
+    ok(ss_atomic_write(&f, "x", 1) != 0 && f.error == ENOSPC,
+       "atomic: a write to a full device fails with ENOSPC");
+    fclose(f.fp);
+    f.fp = real;
+    ok(ss_atomic_write(&f, "more", 4) != 0, "atomic: later writes do nothing");
+    ssError e2 = {0};
+    ok(ss_atomic_commit(&f, &e2) == SS_ERR_IO &&
+           strstr(e2.message, "No space left on device"),
+       "atomic: commit fails and gives the reason (%s)", e2.message);
+    p = slurp(path, &n);
+    ok(p && !strcmp(p, "new\n"), "atomic: the old file is intact");
+    free(p);
+    ok(access(f.tmp_path, F_OK) != 0, "atomic: no temporary file left");
+  } else {
+    f.fp = real;
+    ss_atomic_abort(&f);
+    diag("no /dev/full: the failed-write checks are skipped");
+  }
+}
+
 int main(void)
 {
   snprintf(tmpdir, sizeof tmpdir, "/tmp/soilsim-xml-XXXXXX");
@@ -832,6 +891,7 @@ int main(void)
   test_hostile();
   test_bad_catalogue();
   test_large_bed();
+  test_atomic();
   remove_tree(tmpdir);
   return done_testing();
 }
