@@ -453,8 +453,10 @@ void ss_data_reset(const ssModel *m, ssData *d);
 /* Recompute derived kinematics (body and geom poses) from qpos. */
 void ss_forward(const ssModel *m, ssData *d);
 
-/* One time step.  SS_ERR_NUMERIC (naming the step and body) if the state
- * became non-finite; d is then not advanced. */
+/* One time step.  SS_ERR_NUMERIC (naming the step and body) if a velocity
+ * became non-finite or absurd (above 1e5 m/s or rad/s) or a position
+ * non-finite.  A step that fails for any reason leaves d exactly as it was
+ * (positions, velocities, soil, warm-start cache, statistics). */
 ssStatus ss_step(const ssModel *m, ssData *d, ssError *err);
 
 /* Remove a system from the world (from the next step on). */

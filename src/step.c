@@ -29,6 +29,7 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
   if (m->nq) memcpy(saved, d->qpos, (size_t)m->nq * sizeof(double));
   if (m->nv) memcpy(saved + m->nq, d->qvel, (size_t)m->nv * sizeof(double));
   double closure0 = d->closure_error;
+  ssStepStats stats0 = d->stats;
   d->in_step = 1;
   double *t = d->stats.time_stage, t0 = now(), t1;
   ssStatus st = SS_OK;
@@ -93,6 +94,7 @@ fail:
   if (m->nq) memcpy(d->qpos, saved, (size_t)m->nq * sizeof(double));
   if (m->nv) memcpy(d->qvel, saved + m->nq, (size_t)m->nv * sizeof(double));
   d->closure_error = closure0;
+  d->stats = stats0;
   ss_forward(m, d);
   if (saved != stack) free(saved);
   d->in_step = 0;

@@ -951,6 +951,42 @@ static void test_export(void)
   }
 }
 
+/* A step that fails (here: a body thrown upward at 2e5 m/s, past the
+ * absurd-velocity bound, while it presses on the soil with a warm cache)
+ * leaves everything as it was: the same checkpoint bytes before and after,
+ * soil state and warm-start cache included. */
+static void failed_step(const char *scene, int settle)
+{
+  ssModel *m;
+  ssData *d;
+  if (!load_scene(scene, &m, &d)) {
+    ok(0, "failed step on %s: scene loads", scene);
+    return;
+  }
+  ok(run(m, d, settle) && d->nwarm > 0 && d->nsoil_loaded > 0,
+     "failed step on %s: %d steps settle on the soil with a warm cache", scene, settle);
+  for (int k = 0; k < m->nv; k++) d->qvel[k] = k < 3 ? 2e5 * (k == 2) : 0;
+  size_t la = 0, lb = 0;
+  unsigned char *a = snapshot(m, d, &la);
+  ssError e;
+  ssStatus st = ss_step(m, d, &e);
+  ok(st == SS_ERR_NUMERIC && strstr(e.message, "step"),
+     "failed step on %s: the step fails with a numeric error (%s)", scene, e.message);
+  unsigned char *b = snapshot(m, d, &lb);
+  ok(a && b && la == lb && !memcmp(a, b, la),
+     "failed step on %s: state, soil and warm cache unchanged", scene);
+  free(a);
+  free(b);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
+static void test_failed_step(void)
+{
+  failed_step("plate.xml", 200);
+  failed_step("plate_arm.xml", 200);
+}
+
 int main(void)
 {
   const char *t = getenv("TMPDIR");
@@ -968,6 +1004,7 @@ int main(void)
   test_foreign_and_mismatch();
   test_damage();
   test_export();
+  test_failed_step();
   rmdir(tmpdir);
   return done_testing();
 }
