@@ -71,8 +71,10 @@ static const double inv_k[] = {0, 1, 1.0 / 2, 1.0 / 3, 1.0 / 4, 1.0 / 5, 1.0 / 6
 
 /* series terms are dropped once below this fraction of the leading 1 */
 #define SERIES_EPS 1e-18
-/* relative moves up to this are done by series (|u|^k falls 5 bits a term) */
-#define SERIES_MAX (1.0 / 32)
+/* moves up to these are done by series, larger ones by libm (which costs
+ * about as much as the longest series here) */
+#define SERIES_MAX (1.0 / 256)
+#define EXP_SERIES_MAX (1.0 / 1024)
 
 /* the law of one point, fixed during its solve, and the cached power */
 typedef struct Law {
@@ -163,74 +165,95 @@ static int normal_direct(const Law *L, double a, double g, double vg, double *x)
 }
 
 /* lambda_n = A dt P(a + g lambda_n) (strategy above).  *at_guess is set when
- * the guess itself passes the residual test. */
+ * the guess itself passes the residual test.  The bracket's upper end
+ * A dt P(a) costs an evaluation of its own, so it is formed only when a
+ * step needs it; until then the residual test is against the iterate
+ * itself, which lies below it (a tighter test). */
 static double solve_normal(Law *L, double a, double g, double guess,
                            double tol, int *iters, int *at_guess)
 {
-  double S = L->S, dP, d2P, f = 0, fp = 1, x;
+  double S = L->S, dP, d2P, f, fp, x = guess > 0 && g > 0 ? guess : 0;
+  double lo = 0, hi = INFINITY, bound = 0; /* bound: A dt P(a), 0 unknown */
   *at_guess = 0;
-  int have_guess = guess > 0 && g > 0;
-  if (have_guess) {
+  if (x > 0) {
     (*iters)++;
-    f = guess - S * law_pressure(L, a + g * guess, &dP, &d2P);
-    if (fabs(f) <= tol * guess) {
+    f = x - S * law_pressure(L, a + g * x, &dP, &d2P);
+    if (fabs(f) <= tol * x) {
       *at_guess = 1;
-      return guess;
+      return x;
     }
-    fp = 1 - S * dP * g;
+    if (f > 0) hi = x;
+    else lo = x;
+  } else {
+    (*iters)++;
+    bound = S * law_pressure(L, a, &dP, &d2P);
+    if (!(bound > 0)) return 0;
+    if (!(g > 0)) return bound;
+    hi = bound;
+    f = -bound;
   }
-  double dP0, d2P0, hi = S * law_pressure(L, a, &dP0, &d2P0);
-  if (!(hi > 0)) return 0;
-  if (!(g > 0)) return hi;
-  double lo = 0, ftol = tol * hi;
+  fp = 1 - S * dP * g;
   if (L->linear) {
     double xd;
-    if (normal_direct(L, a, g, have_guess ? a + g * guess : a, &xd)) {
+    if (normal_direct(L, a, g, a + g * x, &xd)) {
       (*iters)++;
       double fd = xd - S * law_pressure(L, a + g * xd, &dP, &d2P);
-      if (fabs(fd) <= ftol) return xd;
+      if (fabs(fd) <= tol * (bound > xd ? bound : xd)) return xd;
+      /* round-off at a kink: iterate from the direct answer */
+      x = xd;
+      f = fd;
+      fp = 1 - S * dP * g;
+      if (f > 0) hi = hi < x ? hi : x;
+      else lo = lo > x ? lo : x;
     }
   }
-  if (have_guess && guess < hi) {
-    if (f > 0) hi = guess;
-    else lo = guess;
-    x = guess;
-  } else {
-    /* Newton from 0: f(0) = -hi, f'(0) = 1 - S g P'(a) >= 1 */
-    x = 0;
-    f = -hi;
-    fp = 1 - S * dP0 * g;
-    d2P = d2P0;
-  }
+  double best = x, fbest = fabs(f);
   for (int it = 0; it < 100; it++) {
     double dx = -f / fp;
-    if (fabs(dx) > 1e-5 * hi && d2P != 0) {
+    if (d2P != 0 && fabs(dx) > 1e-5 * x) {
       /* Halley: the correction of the local parabola f + f' dx + f'' dx^2/2 */
       double fpp = -S * g * g * d2P, den = 1 + 0.5 * dx * fpp / fp;
       if (den >= 0.5 && den <= 2) dx /= den;
     }
     double xn = x + dx;
-    if (!(xn > lo && xn < hi)) xn = 0.5 * (lo + hi);
-    if (!(hi - lo > 4 * DBL_EPSILON * hi)) return x;
+    if (!(xn > lo && xn < hi)) {
+      if (!bound) {
+        /* the analytic bracket [0, A dt P(a)] */
+        (*iters)++;
+        double dPa, d2Pa;
+        bound = S * law_pressure(L, a, &dPa, &d2Pa);
+        if (!(bound > 0)) return 0;
+        if (bound < hi) hi = bound;
+      }
+      if (!(xn > lo && xn < hi)) xn = 0.5 * (lo + hi);
+    }
+    /* no representable progress left: the best point found */
+    if (!(fabs(xn - x) > 2 * DBL_EPSILON * x) ||
+        (hi < INFINITY && !(hi - lo > 4 * DBL_EPSILON * hi)))
+      return best;
     x = xn;
     (*iters)++;
     f = x - S * law_pressure(L, a + g * x, &dP, &d2P);
-    if (fabs(f) <= ftol) return x;
+    if (fabs(f) <= tol * (bound > x ? bound : x)) return x;
+    if (fabs(f) < fbest) {
+      fbest = fabs(f);
+      best = x;
+    }
     if (f > 0) hi = x;
     else lo = x;
     fp = 1 - S * dP * g;
   }
-  return x;
+  return best;
 }
 
 /* 2x2 helpers on the tangential block */
 static void inv2(const double A[4], double R[4])
 {
-  double det = A[0] * A[3] - A[1] * A[2];
-  R[0] = A[3] / det;
-  R[1] = -A[1] / det;
-  R[2] = -A[2] / det;
-  R[3] = A[0] / det;
+  double id = 1 / (A[0] * A[3] - A[1] * A[2]);
+  R[0] = A[3] * id;
+  R[1] = -A[1] * id;
+  R[2] = -A[2] * id;
+  R[3] = A[0] * id;
 }
 
 static void mul2(const double A[4], const double x[2], double y[2])
@@ -287,7 +310,7 @@ static double mobil_at(Mobil *J, double sigma, double *e)
   }
   double x = J->x0 + J->r * sigma, d = x - J->xa;
   if (d != 0) {
-    if (fabs(d) <= 2 * SERIES_MAX) {
+    if (fabs(d) <= EXP_SERIES_MAX) {
       double t = 1, em1 = 0;
       for (int k = 1; k <= 21; k++) {
         t *= -d * inv_k[k];
@@ -298,7 +321,7 @@ static double mobil_at(Mobil *J, double sigma, double *e)
       J->ea += J->ea * em1;
     } else {
       J->ma = -expm1(-x);
-      J->ea = exp(-x);
+      J->ea = 1 - J->ma; /* absolute accuracy is all e needs: T' and the series */
     }
     J->xa = x;
   }
@@ -378,15 +401,17 @@ static double slip_curvature(const TBlock *B, const Slip *z)
 
 /* Tangential impulse of one contact for a fixed normal impulse (strategy
  * above): bound T = tf m(sigma); tl = dT/dlambda_n / m.  *sigma: in, a guess
- * (<= 0: none); out, the slip speed (0 when sticking).  dl: d lambda_t /
- * d lambda_n of the answer (for the coupling). */
+ * (<= 0: none); out, the slip speed (0 when sticking).  dl and *dsig:
+ * d lambda_t / d lambda_n and d sigma / d lambda_n at the answer (for the
+ * coupling and the next guess). */
 static void solve_tangent(const TBlock *B, Mobil *J, double tf, double tl,
                           const double ct[2], double tol, double *sigma,
-                          double lt[2], double dl[2], int *iters)
+                          double *dsig, double lt[2], double dl[2], int *iters)
 {
   double speed = sqrt(ct[0] * ct[0] + ct[1] * ct[1]), e;
   lt[0] = lt[1] = 0;
   dl[0] = dl[1] = 0;
+  *dsig = 0;
   if (B->inert) {
     /* no response (static body): the slip is what it is */
     if (speed == 0) return;
@@ -452,6 +477,7 @@ static void solve_tangent(const TBlock *B, Mobil *J, double tf, double tl,
   double sn = ws != 0 ? -(z.w[0] * wn_[0] + z.w[1] * wn_[1]) / ws : 0;
   double dw0 = wn_[0] + z.dw[0] * sn, dw1 = wn_[1] + z.dw[1] * sn;
   double dT = Tn + z.dT * sn;
+  *dsig = isfinite(sn) ? sn : 0;
   dl[0] = -dT * z.w[0] - z.T * dw0;
   dl[1] = -dT * z.w[1] - z.T * dw1;
   if (!(isfinite(dl[0]) && isfinite(dl[1]))) dl[0] = dl[1] = 0;
@@ -475,15 +501,16 @@ int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
 
   int iters = 0, at_guess, coupled = G[1] != 0 || G[2] != 0;
   double ln = c->lambda[0], lt[2] = {c->lambda[1], c->lambda[2]}, dl[2] = {0, 0};
-  double sigma = 0;
+  double sigma = 0, dsig = 0;
   int have_lt = 0;
   if (ln > 0 && coupled) {
     /* warm: the shear at the previous normal impulse, from the slip speed
      * the previous shear impulse gives now */
     double ct[2] = {v0[1] + G[3] * ln, v0[2] + G[6] * ln};
-    sigma = hypot(ct[0] + B.G[0] * lt[0] + B.G[1] * lt[1],
-                  ct[1] + B.G[2] * lt[0] + B.G[3] * lt[1]);
-    solve_tangent(&B, &J, tf0 + mu * ln, mu, ct, tol, &sigma, lt, dl, &iters);
+    double vt0 = ct[0] + B.G[0] * lt[0] + B.G[1] * lt[1];
+    double vt1 = ct[1] + B.G[2] * lt[0] + B.G[3] * lt[1];
+    sigma = sqrt(vt0 * vt0 + vt1 * vt1);
+    solve_tangent(&B, &J, tf0 + mu * ln, mu, ct, tol, &sigma, &dsig, lt, dl, &iters);
     have_lt = 1;
   }
   for (int outer = 0; outer < 50; outer++) {
@@ -501,7 +528,9 @@ int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
     ln = ln_new;
     double ct[2] = {v0[1] + G[3] * ln, v0[2] + G[6] * ln};
     if (ln > 0) {
-      solve_tangent(&B, &J, tf0 + mu * ln, mu, ct, tol, &sigma, lt, dl, &iters);
+      /* the slip speed moves with lambda_n at the rate the last solve found */
+      sigma += dsig * (ln - prev[0]);
+      solve_tangent(&B, &J, tf0 + mu * ln, mu, ct, tol, &sigma, &dsig, lt, dl, &iters);
     } else {
       lt[0] = lt[1] = dl[0] = dl[1] = 0;
     }
@@ -532,7 +561,7 @@ static void rigid_point(ssContact *c, const double v0[3], double tol)
   Mobil J;
   mobil_init(&J, 0, 0, 0);
   double ln = c->lambda[0], lt[2] = {c->lambda[1], c->lambda[2]}, dl[2];
-  double sigma = 0;
+  double sigma = 0, dsig;
   int iters = 0, coupled = G[1] != 0 || G[2] != 0;
   for (int it = 0; it < 50; it++) {
     double vn = v0[0] + G[1] * lt[0] + G[2] * lt[1];
@@ -540,7 +569,7 @@ static void rigid_point(ssContact *c, const double v0[3], double tol)
     if (ln_new < 0) ln_new = 0;
     double ct[2] = {v0[1] + G[3] * ln_new, v0[2] + G[6] * ln_new};
     double lt_new[2] = {0, 0};
-    if (ln_new > 0) solve_tangent(&B, &J, c->mu * ln_new, c->mu, ct, tol, &sigma, lt_new, dl, &iters);
+    if (ln_new > 0) solve_tangent(&B, &J, c->mu * ln_new, c->mu, ct, tol, &sigma, &dsig, lt_new, dl, &iters);
     double change = fabs(ln_new - ln) + fabs(lt_new[0] - lt[0]) + fabs(lt_new[1] - lt[1]);
     double size = fabs(ln_new) + fabs(lt_new[0]) + fabs(lt_new[1]);
     ln = ln_new;
