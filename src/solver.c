@@ -246,6 +246,20 @@ static double solve_normal(Law *L, double a, double g, double guess,
   return best;
 }
 
+/* A start for the normal impulse (not a solve: the coupled Newton or the
+ * loop checks what follows): the n = 1 piece the solution lies on, or one
+ * Newton step from 0. */
+static double normal_start(Law *L, double a, double g, int *iters)
+{
+  double dP, d2P, x;
+  (*iters)++;
+  double bound = L->S * law_pressure(L, a, &dP, &d2P);
+  if (!(bound > 0)) return 0;
+  if (!(g > 0)) return bound;
+  if (L->linear && normal_direct(L, a, g, a, &x)) return x;
+  return bound / (1 - L->S * dP * g);
+}
+
 /* 2x2 helpers on the tangential block */
 static void inv2(const double A[4], double R[4])
 {
@@ -290,16 +304,26 @@ static void tblock_init(TBlock *B, const double G[9])
  * r = 0: constant bound (K = 0, or a rigid Coulomb contact). */
 typedef struct Mobil {
   double r;          /* dt/K, 0 when constant */
-  double x0, m0;     /* j/K and m there (zero slip) */
-  double xa, ea, ma; /* the last point */
+  double x0, m0;     /* j/K and m there (zero slip; m0 < 0 not yet known) */
+  double xa, ea, ma; /* the last point (xa < 0: none) */
 } Mobil;
 
 static void mobil_init(Mobil *J, double j, double K, double dt)
 {
   J->r = K > 0 ? dt / K : 0;
-  J->x0 = J->xa = K > 0 ? (j > 0 ? j : 0) / K : 0;
-  J->m0 = J->ma = J->r > 0 ? -expm1(-J->xa) : 1;
-  J->ea = 1 - J->ma;
+  J->x0 = K > 0 ? (j > 0 ? j : 0) / K : 0;
+  J->m0 = J->r > 0 ? (J->x0 > 0 ? -1 : 0) : 1;
+  /* at x = 0 the point is free: m = 0, e = 1 */
+  J->xa = J->x0 > 0 ? -1 : 0;
+  J->ma = 0;
+  J->ea = 1;
+}
+
+/* m at zero slip, for the stick test (m(sigma) >= m0 bounds it for free) */
+static double mobil_m0(Mobil *J)
+{
+  if (J->m0 < 0) J->m0 = -expm1(-J->x0);
+  return J->m0;
 }
 
 static double mobil_at(Mobil *J, double sigma, double *e)
@@ -310,7 +334,7 @@ static double mobil_at(Mobil *J, double sigma, double *e)
   }
   double x = J->x0 + J->r * sigma, d = x - J->xa;
   if (d != 0) {
-    if (fabs(d) <= EXP_SERIES_MAX) {
+    if (J->xa >= 0 && fabs(d) <= EXP_SERIES_MAX) {
       double t = 1, em1 = 0;
       for (int k = 1; k <= 21; k++) {
         t *= -d * inv_k[k];
@@ -426,7 +450,7 @@ static void solve_tangent(const TBlock *B, Mobil *J, double tf, double tl,
   /* stick: lambda_t = -G^-1 c_t, inside the bound at zero slip */
   double ls[2];
   mul2(B->Gi, ct, ls);
-  double T0 = tf * J->m0;
+  double T0 = tf * mobil_m0(J);
   if (ls[0] * ls[0] + ls[1] * ls[1] <= T0 * T0) {
     lt[0] = -ls[0];
     lt[1] = -ls[1];
@@ -483,6 +507,66 @@ static void solve_tangent(const TBlock *B, Mobil *J, double tf, double tl,
   if (!(isfinite(dl[0]) && isfinite(dl[1]))) dl[0] = dl[1] = 0;
 }
 
+/* Coupled Newton on (lambda_n, sigma) for a slipping point, from a close
+ * start: both equations, F1 = lambda_n - A dt P(v_n) with v_n including
+ * the shear impulse -T w, and F2 = 1/|w| - 1, with their full 2x2
+ * Jacobian.  Returns 1 with the impulse in lam once both residuals pass at
+ * the same point (and the point does not stick there); 0 leaves the point
+ * to the safeguarded loop, e.g. when an iterate leaves lambda_n > 0,
+ * 0 < sigma <= |c_t|. */
+static int coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu,
+                        const double v0[3], const double G[9], double tol,
+                        double x, double sigma, double lam[3], int *iters)
+{
+  double S = L->S;
+  for (int it = 0; it < 6; it++) {
+    (*iters)++;
+    double ct[2] = {v0[1] + B->e[0] * x, v0[2] + B->e[1] * x};
+    double tf = tf0 + mu * x;
+    if (!(sigma > 0) || sigma * sigma > ct[0] * ct[0] + ct[1] * ct[1]) return 0;
+    Slip z;
+    slip_eval(B, J, tf, ct, sigma, &z);
+    if (!z.ok) return 0;
+    double lt0 = -z.T * z.w[0], lt1 = -z.T * z.w[1];
+    double dP, d2P, vn = v0[0] + G[0] * x + G[1] * lt0 + G[2] * lt1;
+    double F1 = x - S * law_pressure(L, vn, &dP, &d2P), F2 = z.q - 1;
+    if (fabs(F1) <= tol * x && fabs(z.wn - 1) <= tol) {
+      /* a slip solution excludes sticking for SPD G; checked all the same,
+       * with m(sigma) >= m0 deciding most cases without m0 */
+      double ls[2], ls2, Tz = tf * z.m;
+      mul2(B->Gi, ct, ls);
+      ls2 = ls[0] * ls[0] + ls[1] * ls[1];
+      if (!(ls2 > Tz * Tz)) {
+        double T0 = tf * mobil_m0(J);
+        if (ls2 <= T0 * T0) return 0;
+      }
+      lam[0] = x;
+      lam[1] = lt0;
+      lam[2] = lt1;
+      return 1;
+    }
+    /* d lambda_t/d lambda_n and d lambda_t/d sigma (M w = c_t, see
+     * solve_tangent), then the 2x2 Newton step */
+    double Tx = mu * z.m, Gw[2], r[2], wx[2];
+    mul2(B->G, z.w, Gw);
+    r[0] = B->e[0] - Tx * Gw[0];
+    r[1] = B->e[1] - Tx * Gw[1];
+    mul2(z.Mi, r, wx);
+    double ltx0 = -Tx * z.w[0] - z.T * wx[0], ltx1 = -Tx * z.w[1] - z.T * wx[1];
+    double lts0 = -z.dT * z.w[0] - z.T * z.dw[0], lts1 = -z.dT * z.w[1] - z.T * z.dw[1];
+    double J11 = 1 - S * dP * (G[0] + G[1] * ltx0 + G[2] * ltx1);
+    double J12 = -S * dP * (G[1] * lts0 + G[2] * lts1);
+    double J21 = -(z.w[0] * wx[0] + z.w[1] * wx[1]) * z.q * z.q * z.q;
+    double J22 = z.dq;
+    double det = J11 * J22 - J12 * J21;
+    if (!(det > 0)) return 0;
+    x -= (J22 * F1 - J12 * F2) / det;
+    sigma -= (J11 * F2 - J21 * F1) / det;
+    if (!(x > 0)) return 0;
+  }
+  return 0;
+}
+
 int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
                          const double v0[3], double tol)
 {
@@ -503,6 +587,30 @@ int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
   double ln = c->lambda[0], lt[2] = {c->lambda[1], c->lambda[2]}, dl[2] = {0, 0};
   double sigma = 0, dsig = 0;
   int have_lt = 0;
+  if (coupled && !B.inert) {
+    /* cold: a start for the normal impulse with the shear held */
+    if (!(ln > 0)) ln = normal_start(&L, v0[0] + G[1] * lt[0] + G[2] * lt[1], G[0], &iters);
+    double ct[2] = {v0[1] + G[3] * ln, v0[2] + G[6] * ln};
+    double vt0 = ct[0] + B.G[0] * lt[0] + B.G[1] * lt[1];
+    double vt1 = ct[1] + B.G[2] * lt[0] + B.G[3] * lt[1];
+    double sig0 = sqrt(vt0 * vt0 + vt1 * vt1), tf = tf0 + mu * ln, ls[2], lam[3], e;
+    /* cheap stick test first: beyond the bound at the guessed slip speed
+     * (>= the bound at zero slip) it surely slips: the coupled Newton */
+    if (ln > 0 && sig0 > 0) {
+      mul2(B.Gi, ct, ls);
+      double Ts = tf * mobil_at(&J, sig0, &e);
+      if (ls[0] * ls[0] + ls[1] * ls[1] > Ts * Ts &&
+          coupled_slip(&L, &B, &J, tf0, mu, v0, G, tol, ln, sig0, lam, &iters)) {
+        memcpy(c->lambda, lam, sizeof lam);
+        return iters;
+      }
+    }
+    if (!(c->lambda[0] > 0)) {
+      /* the general loop starts cold */
+      ln = 0;
+      lt[0] = lt[1] = 0;
+    }
+  }
   if (ln > 0 && coupled) {
     /* warm: the shear at the previous normal impulse, from the slip speed
      * the previous shear impulse gives now */
