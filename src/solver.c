@@ -89,7 +89,7 @@ typedef struct Law {
 /* s^(n-1), from the last value by (1 + u)^(n-1) = sum C(n-1, k) u^k when
  * s = ps (1 + u) is near it: the binomial terms shrink by |u| each, so a few
  * suffice where pow would cost a log and an exp */
-static double pow_near(Law *L, double s)
+static inline double pow_near(Law *L, double s)
 {
   double v;
   double u = L->ps > 0 ? (s - L->ps) / L->ps : INFINITY;
@@ -111,7 +111,7 @@ static double pow_near(Law *L, double s)
 
 /* Normal pressure at end-of-step normal velocity vn (DESIGN 3.1) and its
  * first two derivatives in vn (P' <= 0; P'' from the envelope only). */
-static double law_pressure(Law *L, double vn, double *dP, double *d2P)
+static inline double law_pressure(Law *L, double vn, double *dP, double *d2P)
 {
   double delta = -(L->g0 + L->dt * vn);
   if (!(delta > 0)) {
@@ -280,7 +280,9 @@ static void mul2(const double A[4], const double x[2], double y[2])
 /* The tangential block of one contact, fixed for its whole solve. */
 typedef struct TBlock {
   double G[4];   /* G_tt */
-  double Gi[4];  /* G_tt^-1 (not finite when singular) */
+  double adj[4]; /* its adjugate: G_tt^-1 = adj / det, no division needed
+                    to compare |G_tt^-1 c| with a bound */
+  double det;
   double e[2];   /* G_tn = d c_t / d lambda_n */
   int inert;     /* G_tt = 0: no response (static body) */
 } TBlock;
@@ -291,10 +293,22 @@ static void tblock_init(TBlock *B, const double G[9])
   B->G[1] = G[5];
   B->G[2] = G[7];
   B->G[3] = G[8];
+  B->adj[0] = G[8];
+  B->adj[1] = -G[5];
+  B->adj[2] = -G[7];
+  B->adj[3] = G[4];
+  B->det = G[4] * G[8] - G[5] * G[7];
   B->e[0] = G[3];
   B->e[1] = G[6];
   B->inert = !(fabs(G[4]) + fabs(G[8]) > 0);
-  inv2(B->G, B->Gi);
+}
+
+/* the stick test |G_tt^-1 c| <= T, as |adj c| <= T |det| */
+static inline int stick_fits(const TBlock *B, const double ct[2], double T)
+{
+  double u[2], Td = T * B->det;
+  mul2(B->adj, ct, u);
+  return B->det != 0 && u[0] * u[0] + u[1] * u[1] <= Td * Td;
 }
 
 /* Janosi mobilisation m = 1 - exp(-x), x = (j + dt sigma)/K, and e = 1 - m,
@@ -310,8 +324,9 @@ typedef struct Mobil {
 
 static void mobil_init(Mobil *J, double j, double K, double dt)
 {
-  J->r = K > 0 ? dt / K : 0;
-  J->x0 = K > 0 ? (j > 0 ? j : 0) / K : 0;
+  double iK = K > 0 ? 1 / K : 0;
+  J->r = dt * iK;
+  J->x0 = (j > 0 ? j : 0) * iK;
   J->m0 = J->r > 0 ? (J->x0 > 0 ? -1 : 0) : 1;
   /* at x = 0 the point is free: m = 0, e = 1 */
   J->xa = J->x0 > 0 ? -1 : 0;
@@ -326,7 +341,7 @@ static double mobil_m0(Mobil *J)
   return J->m0;
 }
 
-static double mobil_at(Mobil *J, double sigma, double *e)
+static inline double mobil_at(Mobil *J, double sigma, double *e)
 {
   if (!(J->r > 0)) {
     *e = 0;
@@ -359,12 +374,12 @@ static double mobil_at(Mobil *J, double sigma, double *e)
 typedef struct Slip {
   double sigma, m, T, dT, d2T;
   double Mi[4];
-  double w[2], dw[2];
+  double w[2], dw[2], Gw[2];
   double wn, q, dq;
   int ok;
 } Slip;
 
-static void slip_eval(const TBlock *B, Mobil *J, double tf, const double ct[2],
+static inline void slip_eval(const TBlock *B, Mobil *J, double tf, const double ct[2],
                       double sigma, Slip *z)
 {
   const double *G = B->G;
@@ -395,10 +410,15 @@ static void slip_eval(const TBlock *B, Mobil *J, double tf, const double ct[2],
   double W = z->w[0] * z->w[0] + z->w[1] * z->w[1];
   z->wn = sqrt(W);
   z->q = 1 / z->wn;
-  double Gw[2], a[2];
-  mul2(G, z->w, Gw);
-  a[0] = z->w[0] + z->dT * Gw[0];
-  a[1] = z->w[1] + z->dT * Gw[1];
+}
+
+/* the slope of the evaluation z (only needed when it did not converge) */
+static inline void slip_slope(const TBlock *B, Slip *z)
+{
+  double a[2];
+  mul2(B->G, z->w, z->Gw);
+  a[0] = z->w[0] + z->dT * z->Gw[0];
+  a[1] = z->w[1] + z->dT * z->Gw[1];
   mul2(z->Mi, a, z->dw);
   z->dw[0] = -z->dw[0];
   z->dw[1] = -z->dw[1];
@@ -409,12 +429,10 @@ static void slip_eval(const TBlock *B, Mobil *J, double tf, const double ct[2],
 /* q'' for Halley: -(w'.w' + w.w'') / |w|^3 + 3 (w.w')^2 / |w|^5 */
 static double slip_curvature(const TBlock *B, const Slip *z)
 {
-  const double *G = B->G;
-  double Gw[2], Gdw[2], b[2], d2w[2];
-  mul2(G, z->w, Gw);
-  mul2(G, z->dw, Gdw);
-  b[0] = z->d2T * Gw[0] + 2 * (z->dw[0] + z->dT * Gdw[0]);
-  b[1] = z->d2T * Gw[1] + 2 * (z->dw[1] + z->dT * Gdw[1]);
+  double Gdw[2], b[2], d2w[2];
+  mul2(B->G, z->dw, Gdw);
+  b[0] = z->d2T * z->Gw[0] + 2 * (z->dw[0] + z->dT * Gdw[0]);
+  b[1] = z->d2T * z->Gw[1] + 2 * (z->dw[1] + z->dT * Gdw[1]);
   mul2(z->Mi, b, d2w);
   double q3 = z->q * z->q * z->q;
   double wdw = z->w[0] * z->dw[0] + z->w[1] * z->dw[1];
@@ -448,13 +466,13 @@ static void solve_tangent(const TBlock *B, Mobil *J, double tf, double tl,
     return;
   }
   /* stick: lambda_t = -G^-1 c_t, inside the bound at zero slip */
-  double ls[2];
-  mul2(B->Gi, ct, ls);
-  double T0 = tf * mobil_m0(J);
-  if (ls[0] * ls[0] + ls[1] * ls[1] <= T0 * T0) {
-    lt[0] = -ls[0];
-    lt[1] = -ls[1];
-    mul2(B->Gi, B->e, dl);
+  if (stick_fits(B, ct, tf * mobil_m0(J))) {
+    double Gi[4];
+    inv2(B->G, Gi);
+    mul2(Gi, ct, lt);
+    mul2(Gi, B->e, dl);
+    lt[0] = -lt[0];
+    lt[1] = -lt[1];
     dl[0] = -dl[0];
     dl[1] = -dl[1];
     if (!(isfinite(dl[0]) && isfinite(dl[1]))) dl[0] = dl[1] = 0;
@@ -467,6 +485,7 @@ static void solve_tangent(const TBlock *B, Mobil *J, double tf, double tl,
   for (int it = 0; it < 100; it++) {
     (*iters)++;
     slip_eval(B, J, tf, ct, x, &z);
+    if (z.ok) slip_slope(B, &z);
     if (fabs(z.wn - 1) <= tol) break;
     double r = z.q - 1;
     if (r > 0) hi = x;
@@ -492,10 +511,9 @@ static void solve_tangent(const TBlock *B, Mobil *J, double tf, double tl,
   lt[1] = -z.T * z.w[1];
   /* implicit derivative in lambda_n: c_t' = G_tn, T_n = tl m; |w| = 1 fixes
    * sigma' = -(w.w_n)/(w.w_sigma) */
-  double Tn = tl * z.m, Gw[2], rhs[2], wn_[2];
-  mul2(B->G, z.w, Gw);
-  rhs[0] = B->e[0] - Tn * Gw[0];
-  rhs[1] = B->e[1] - Tn * Gw[1];
+  double Tn = tl * z.m, rhs[2], wn_[2];
+  rhs[0] = B->e[0] - Tn * z.Gw[0];
+  rhs[1] = B->e[1] - Tn * z.Gw[1];
   mul2(z.Mi, rhs, wn_);
   double ws = z.w[0] * z.dw[0] + z.w[1] * z.dw[1];
   double sn = ws != 0 ? -(z.w[0] * wn_[0] + z.w[1] * wn_[1]) / ws : 0;
@@ -533,13 +551,7 @@ static int coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu
     if (fabs(F1) <= tol * x && fabs(z.wn - 1) <= tol) {
       /* a slip solution excludes sticking for SPD G; checked all the same,
        * with m(sigma) >= m0 deciding most cases without m0 */
-      double ls[2], ls2, Tz = tf * z.m;
-      mul2(B->Gi, ct, ls);
-      ls2 = ls[0] * ls[0] + ls[1] * ls[1];
-      if (!(ls2 > Tz * Tz)) {
-        double T0 = tf * mobil_m0(J);
-        if (ls2 <= T0 * T0) return 0;
-      }
+      if (stick_fits(B, ct, z.T) && stick_fits(B, ct, tf * mobil_m0(J))) return 0;
       lam[0] = x;
       lam[1] = lt0;
       lam[2] = lt1;
@@ -547,10 +559,10 @@ static int coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu
     }
     /* d lambda_t/d lambda_n and d lambda_t/d sigma (M w = c_t, see
      * solve_tangent), then the 2x2 Newton step */
-    double Tx = mu * z.m, Gw[2], r[2], wx[2];
-    mul2(B->G, z.w, Gw);
-    r[0] = B->e[0] - Tx * Gw[0];
-    r[1] = B->e[1] - Tx * Gw[1];
+    slip_slope(B, &z);
+    double Tx = mu * z.m, r[2], wx[2];
+    r[0] = B->e[0] - Tx * z.Gw[0];
+    r[1] = B->e[1] - Tx * z.Gw[1];
     mul2(z.Mi, r, wx);
     double ltx0 = -Tx * z.w[0] - z.T * wx[0], ltx1 = -Tx * z.w[1] - z.T * wx[1];
     double lts0 = -z.dT * z.w[0] - z.T * z.dw[0], lts1 = -z.dT * z.w[1] - z.T * z.dw[1];
@@ -573,7 +585,8 @@ int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
   const double *G = c->G;
   double S = c->area * dt;
   Law L = {S, dt, c->g0, c->sp,
-           (c->width > 0 ? mat->bekker_kc / c->width : 0) + mat->bekker_kphi,
+           (c->width > 0 && mat->bekker_kc != 0 ? mat->bekker_kc / c->width : 0) +
+               mat->bekker_kphi,
            mat->sinkage_exponent, mat->sinkage_exponent - 1,
            mat->elastic_stiffness, mat->damping, mat->sinkage_exponent == 1.0, 0, 0};
   TBlock B;
@@ -593,13 +606,11 @@ int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
     double ct[2] = {v0[1] + G[3] * ln, v0[2] + G[6] * ln};
     double vt0 = ct[0] + B.G[0] * lt[0] + B.G[1] * lt[1];
     double vt1 = ct[1] + B.G[2] * lt[0] + B.G[3] * lt[1];
-    double sig0 = sqrt(vt0 * vt0 + vt1 * vt1), tf = tf0 + mu * ln, ls[2], lam[3], e;
+    double sig0 = sqrt(vt0 * vt0 + vt1 * vt1), tf = tf0 + mu * ln, lam[3], e;
     /* cheap stick test first: beyond the bound at the guessed slip speed
      * (>= the bound at zero slip) it surely slips: the coupled Newton */
     if (ln > 0 && sig0 > 0) {
-      mul2(B.Gi, ct, ls);
-      double Ts = tf * mobil_at(&J, sig0, &e);
-      if (ls[0] * ls[0] + ls[1] * ls[1] > Ts * Ts &&
+      if (!stick_fits(&B, ct, tf * mobil_at(&J, sig0, &e)) &&
           coupled_slip(&L, &B, &J, tf0, mu, v0, G, tol, ln, sig0, lam, &iters)) {
         memcpy(c->lambda, lam, sizeof lam);
         return iters;
