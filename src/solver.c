@@ -610,7 +610,16 @@ int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
     /* cheap stick test first: beyond the bound at the guessed slip speed
      * (>= the bound at zero slip) it surely slips: the coupled Newton */
     if (ln > 0 && sig0 > 0) {
-      if (!stick_fits(&B, ct, tf * mobil_at(&J, sig0, &e)) &&
+      double Ts = tf * mobil_at(&J, sig0, &e);
+      if (!(lt[0] != 0 || lt[1] != 0)) {
+        /* no shear to go by: sigma + T(sigma) gamma = |c_t| for an
+         * isotropic block of the block's compliance gamma along c_t */
+        double Gc[2];
+        mul2(B.G, ct, Gc);
+        double s1 = sig0 - Ts * (ct[0] * Gc[0] + ct[1] * Gc[1]) / (sig0 * sig0);
+        if (s1 > 0.5 * sig0) sig0 = s1;
+      }
+      if (!stick_fits(&B, ct, Ts) &&
           coupled_slip(&L, &B, &J, tf0, mu, v0, G, tol, ln, sig0, lam, &iters)) {
         memcpy(c->lambda, lam, sizeof lam);
         return iters;
