@@ -19,29 +19,30 @@
 /*
  * Solve strategy (DESIGN 3.1).  With the other contacts held, the point's
  * end-of-step velocity is v = v0 + G lambda, and lambda = (lambda_n,
- * lambda_t) must satisfy the normal law and the shear law together.
+ * lambda_t) must satisfy the normal law and the shear law together.  Every
+ * answer returned has passed the residual tests below at the point
+ * returned; the tolerances are those of the caller, never relaxed.
  *
  * Normal, for a given tangential impulse: f(x) = x - A dt P(a + g x) with
  * g > 0 and P non-increasing is increasing, so it has one root, bracketed
- * by [0, A dt P(a)].  The root is accepted only where |f| <= tol times the
- * bracket's upper end (or times the root itself when the guess is checked
- * before the bracket is formed, a tighter test).
+ * by [0, A dt P(a)].  Accepted where |f| <= tol times the bracket's upper
+ * end, or times the iterate while that end is not formed (tighter).
  *  - n = 1: P is piecewise affine in v_n: elastic or yield branch, times
  *    damping active (v_n < 0) or not.  On each of the four pieces f = 0 is
  *    a linear equation in x; as f is monotone, the piece whose own solution
  *    lies in it holds the root.  No iteration; the answer is re-checked
  *    against the residual and the iteration below takes over only if
  *    round-off at a kink leaves no piece consistent.
- *  - n != 1: Newton from the previous impulse when it lies in the bracket,
- *    Halley (with P'' of the envelope) when the Newton correction is large,
- *    bisection whenever a step leaves the bracket.
+ *  - n != 1: Newton from the previous impulse (the warm lambda_n), Halley
+ *    (with P'' of the envelope) when the Newton correction is large,
+ *    bisection in the analytic bracket whenever a step leaves it.
  *
  * Shear, for a given normal impulse: with c_t the tangential velocity at
  * lambda_t = 0, the point sticks when the impulse that stops slip,
- * -G_tt^-1 c_t, lies inside A dt tau_max(p_n, j) (cheap test, tried first,
- * G_tt^-1 formed once per point).  Otherwise the slip speed sigma in
- * (0, |c_t|] solves |w(sigma)| = 1, w = M^-1 c_t, M = sigma I + T(sigma) G_tt
- * (the impulse -T w opposes the slip sigma w: maximum dissipation), with
+ * -G_tt^-1 c_t, lies inside A dt tau_max(p_n, j) (tested first, by the
+ * adjugate, no inverse).  Otherwise the slip speed sigma in (0, |c_t|]
+ * solves |w(sigma)| = 1, w = M^-1 c_t, M = sigma I + T(sigma) G_tt (the
+ * impulse -T w opposes the slip sigma w: maximum dissipation), with
  * T(sigma) = A dt tau_f (1 - exp(-(j + dt sigma)/K)).  We solve
  * q(sigma) = 1/|w| - 1, which is affine in sigma for an isotropic block and
  * a constant bound, so Newton is nearly exact; Halley adds the curvature of
@@ -49,20 +50,34 @@
  * the bracket is the fallback.  The first guess is the slip speed the
  * previous (warm) impulse gives, else |c_t|.  Accepted when ||w| - 1| <= tol.
  *
- * Coupling: G_nt couples the two.  Rather than a plain fixed point between
- * them, each shear solve also returns d lambda_t / d lambda_n (implicit
- * derivative of its equations: -G_tt^-1 G_tn when sticking), and the next
- * normal solve sees lambda_t linearised about the current point, i.e. the
- * effective compliance g + G_nt . d lambda_t/d lambda_n (the Schur
- * complement when sticking).  This is Newton on the reduced normal equation:
- * one or two rounds, and none when G_nt = 0.  The loop stops when the
- * normal residual at the current shear impulse is within tolerance, so the
- * returned pair satisfies both laws.
+ * Coupling, G_nt != 0, in two layers:
+ *  - Fast path (coupled_slip): a point that surely slips at the start (its
+ *    stop-slip impulse exceeds the bound at the guessed slip speed, itself
+ *    >= the bound at zero slip) is solved by Newton on both equations at
+ *    once in (lambda_n, sigma), F1 = f with the shear impulse -T w inside
+ *    v_n and F2 = q - 1, with their full 2x2 Jacobian.  From a warm start
+ *    this is one step and the checking evaluation.  It returns only when
+ *    both residual tests pass at the same point and the point cannot stick
+ *    there; any iterate leaving lambda_n > 0, 0 < sigma <= |c_t| hands the
+ *    point to the safeguarded loop.  Cold, the start is the n = 1 piece (or
+ *    a Newton step from 0) with the shear held, and sigma from the
+ *    isotropic slip equation sigma + T gamma = |c_t|.
+ *  - Safeguarded loop: the scalar solves above, alternated.  Each shear
+ *    solve also returns d lambda_t / d lambda_n (implicit derivative of its
+ *    equations; -G_tt^-1 G_tn when sticking), and the next normal solve
+ *    sees lambda_t linearised about the current point, i.e. the effective
+ *    compliance g + G_nt . d lambda_t/d lambda_n (the Schur complement when
+ *    sticking): Newton on the reduced normal equation, and the next slip
+ *    guess moves by d sigma/d lambda_n.  It stops when the normal residual
+ *    at the current shear impulse passes; after 20 rounds it falls back to
+ *    the plain fixed point and the old step-size test.
+ *  Without coupling, one normal solve and one shear solve.
  *
  * Reuse: s^(n-1) and the Janosi exponential are taken from libm once and
  * then moved to nearby arguments by short series in the small change (to
  * rounding, see pow_near and Mobil), since the iterates of one point stay
- * close together. */
+ * close together; the Janosi value at zero slip is formed only when a
+ * stick test needs it. */
 
 static const double inv_k[] = {0, 1, 1.0 / 2, 1.0 / 3, 1.0 / 4, 1.0 / 5, 1.0 / 6,
                                1.0 / 7, 1.0 / 8, 1.0 / 9, 1.0 / 10, 1.0 / 11,
