@@ -3,7 +3,8 @@
  * normal impulse, bisection for the slip speed, and an outer bisection on
  * the normal impulse for a coupled point.  Covers the four n = 1 pieces
  * (elastic/yield x damped/undamped), n = 1.1, stick and slip, Janosi-limited
- * shear, K_j = 0, strong normal-shear coupling, and warm vs cold starts. */
+ * shear, K_j = 0, strong normal-shear coupling, warm vs cold starts, and a
+ * warm shear impulse that alone would lift the point. */
 #include "soilsim.h"
 #include "solver.h"
 #include "tap.h"
@@ -277,6 +278,19 @@ static void test_coupled(void)
   Case hl = h;
   hl.mat.sinkage_exponent = 1;
   check_point(&hl, "strong coupling, n = 1", 0);
+
+  /* a warm shear impulse with no normal one, large enough that with it
+   * held the point would separate: it must not be taken as the answer */
+  Case wz = h;
+  double ref[3];
+  int stuck;
+  ref_point(&wz, ref, &stuck);
+  /* G_nt lt = 2 m/s upward against v0_n = -0.4: held, the point would
+   * rise 1.6 mm in the step, out of its 1 mm compression */
+  double lift[3] = {0, 2.0 / H[1], 0};
+  solve(&wz, lift, 1e-13);
+  ok(ref[0] > 0 && rel3(wz.c.lambda, ref) <= 1e-11,
+     "warm shear alone does not unload the point (rel %.3g)", rel3(wz.c.lambda, ref));
 }
 
 int main(void)
