@@ -113,6 +113,27 @@ void ss_scene_c_locale_pop(ssCLocale *l)
   l->loc = (locale_t)0;
 }
 
+ssStatus ss_scene_c_locale_begin(ssCLocale *l, const char *path, ssError *err)
+{
+  if (ss_scene_c_locale_push(l) == 0) return SS_OK;
+  struct lconv *lc = localeconv();
+  if (!lc || !lc->decimal_point || strcmp(lc->decimal_point, "."))
+    return ss_error_set(err, SS_ERR_STATE, path, 0,
+                        "cannot switch to the C locale to read numbers");
+  return SS_OK;
+}
+
+void ss_scene_path_dir(const char *path, char *dir, size_t cap)
+{
+  const char *slash = path ? strrchr(path, '/') : NULL;
+  if (!slash)
+    snprintf(dir, cap, ".");
+  else if (slash == path)
+    snprintf(dir, cap, "/");
+  else
+    snprintf(dir, cap, "%.*s", (int)(slash - path), path);
+}
+
 static int is_digit(char ch) { return ch >= '0' && ch <= '9'; }
 
 int ss_scene_parse_double(const char *s, const char *end, double *out)
@@ -1692,17 +1713,6 @@ static ssStatus parse_xml(readCtx *c, const char *buf, size_t len,
 /* ---------------------------------------------------------------------- */
 /* entry points                                                            */
 
-static void this_dir(const char *path, char *dir, size_t cap)
-{
-  const char *slash = path ? strrchr(path, '/') : NULL;
-  if (!slash)
-    snprintf(dir, cap, ".");
-  else if (slash == path)
-    snprintf(dir, cap, "/");
-  else
-    snprintf(dir, cap, "%.*s", (int)(slash - path), path);
-}
-
 static void ctx_free(readCtx *c)
 {
   for (int i = 0; i < c->npend; i++) pending_free(&c->pend[i]);
@@ -1719,15 +1729,10 @@ static ssStatus load(const char *buf, size_t len, const char *path,
   readCtx c;
   memset(&c, 0, sizeof c);
   c.path = path;
-  this_dir(path, c.dir, sizeof c.dir);
+  ss_scene_path_dir(path, c.dir, sizeof c.dir);
 
   ssCLocale loc;
-  if (ss_scene_c_locale_push(&loc) != 0) {
-    struct lconv *lc = localeconv();
-    if (!lc || !lc->decimal_point || strcmp(lc->decimal_point, "."))
-      return ss_error_set(err, SS_ERR_STATE, path, 0,
-                          "cannot switch to the C locale to read numbers");
-  }
+  if (ss_scene_c_locale_begin(&loc, path, err) != SS_OK) return SS_ERR_STATE;
 
   ssData *d = NULL;
   ssStatus st = parse_xml(&c, buf, len, &c.doc);

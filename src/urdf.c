@@ -10,6 +10,7 @@
  * list of allowed attributes and children so that typos are reported
  * instead of ignored. */
 #include "urdf.h"
+#include "scene.h"
 #include "ss_math.h"
 #include "xml_safe.h"
 
@@ -17,9 +18,7 @@
 #include <libxml/tree.h>
 
 #include <errno.h>
-#include <fcntl.h>
 #include <limits.h>
-#include <locale.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
@@ -32,122 +31,6 @@
 /* attributes per element kept (none of ours allows nearly as many) */
 #define MAX_ATTR 24
 #define NAME_LEN 128
-
-/* ---------------------------------------------------------------------- */
-/* files, locale, numbers (the logic of scene_read.c, kept local)          */
-
-static ssStatus read_file(const char *path, long max_bytes, char **buf,
-                          size_t *len, ssError *err)
-{
-  *buf = NULL;
-  *len = 0;
-  if (!path || !*path)
-    return ss_error_set(err, SS_ERR_IO, "", 0, "no URDF file name given");
-  /* O_NONBLOCK: opening a FIFO must not wait for a writer */
-  int fd = open(path, O_RDONLY | O_NONBLOCK);
-  if (fd < 0)
-    return ss_error_set(err, SS_ERR_IO, path, 0, "cannot open: %s",
-                        strerror(errno));
-  struct stat st;
-  if (fstat(fd, &st) != 0) {
-    int e = errno;
-    close(fd);
-    return ss_error_set(err, SS_ERR_IO, path, 0, "cannot read: %s",
-                        strerror(e));
-  }
-  if (!S_ISREG(st.st_mode)) {
-    close(fd);
-    return ss_error_set(err, SS_ERR_IO, path, 0,
-                        "cannot read: not a regular file");
-  }
-  if (st.st_size > max_bytes) {
-    close(fd);
-    return ss_error_set(err, SS_ERR_IO, path, 0,
-                        "file is %lld bytes, larger than the limit of %ld",
-                        (long long)st.st_size, max_bytes);
-  }
-  size_t n = (size_t)st.st_size;
-  char *b = malloc(n + 1);
-  if (!b) {
-    close(fd);
-    return ss_error_set(err, SS_ERR_NOMEM, path, 0,
-                        "out of memory reading %zu bytes", n);
-  }
-  size_t got = 0;
-  while (got < n) {
-    ssize_t r = read(fd, b + got, n - got);
-    if (r < 0 && errno == EINTR) continue;
-    if (r < 0) {
-      int e = errno;
-      free(b);
-      close(fd);
-      return ss_error_set(err, SS_ERR_IO, path, 0, "cannot read: %s",
-                          strerror(e));
-    }
-    if (r == 0) break;
-    got += (size_t)r;
-  }
-  close(fd);
-  b[got] = 0;
-  *buf = b;
-  *len = got;
-  return SS_OK;
-}
-
-typedef struct cLocale {
-  locale_t loc, old;
-} cLocale;
-
-static int c_locale_push(cLocale *l)
-{
-  l->loc = (locale_t)0;
-  l->old = (locale_t)0;
-  locale_t c = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
-  if (c == (locale_t)0) return -1;
-  l->old = uselocale(c);
-  l->loc = c;
-  return 0;
-}
-
-static void c_locale_pop(cLocale *l)
-{
-  if (l->loc == (locale_t)0) return;
-  uselocale(l->old);
-  freelocale(l->loc);
-  l->loc = (locale_t)0;
-}
-
-static int is_digit(char ch) { return ch >= '0' && ch <= '9'; }
-
-/* One decimal number in exactly [s, end): 0 ok, 1 not a number, 2 out of
- * range.  The grammar check keeps out nan, inf, hexadecimal and junk. */
-static int parse_double(const char *s, const char *end, double *out)
-{
-  const char *p = s;
-  if (p < end && (*p == '+' || *p == '-')) p++;
-  int nd = 0;
-  while (p < end && is_digit(*p)) p++, nd++;
-  if (p < end && *p == '.') {
-    p++;
-    while (p < end && is_digit(*p)) p++, nd++;
-  }
-  if (nd == 0) return 1;
-  if (p < end && (*p == 'e' || *p == 'E')) {
-    p++;
-    if (p < end && (*p == '+' || *p == '-')) p++;
-    int ne = 0;
-    while (p < end && is_digit(*p)) p++, ne++;
-    if (ne == 0) return 1;
-  }
-  if (p != end) return 1;
-  char *e = NULL;
-  errno = 0;
-  double v = strtod(s, &e);
-  if (e != end) return 1;
-  if (!isfinite(v) || (errno == ERANGE && fabs(v) > 1)) return 2;
-  *out = v;
-  return 0;
-}
 
 /* ---------------------------------------------------------------------- */
 /* reader context and messages                                             */
@@ -327,7 +210,7 @@ static ssStatus parse_values(uCtx *c, const xEl *e, const char *name,
   const char *p = v, *tb = NULL, *te = NULL;
   for (long k = 0; k < cnt; k++) {
     ss_xml_vec_next(&p, k == 0, &tb, &te);
-    int r = parse_double(tb, te, &out[k]);
+    int r = ss_scene_parse_double(tb, te, &out[k]);
     if (r) {
       int len = (int)(te - tb) > 40 ? 40 : (int)(te - tb);
       char where[64] = "";
@@ -1835,17 +1718,6 @@ static ssStatus parse_xml(uCtx *c, const char *buf, size_t len,
 /* ---------------------------------------------------------------------- */
 /* entry points                                                            */
 
-static void this_dir(const char *path, char *dir, size_t cap)
-{
-  const char *slash = path ? strrchr(path, '/') : NULL;
-  if (!slash)
-    snprintf(dir, cap, ".");
-  else if (slash == path)
-    snprintf(dir, cap, "/");
-  else
-    snprintf(dir, cap, "%.*s", (int)(slash - path), path);
-}
-
 static void ctx_free(uCtx *c)
 {
   for (int i = 0; i < c->nlink; i++) free(c->link[i].geom);
@@ -1876,15 +1748,10 @@ static ssStatus load(const char *buf, size_t len, const char *path,
   memset(&c, 0, sizeof c);
   c.path = path;
   c.res_dir = res_dir;
-  this_dir(path, c.dir, sizeof c.dir);
+  ss_scene_path_dir(path, c.dir, sizeof c.dir);
 
-  cLocale loc;
-  if (c_locale_push(&loc) != 0) {
-    struct lconv *lc = localeconv();
-    if (!lc || !lc->decimal_point || strcmp(lc->decimal_point, "."))
-      return ss_error_set(err, SS_ERR_STATE, path, 0,
-                          "cannot switch to the C locale to read numbers");
-  }
+  ssCLocale loc;
+  if (ss_scene_c_locale_begin(&loc, path, err) != SS_OK) return SS_ERR_STATE;
   ssUrdf *u = calloc(1, sizeof *u);
   ssStatus st = u ? SS_OK : fail(&c, SS_ERR_NOMEM, 0, "out of memory");
   if (!st) {
@@ -1894,7 +1761,7 @@ static ssStatus load(const char *buf, size_t len, const char *path,
   if (!st) st = read_robot(&c, xmlDocGetRootElement(c.doc), u);
   ssError e = c.e;
   ctx_free(&c);
-  c_locale_pop(&loc);
+  ss_scene_c_locale_pop(&loc);
   if (st) {
     ss_urdf_free(u);
     if (err) *err = e;
@@ -1927,7 +1794,9 @@ ssStatus ss_urdf_load(const char *path, const char *res_dir, ssUrdf **out,
   *out = NULL;
   char *buf = NULL;
   size_t len = 0;
-  ssStatus st = read_file(path, SS_URDF_MAX_BYTES, &buf, &len, err);
+  if (!path || !*path)
+    return ss_error_set(err, SS_ERR_IO, "", 0, "no URDF file name given");
+  ssStatus st = ss_read_file(path, SS_URDF_MAX_BYTES, &buf, &len, err);
   if (st != SS_OK) return st;
   st = load(buf, len, path, res_dir, out, err);
   free(buf);
