@@ -596,6 +596,28 @@ static ssStatus once(readCtx *c, int *seen, const xEl *e)
   return SS_OK;
 }
 
+/* once() for the child element k, named kn, before it is opened. */
+static ssStatus once_at(readCtx *c, int *seen, xmlNodePtr k, const char *kn)
+{
+  xEl tmp;
+  tmp.line = ss_xml_line(k);
+  snprintf(tmp.name, sizeof tmp.name, "%s", kn);
+  return once(c, seen, &tmp);
+}
+
+/* In a loop over an element's children: 1 when k is an element (its name
+ * normalised into kn); otherwise 0, with k checked into *st. */
+static int child_el(readCtx *c, xmlNodePtr k, const xEl *parent,
+                    char kn[NAME_CAP], ssStatus *st)
+{
+  if (k->type != XML_ELEMENT_NODE) {
+    *st = check_other_node(c, k, parent);
+    return 0;
+  }
+  norm_name((const char *)k->name, kn);
+  return 1;
+}
+
 /* Expand [THIS_DIR]; a relative path without it is relative to the scene's
  * folder. */
 static ssStatus resolve_path(readCtx *c, xEl *e, const char *name,
@@ -812,29 +834,22 @@ static ssStatus read_body(readCtx *c, xmlNodePtr n, ssGeomType shape)
   int seen_dim = 0, seen_state = 0, seen_inertia = 0;
   double quat_read[4] = {1, 0, 0, 0};
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
-    if (k->type != XML_ELEMENT_NODE) {
-      st = check_other_node(c, k, &e);
-      continue;
-    }
     char kn[NAME_CAP];
-    norm_name((const char *)k->name, kn);
-    xEl tmp;
-    tmp.line = ss_xml_line(k);
-    snprintf(tmp.name, sizeof tmp.name, "%s", kn);
+    if (!child_el(c, k, &e, kn, &st)) continue;
     if (!strcmp(kn, "dim")) {
-      st = once(c, &seen_dim, &tmp);
+      st = once_at(c, &seen_dim, k, kn);
       if (!st) st = read_dim(c, k, e.label, &def);
     } else if (!strcmp(kn, "state")) {
-      st = once(c, &seen_state, &tmp);
+      st = once_at(c, &seen_state, k, kn);
       if (!st) st = read_state(c, k, e.label, &def);
       memcpy(quat_read, def.quat, sizeof quat_read);
     } else if (!strcmp(kn, "inertia")) {
-      st = once(c, &seen_inertia, &tmp);
+      st = once_at(c, &seen_inertia, k, kn);
       if (!st) st = read_inertia(c, k, e.label, &def);
     } else if (!strcmp(kn, "external_force")) {
       xforceDef *p = realloc(xf, (size_t)(nxf + 1) * sizeof *xf);
       if (!p) {
-        st = fail(c, SS_ERR_NOMEM, tmp.line, "out of memory");
+        st = fail(c, SS_ERR_NOMEM, ss_xml_line(k), "out of memory");
         break;
       }
       xf = p;
@@ -1122,18 +1137,14 @@ static ssStatus read_heightmap(readCtx *c, xmlNodePtr n)
   } else if (!st && form == HF_GENERATED) {
     ssTerrainProps p;
     if (ntp > 1) {
-      xEl tmp;
-      tmp.line = ss_xml_line(tp);
-      strcpy(tmp.name, "terrain_properties");
       int seen = 0;
-      once(c, &seen, &tmp);
+      once_at(c, &seen, tp, "terrain_properties");
       for (xmlNodePtr k = tp->next; k; k = k->next)
         if (k->type == XML_ELEMENT_NODE) {
           char kn[NAME_CAP];
           norm_name((const char *)k->name, kn);
           if (!strcmp(kn, "terrain_properties")) {
-            tmp.line = ss_xml_line(k);
-            st = once(c, &seen, &tmp);
+            st = once_at(c, &seen, k, kn);
             break;
           }
         }
@@ -1155,17 +1166,10 @@ static ssStatus read_heightmap(readCtx *c, xmlNodePtr n)
   /* children: <soil>, and <terrain_properties> (read above) */
   int seen_soil = 0;
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
-    if (k->type != XML_ELEMENT_NODE) {
-      st = check_other_node(c, k, &e);
-      continue;
-    }
     char kn[NAME_CAP];
-    norm_name((const char *)k->name, kn);
+    if (!child_el(c, k, &e, kn, &st)) continue;
     if (!strcmp(kn, "soil")) {
-      xEl tmp;
-      tmp.line = ss_xml_line(k);
-      strcpy(tmp.name, "soil");
-      st = once(c, &seen_soil, &tmp);
+      st = once_at(c, &seen_soil, k, kn);
       if (!st) st = read_soil(c, k, e.label, def.nx, def.ny, &def.soilmat, &ps);
       def.soil = 1;
     } else if (!(form == HF_GENERATED && !strcmp(kn, "terrain_properties"))) {
@@ -1243,12 +1247,8 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
   int nqpos = 0, nqvel = 0, nref = 0, seen_state = 0, npd = 0;
   pendingPd pd[64];
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
-    if (k->type != XML_ELEMENT_NODE) {
-      st = check_other_node(c, k, &e);
-      continue;
-    }
     char kn[NAME_CAP];
-    norm_name((const char *)k->name, kn);
+    if (!child_el(c, k, &e, kn, &st)) continue;
     if (!strcmp(kn, "state")) {
       static const char *const sa[] = {"qpos", "qvel", "pos", "quat",
                                        "reference_qpos", NULL};
@@ -1415,12 +1415,8 @@ static ssStatus read_objects(readCtx *c, xmlNodePtr n)
   if (!st) st = el_allow(c, &e, none);
   int soil = has_soil_bed(n);
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
-    if (k->type != XML_ELEMENT_NODE) {
-      st = check_other_node(c, k, &e);
-      continue;
-    }
     char kn[NAME_CAP];
-    norm_name((const char *)k->name, kn);
+    if (!child_el(c, k, &e, kn, &st)) continue;
     if (!strcmp(kn, "ground")) st = read_ground(c, k);
     else if (!strcmp(kn, "box")) st = read_body(c, k, SS_GEOM_BOX);
     else if (!strcmp(kn, "sphere")) st = read_body(c, k, SS_GEOM_SPHERE);
@@ -1464,12 +1460,8 @@ static ssStatus read_material(readCtx *c, xmlNodePtr n)
   ssStatus st = el_open(c, n, NULL, &e);
   if (!st) st = el_allow(c, &e, none);
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
-    if (k->type != XML_ELEMENT_NODE) {
-      st = check_other_node(c, k, &e);
-      continue;
-    }
     char kn[NAME_CAP];
-    norm_name((const char *)k->name, kn);
+    if (!child_el(c, k, &e, kn, &st)) continue;
     xEl x;
     if (!strcmp(kn, "default")) {
       ssMaterialPair p = c->m->material_default;
@@ -1639,12 +1631,8 @@ static ssStatus read_root(readCtx *c, xmlNodePtr root)
   if (!st) st = el_allow(c, &e, allowed);
   int seen[7] = {0};
   for (xmlNodePtr k = root->children; !st && k; k = k->next) {
-    if (k->type != XML_ELEMENT_NODE) {
-      st = check_other_node(c, k, &e);
-      continue;
-    }
     char kn[NAME_CAP];
-    norm_name((const char *)k->name, kn);
+    if (!child_el(c, k, &e, kn, &st)) continue;
     int which = -1;
     for (int i = 0; kids[i]; i++)
       if (!strcmp(kn, kids[i])) which = i;
