@@ -521,33 +521,16 @@ static const char *get_alias(readCtx *c, xEl *e, const char *a, const char *b,
   return va ? va : vb;
 }
 
-/* Non-element children: blank text, comments and processing instructions
- * are fine; anything else is an error. */
+/* Non-element children: blank text, comments, processing instructions
+ * and XInclude markers are fine; anything else is an error. */
 static ssStatus check_other_node(readCtx *c, xmlNodePtr n, const xEl *parent)
 {
-  int line = ss_xml_line(n) ? ss_xml_line(n) : parent->line;
-  switch (n->type) {
-  case XML_TEXT_NODE:
-  case XML_CDATA_SECTION_NODE:
-    if (ss_xml_is_blank(n->content)) return SS_OK;
-    {
-      const char *t = (const char *)n->content;
-      while (ss_xml_is_space(*t)) t++;
-      int len = 0;
-      while (t[len] && !ss_xml_is_space(t[len]) && len < 30) len++;
-      return fail(c, SS_ERR_PARSE, line,
-                  "unexpected text '%.*s' inside <%s> (values go in "
-                  "attributes)", len, t, parent->name);
-    }
-  case XML_COMMENT_NODE:
-  case XML_PI_NODE:
-  case XML_XINCLUDE_START:
-  case XML_XINCLUDE_END:
+  char msg[sizeof c->e.message];
+  if (n->type == XML_XINCLUDE_START || n->type == XML_XINCLUDE_END ||
+      !ss_xml_stray(n, parent->name, msg, sizeof msg))
     return SS_OK;
-  default:
-    return fail(c, SS_ERR_PARSE, line,
-                "unexpected content inside <%s>", parent->name);
-  }
+  return fail(c, SS_ERR_PARSE, ss_xml_line(n) ? ss_xml_line(n) : parent->line,
+              "%s", msg);
 }
 
 static ssStatus unknown_child(readCtx *c, xmlNodePtr n, const xEl *parent,

@@ -277,27 +277,10 @@ static ssStatus get_name(uCtx *c, const xEl *e, const char *attr,
  * are fine; anything else is an error. */
 static ssStatus check_other_node(uCtx *c, xmlNodePtr n, const xEl *parent)
 {
-  int line = ss_xml_line(n) ? ss_xml_line(n) : parent->line;
-  switch (n->type) {
-  case XML_TEXT_NODE:
-  case XML_CDATA_SECTION_NODE:
-    if (ss_xml_is_blank(n->content)) return SS_OK;
-    {
-      const char *t = (const char *)n->content;
-      while (ss_xml_is_space(*t)) t++;
-      int len = 0;
-      while (t[len] && !ss_xml_is_space(t[len]) && len < 30) len++;
-      return fail(c, SS_ERR_PARSE, line,
-                  "unexpected text '%.*s' inside <%s> (values go in "
-                  "attributes)", len, t, parent->name);
-    }
-  case XML_COMMENT_NODE:
-  case XML_PI_NODE:
-    return SS_OK;
-  default:
-    return fail(c, SS_ERR_PARSE, line,
-                "unexpected content inside <%s>", parent->name);
-  }
+  char msg[sizeof c->e.message];
+  if (!ss_xml_stray(n, parent->name, msg, sizeof msg)) return SS_OK;
+  return fail(c, SS_ERR_PARSE, ss_xml_line(n) ? ss_xml_line(n) : parent->line,
+              "%s", msg);
 }
 
 /* A namespaced element (xacro:macro) or one of URDF's we do not read. */

@@ -190,7 +190,21 @@ int ss_xml_line(xmlNodePtr n)
 }
 
 /* ---------------------------------------------------------------------- */
-/* attributes                                                              */
+/* attributes, children, value lists                                      */
+
+/* XML white space */
+static int is_space(char ch)
+{
+  return ch == ' ' || ch == '\t' || ch == '\n' || ch == '\r';
+}
+
+static int is_blank(const xmlChar *s)
+{
+  if (!s) return 1;
+  for (; *s; s++)
+    if (!is_space((char)*s)) return 0;
+  return 1;
+}
 
 const char *ss_xml_attr_text(xmlDocPtr doc, xmlAttrPtr a, xmlChar **owned)
 {
@@ -203,28 +217,39 @@ const char *ss_xml_attr_text(xmlDocPtr doc, xmlAttrPtr a, xmlChar **owned)
   return v ? (const char *)v : "";
 }
 
-int ss_xml_is_space(char ch)
+int ss_xml_stray(xmlNodePtr n, const char *parent, char *msg, size_t cap)
 {
-  return ch == ' ' || ch == '\t' || ch == '\n' || ch == '\r';
-}
-
-int ss_xml_is_blank(const xmlChar *s)
-{
-  if (!s) return 1;
-  for (; *s; s++)
-    if (!ss_xml_is_space((char)*s)) return 0;
-  return 1;
+  switch (n->type) {
+  case XML_TEXT_NODE:
+  case XML_CDATA_SECTION_NODE:
+    if (is_blank(n->content)) return 0;
+    {
+      const char *t = (const char *)n->content;
+      while (is_space(*t)) t++;
+      int len = 0;
+      while (t[len] && !is_space(t[len]) && len < 30) len++;
+      snprintf(msg, cap, "unexpected text '%.*s' inside <%s> (values go in "
+               "attributes)", len, t, parent);
+      return 1;
+    }
+  case XML_COMMENT_NODE:
+  case XML_PI_NODE:
+    return 0;
+  default:
+    snprintf(msg, cap, "unexpected content inside <%s>", parent);
+    return 1;
+  }
 }
 
 int ss_xml_vec_next(const char **pp, int first, const char **tb,
                     const char **te)
 {
   const char *p = *pp;
-  while (ss_xml_is_space(*p)) p++;
+  while (is_space(*p)) p++;
   if (*p == ',') {
     if (first) return -1;
     p++;
-    while (ss_xml_is_space(*p)) p++;
+    while (is_space(*p)) p++;
     if (*p == 0 || *p == ',') return -1;
   }
   if (*p == 0) {
@@ -232,7 +257,7 @@ int ss_xml_vec_next(const char **pp, int first, const char **tb,
     return 0;
   }
   *tb = p;
-  while (*p && !ss_xml_is_space(*p) && *p != ',') p++;
+  while (*p && !is_space(*p) && *p != ',') p++;
   *te = p;
   *pp = p;
   return 1;

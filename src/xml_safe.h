@@ -1,5 +1,5 @@
 /* xml_safe.h -- what the two XML readers share (internal): the safe
- * libxml2 parse, the line of an element, attribute values and value lists.
+ * libxml2 parse, element lines, attribute values, stray text, value lists.
  *
  * The world XML reader (scene_read.c) and the URDF reader (urdf.c) parse
  * with the same safety measures (scene.h, "Safety"): no DTD, no entity
@@ -46,10 +46,10 @@ int ss_xml_line(xmlNodePtr n);
  * for the caller to xmlFree.  Never NULL. */
 const char *ss_xml_attr_text(xmlDocPtr doc, xmlAttrPtr a, xmlChar **owned);
 
-/* XML white space. */
-int ss_xml_is_space(char ch);
-/* NULL or only white space. */
-int ss_xml_is_blank(const xmlChar *s);
+/* n, a child of element <parent> that is not an element: 0 when it may
+ * stand there (blank text, a comment, a processing instruction); otherwise
+ * 1 with what is wrong in msg[cap] ("unexpected text 'x' inside <box> ..."). */
+int ss_xml_stray(xmlNodePtr n, const char *parent, char *msg, size_t cap);
 
 /* Next value of a vector attribute: values are separated by white space or
  * one comma.  Returns 1 with the value in [*tb, *te), 0 at the end, -1 on
