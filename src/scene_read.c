@@ -2,9 +2,9 @@
  *
  * The accepted format, the safety measures and the error conventions are
  * described in scene.h.  The reader parses the whole document with libxml2
- * (safely: xml_safe.h), then walks the tree once, building the model with the model
- * builder; every element is checked against a list of allowed attributes
- * and children so that typos are reported instead of ignored. */
+ * (safely: xml_safe.h), then walks the tree once, building the model with
+ * the model builder; every element is checked against a list of allowed
+ * attributes and children so that typos are reported instead of ignored. */
 #include "scene.h"
 #include "articulated.h"
 #include "urdf.h"
