@@ -2,7 +2,8 @@
 #   SOILSIM=...; TAP_NAME=cli; . "$top_srcdir/tests/tap.sh"
 # Bails out when $SOILSIM is not built; makes the scratch folder $tmp
 # (soilsim-$TAP_NAME.XXXXXX, the caller removes it with a trap); defines
-# run, check, skip and the predicates used inside checks.  The script ends
+# run, check, skip, the predicates used inside checks and expect_line (the
+# expect comment of a catalogue file).  The script ends
 # with: echo "1..$n"; [ "$nfail" -eq 0 ]
 
 # The checks are shell expressions in single quotes, expanded by eval.
@@ -66,4 +67,14 @@ no_tmp() {
     [ -e "$f" ] && return 1
   done
   return 0
+}
+
+# expect_line FILE: the first line of FILE, <!-- expect: N: SUBSTRING -->,
+# into expect_n and expect_sub (both empty when it is not such a line).
+expect_line() {
+  first=$(sed -n 1p "$1")
+  expect_n=$(printf '%s\n' "$first" |
+    sed -n 's/^<!-- *expect: *\([0-9][0-9]*\): .*-->.*$/\1/p')
+  expect_sub=$(printf '%s\n' "$first" |
+    sed -n 's/^<!-- *expect: *[0-9][0-9]*: *\(.*[^ ]\) *-->.*$/\1/p')
 }

@@ -91,11 +91,9 @@ for f in "$top_srcdir"/tests/data/bad/*.xml; do
   [ -f "$f" ] || continue
   nbad=$((nbad + 1))
   b=$(basename "$f")
-  first=$(sed -n 1p "$f")
-  line=$(printf '%s\n' "$first" |
-    sed -n 's/^<!-- *expect: *\([0-9][0-9]*\): .*-->.*$/\1/p')
-  sub=$(printf '%s\n' "$first" |
-    sed -n 's/^<!-- *expect: *[0-9][0-9]*: *\(.*[^ ]\) *-->.*$/\1/p')
+  expect_line "$f"
+  line=$expect_n
+  sub=$expect_sub
   if [ -z "$line" ] || [ -z "$sub" ]; then
     check "bad/$b has an expect line ('<!-- expect: LINE: SUBSTRING -->')" false
     continue

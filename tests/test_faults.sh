@@ -287,11 +287,9 @@ for f in "$top_srcdir"/tests/data/blowup/*.xml; do
   [ -f "$f" ] || continue
   nblow=$((nblow + 1))
   b=$(basename "$f")
-  first=$(sed -n 1p "$f")
-  step=$(printf '%s\n' "$first" |
-    sed -n 's/^<!-- *expect: *\([0-9][0-9]*\): .*-->.*$/\1/p')
-  sub=$(printf '%s\n' "$first" |
-    sed -n 's/^<!-- *expect: *[0-9][0-9]*: *\(.*[^ ]\) *-->.*$/\1/p')
+  expect_line "$f"
+  step=$expect_n
+  sub=$expect_sub
   if [ -z "$step" ] || [ -z "$sub" ]; then
     check "blowup/$b has an expect line ('<!-- expect: STEP: SUBSTRING -->')" false
     continue
