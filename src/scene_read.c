@@ -506,19 +506,20 @@ static ssStatus get_bool(readCtx *c, xEl *e, const char *name, int *out)
               e->label, name, v);
 }
 
-/* One of two spellings of an attribute (x_sample / x_samples). */
-static const char *get_alias(readCtx *c, xEl *e, const char *a, const char *b,
-                             const char **used, ssStatus *st)
+/* A required integer in [lo, hi] with two spellings (x_sample /
+ * x_samples); messages name `a` when neither is given.  *used tells which
+ * spelling was read. */
+static ssStatus get_alias_long(readCtx *c, xEl *e, const char *a,
+                               const char *b, long lo, long hi,
+                               const char **used, long *out)
 {
   const char *va = el_find(e, a), *vb = el_find(e, b);
-  *st = SS_OK;
-  if (va && vb) {
-    *st = fail(c, SS_ERR_PARSE, e->line,
-               "%s: give either '%s' or '%s', not both", e->label, a, b);
-    return NULL;
-  }
+  if (va && vb)
+    return fail(c, SS_ERR_PARSE, e->line,
+                "%s: give either '%s' or '%s', not both", e->label, a, b);
+  if (!va && !vb) return missing(c, e, a);
   *used = va ? a : b;
-  return va ? va : vb;
+  return get_long(c, e, *used, 1, lo, hi, out);
 }
 
 /* Non-element children: blank text, comments, processing instructions
@@ -883,15 +884,9 @@ static ssStatus read_terrain_props(readCtx *c, xmlNodePtr n, const char *label,
   if (!st) st = get_num(c, &e, "y_size", 1, &p->y_size);
   for (int k = 0; k < 2 && !st; k++) {
     const char *used = NULL;
-    const char *v = get_alias(c, &e, k ? "y_samples" : "x_samples",
-                              k ? "y_sample" : "x_sample", &used, &st);
-    if (st) break;
-    if (!v) {
-      st = missing(c, &e, k ? "y_samples" : "x_samples");
-      break;
-    }
     long x = 0;
-    st = get_long(c, &e, used, 1, 2, INT_MAX, &x);
+    st = get_alias_long(c, &e, k ? "y_samples" : "x_samples",
+                        k ? "y_sample" : "x_sample", 2, INT_MAX, &used, &x);
     if (!st) *(k ? &p->y_samples : &p->x_samples) = (int)x;
   }
   if (!st) st = get_num(c, &e, "frequency", 0, &p->frequency);
@@ -1064,14 +1059,9 @@ static ssStatus read_heightmap(readCtx *c, xmlNodePtr n)
     long cnt[2] = {0, 0};
     for (int k = 0; k < 2 && !st; k++) {
       const char *used = NULL;
-      const char *v = get_alias(c, &e, k ? "y_sample" : "x_sample",
-                                k ? "y_samples" : "x_samples", &used, &st);
-      if (st) break;
-      if (!v) {
-        st = missing(c, &e, k ? "y_sample" : "x_sample");
-        break;
-      }
-      st = get_long(c, &e, used, 1, LONG_MIN, LONG_MAX, &cnt[k]);
+      st = get_alias_long(c, &e, k ? "y_sample" : "x_sample",
+                          k ? "y_samples" : "x_samples", LONG_MIN, LONG_MAX,
+                          &used, &cnt[k]);
       if (!st && cnt[k] < 2)
         st = fail(c, SS_ERR_VALUE, e.line,
                   "%s: %s = %ld is invalid: need at least 2 samples along %c",
