@@ -447,6 +447,16 @@ static ssStatus get_array(readCtx *c, xEl *e, const char *name, long n,
   return SS_OK;
 }
 
+/* An optional array attribute of any length: its *n values into *out. */
+static ssStatus get_list(readCtx *c, xEl *e, const char *name, int *n,
+                         double **out)
+{
+  const char *v = el_find(e, name);
+  if (!v) return SS_OK;
+  *n = (int)ss_xml_vec_count(v);
+  return get_array(c, e, name, *n, "as many", 0, out);
+}
+
 static ssStatus get_long(readCtx *c, xEl *e, const char *name, int required,
                          long lo, long hi, long *out)
 {
@@ -1228,19 +1238,9 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
       xEl se;
       st = open_leaf(c, k, e.label, sa, &se);
       if (!st) st = once(c, &seen_state, &se);
-      const char *v;
-      if (!st && (v = el_find(&se, "qpos"))) {
-        nqpos = (int)ss_xml_vec_count(v);
-        st = get_array(c, &se, "qpos", nqpos, "as many", 0, &qpos);
-      }
-      if (!st && (v = el_find(&se, "qvel"))) {
-        nqvel = (int)ss_xml_vec_count(v);
-        st = get_array(c, &se, "qvel", nqvel, "as many", 0, &qvel);
-      }
-      if (!st && (v = el_find(&se, "reference_qpos"))) {
-        nref = (int)ss_xml_vec_count(v);
-        st = get_array(c, &se, "reference_qpos", nref, "as many", 0, &ref);
-      }
+      if (!st) st = get_list(c, &se, "qpos", &nqpos, &qpos);
+      if (!st) st = get_list(c, &se, "qvel", &nqvel, &qvel);
+      if (!st) st = get_list(c, &se, "reference_qpos", &nref, &ref);
       if (!st) st = get_vec(c, &se, "pos", 3, 0, def.pos);
       if (!st) st = get_vec(c, &se, "quat", 4, 0, def.quat);
       if (!st && quat_is_zero(def.quat))
