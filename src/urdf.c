@@ -567,26 +567,19 @@ static ssStatus resolve_mesh(uCtx *c, const xEl *e, const char *fn,
       return fail(c, SS_ERR_VALUE, e->line, "%s: mesh path '%.300s' is too long",
                   e->label, fn);
     ncand = 2;
-  } else if (!strncmp(fn, "file://", 7)) {
-    const char *p = fn + 7;
+  } else if (strstr(fn, "://") && strncmp(fn, "file://", 7)) {
+    return fail(c, SS_ERR_UNSUPPORTED, e->line,
+                "%s: filename = '%.300s' uses an unsupported URI scheme "
+                "(allowed: package://, file://, plain paths)", e->label, fn);
+  } else {
+    /* file://PATH or a plain PATH: absolute, or relative to the URDF */
+    const char *p = strncmp(fn, "file://", 7) ? fn : fn + 7;
     if (!*p)
       return fail(c, SS_ERR_PARSE, e->line, "%s: filename = '%s' names no file",
                   e->label, fn);
     int bad = p[0] == '/' ? snprintf(cand[0], sizeof cand[0], "%s", p) >=
                                 (int)sizeof cand[0]
                           : join_path(cand[0], sizeof cand[0], c->dir, p);
-    if (bad)
-      return fail(c, SS_ERR_VALUE, e->line, "%s: mesh path '%.300s' is too long",
-                  e->label, fn);
-    ncand = 1;
-  } else if (strstr(fn, "://")) {
-    return fail(c, SS_ERR_UNSUPPORTED, e->line,
-                "%s: filename = '%.300s' uses an unsupported URI scheme "
-                "(allowed: package://, file://, plain paths)", e->label, fn);
-  } else {
-    int bad = fn[0] == '/' ? snprintf(cand[0], sizeof cand[0], "%s", fn) >=
-                                 (int)sizeof cand[0]
-                           : join_path(cand[0], sizeof cand[0], c->dir, fn);
     if (bad)
       return fail(c, SS_ERR_VALUE, e->line, "%s: mesh path '%.300s' is too long",
                   e->label, fn);
