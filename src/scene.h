@@ -147,6 +147,13 @@ typedef struct ssCLocale {
 } ssCLocale;
 int ss_scene_c_locale_push(ssCLocale *l);
 void ss_scene_c_locale_pop(ssCLocale *l);
+/* push for a reader of `path`: SS_OK (also when no C locale object could
+ * be made but the decimal point is already '.'), or SS_ERR_STATE in *err.
+ * Undo with pop either way. */
+ssStatus ss_scene_c_locale_begin(ssCLocale *l, const char *path, ssError *err);
+
+/* The folder of path into dir[cap]: "." for a bare name, "/" at the root. */
+void ss_scene_path_dir(const char *path, char *dir, size_t cap);
 
 /* ---------------------------------------------------------------------- */
 /* height-map sources (hfield_source.c)                                    */

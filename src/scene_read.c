@@ -2,18 +2,17 @@
  *
  * The accepted format, the safety measures and the error conventions are
  * described in scene.h.  The reader parses the whole document with libxml2
- * (safely), then walks the tree once, building the model with the model
- * builder; every element is checked against a list of allowed attributes
- * and children so that typos are reported instead of ignored. */
+ * (safely: xml_safe.h), then walks the tree once, building the model with
+ * the model builder; every element is checked against a list of allowed
+ * attributes and children so that typos are reported instead of ignored. */
 #include "scene.h"
 #include "articulated.h"
 #include "urdf.h"
 #include "ss_math.h"
+#include "xml_safe.h"
 
 #include <libxml/parser.h>
-#include <libxml/parserInternals.h>
 #include <libxml/tree.h>
-#include <libxml/xmlerror.h>
 
 #include <errno.h>
 #include <fcntl.h>
@@ -112,6 +111,27 @@ void ss_scene_c_locale_pop(ssCLocale *l)
   uselocale(l->old);
   freelocale(l->loc);
   l->loc = (locale_t)0;
+}
+
+ssStatus ss_scene_c_locale_begin(ssCLocale *l, const char *path, ssError *err)
+{
+  if (ss_scene_c_locale_push(l) == 0) return SS_OK;
+  struct lconv *lc = localeconv();
+  if (!lc || !lc->decimal_point || strcmp(lc->decimal_point, "."))
+    return ss_error_set(err, SS_ERR_STATE, path, 0,
+                        "cannot switch to the C locale to read numbers");
+  return SS_OK;
+}
+
+void ss_scene_path_dir(const char *path, char *dir, size_t cap)
+{
+  const char *slash = path ? strrchr(path, '/') : NULL;
+  if (!slash)
+    snprintf(dir, cap, ".");
+  else if (slash == path)
+    snprintf(dir, cap, "/");
+  else
+    snprintf(dir, cap, "%.*s", (int)(slash - path), path);
 }
 
 static int is_digit(char ch) { return ch >= '0' && ch <= '9'; }
@@ -265,17 +285,6 @@ static void norm_name(const char *in, char out[NAME_CAP])
   if (!strcmp(out, "timestep")) strcpy(out, "time_step");
 }
 
-/* The line where an element's start tag begins, recorded while parsing
- * (libxml2's own node line is where the start tag ends, the last line of a
- * multi-line tag, and stops at 65535). */
-static int line_of(xmlNodePtr n)
-{
-  if (n->type == XML_ELEMENT_NODE && n->_private)
-    return (int)(intptr_t)n->_private;
-  long l = xmlGetLineNo(n);
-  return l > 0 && l < INT_MAX ? (int)l : 0;
-}
-
 static void el_free(xEl *e)
 {
   for (int i = 0; i < e->nattr; i++)
@@ -292,7 +301,7 @@ static ssStatus el_open(readCtx *c, xmlNodePtr node, const char *parent_label,
   e->node = node;
   e->raw = (const char *)node->name;
   norm_name(e->raw, e->name);
-  e->line = line_of(node);
+  e->line = ss_xml_line(node);
   if (parent_label)
     snprintf(e->label, sizeof e->label, "%s <%s>", parent_label, e->name);
   else
@@ -304,14 +313,7 @@ static ssStatus el_open(readCtx *c, xmlNodePtr node, const char *parent_label,
     xAttr *x = &e->attr[e->nattr];
     x->raw = (const char *)a->name;
     norm_name(x->raw, x->name);
-    if (a->children && a->children->type == XML_TEXT_NODE && !a->children->next &&
-        a->children->content) {
-      x->val = (const char *)a->children->content;
-    } else {
-      xmlChar *v = xmlNodeListGetString(c->doc, a->children, 1);
-      e->owned[e->nattr] = v;
-      x->val = v ? (const char *)v : "";
-    }
+    x->val = ss_xml_attr_text(c->doc, a, &e->owned[e->nattr]);
     e->nattr++;
     for (int i = 0; i < e->nattr - 1; i++)
       if (!strcmp(e->attr[i].name, x->name))
@@ -322,31 +324,13 @@ static ssStatus el_open(readCtx *c, xmlNodePtr node, const char *parent_label,
   return SS_OK;
 }
 
-static void join_names(char *out, size_t cap, const char *const *names)
-{
-  size_t k = 0;
-  out[0] = 0;
-  for (int i = 0; names[i]; i++) {
-    int n = snprintf(out + k, cap - k, "%s%s", i ? ", " : "", names[i]);
-    if (n < 0 || (size_t)n >= cap - k) break;
-    k += (size_t)n;
-  }
-}
-
-static int in_list(const char *name, const char *const *list)
-{
-  for (int i = 0; list[i]; i++)
-    if (!strcmp(list[i], name)) return 1;
-  return 0;
-}
-
 /* Every attribute must be in `allowed` (NULL-terminated). */
 static ssStatus el_allow(readCtx *c, xEl *e, const char *const *allowed)
 {
   for (int i = 0; i < e->nattr; i++)
-    if (!in_list(e->attr[i].name, allowed)) {
+    if (!ss_xml_in_list(e->attr[i].name, allowed)) {
       char list[600];
-      join_names(list, sizeof list, allowed);
+      ss_xml_join_names(list, sizeof list, allowed);
       return fail(c, SS_ERR_PARSE, e->line,
                   "unknown attribute '%s' on <%s> (allowed: %s)", e->attr[i].raw,
                   e->name, allowed[0] ? list : "none");
@@ -389,45 +373,6 @@ static ssStatus get_material(readCtx *c, xEl *e, const char **out)
   return SS_OK;
 }
 
-static int is_space(char ch)
-{
-  return ch == ' ' || ch == '\t' || ch == '\n' || ch == '\r';
-}
-
-/* Next value of a vector: separated by white space or one comma.  Returns
- * 1 with [*tb, *te), 0 at the end, -1 on an empty value (",," or a comma
- * at either end). */
-static int vec_next(const char **pp, int first, const char **tb, const char **te)
-{
-  const char *p = *pp;
-  while (is_space(*p)) p++;
-  if (*p == ',') {
-    if (first) return -1;
-    p++;
-    while (is_space(*p)) p++;
-    if (*p == 0 || *p == ',') return -1;
-  }
-  if (*p == 0) {
-    *pp = p;
-    return 0;
-  }
-  *tb = p;
-  while (*p && !is_space(*p) && *p != ',') p++;
-  *te = p;
-  *pp = p;
-  return 1;
-}
-
-/* Count the values of a vector attribute; -1 on a syntax error. */
-static long vec_count(const char *v)
-{
-  const char *p = v, *tb, *te;
-  long n = 0;
-  int r;
-  while ((r = vec_next(&p, n == 0, &tb, &te)) == 1) n++;
-  return r < 0 ? -1 : n;
-}
-
 static ssStatus bad_number(readCtx *c, xEl *e, const char *name, const char *tb,
                            const char *te, long index, long n, int why)
 {
@@ -446,7 +391,7 @@ static ssStatus parse_values(readCtx *c, xEl *e, const char *name,
                              const char *v, long n, const char *what,
                              double *out)
 {
-  long got = vec_count(v);
+  long got = ss_xml_vec_count(v);
   if (got < 0)
     return fail(c, SS_ERR_PARSE, e->line,
                 "%s: attribute '%s' has an empty value (values are separated "
@@ -462,7 +407,7 @@ static ssStatus parse_values(readCtx *c, xEl *e, const char *name,
   }
   const char *p = v, *tb = NULL, *te = NULL;
   for (long k = 0; k < n; k++) {
-    vec_next(&p, k == 0, &tb, &te);
+    ss_xml_vec_next(&p, k == 0, &tb, &te);
     int r = ss_scene_parse_double(tb, te, &out[k]);
     if (r) return bad_number(c, e, name, tb, te, k, n, r);
   }
@@ -502,17 +447,27 @@ static ssStatus get_array(readCtx *c, xEl *e, const char *name, long n,
   return SS_OK;
 }
 
+/* An optional array attribute of any length: its *n values into *out. */
+static ssStatus get_list(readCtx *c, xEl *e, const char *name, int *n,
+                         double **out)
+{
+  const char *v = el_find(e, name);
+  if (!v) return SS_OK;
+  *n = (int)ss_xml_vec_count(v);
+  return get_array(c, e, name, *n, "as many", 0, out);
+}
+
 static ssStatus get_long(readCtx *c, xEl *e, const char *name, int required,
                          long lo, long hi, long *out)
 {
   const char *v = el_find(e, name);
   if (!v) return required ? missing(c, e, name) : SS_OK;
   const char *p = v, *tb = NULL, *te = NULL;
-  long n = vec_count(v);
+  long n = ss_xml_vec_count(v);
   int r = 1;
   long x = 0;
   if (n == 1) {
-    vec_next(&p, 1, &tb, &te);
+    ss_xml_vec_next(&p, 1, &tb, &te);
     r = ss_scene_parse_long(tb, te, &x);
   }
   if (r != 0) {
@@ -544,8 +499,8 @@ static ssStatus get_bool(readCtx *c, xEl *e, const char *name, int *out)
   const char *v = el_find(e, name);
   if (!v) return SS_OK;
   const char *p = v, *tb = NULL, *te = NULL;
-  if (vec_count(v) == 1) {
-    vec_next(&p, 1, &tb, &te);
+  if (ss_xml_vec_count(v) == 1) {
+    ss_xml_vec_next(&p, 1, &tb, &te);
     size_t n = (size_t)(te - tb);
     if ((n == 4 && !strncmp(tb, "true", 4)) || (n == 1 && *tb == '1')) {
       *out = 1;
@@ -561,67 +516,44 @@ static ssStatus get_bool(readCtx *c, xEl *e, const char *name, int *out)
               e->label, name, v);
 }
 
-/* One of two spellings of an attribute (x_sample / x_samples). */
-static const char *get_alias(readCtx *c, xEl *e, const char *a, const char *b,
-                             const char **used, ssStatus *st)
+/* A required integer in [lo, hi] with two spellings (x_sample /
+ * x_samples); messages name `a` when neither is given.  *used tells which
+ * spelling was read. */
+static ssStatus get_alias_long(readCtx *c, xEl *e, const char *a,
+                               const char *b, long lo, long hi,
+                               const char **used, long *out)
 {
   const char *va = el_find(e, a), *vb = el_find(e, b);
-  *st = SS_OK;
-  if (va && vb) {
-    *st = fail(c, SS_ERR_PARSE, e->line,
-               "%s: give either '%s' or '%s', not both", e->label, a, b);
-    return NULL;
-  }
+  if (va && vb)
+    return fail(c, SS_ERR_PARSE, e->line,
+                "%s: give either '%s' or '%s', not both", e->label, a, b);
+  if (!va && !vb) return missing(c, e, a);
   *used = va ? a : b;
-  return va ? va : vb;
+  return get_long(c, e, *used, 1, lo, hi, out);
 }
 
-static int is_blank(const xmlChar *s)
-{
-  if (!s) return 1;
-  for (; *s; s++)
-    if (!is_space((char)*s)) return 0;
-  return 1;
-}
-
-/* Non-element children: blank text, comments and processing instructions
- * are fine; anything else is an error. */
+/* Non-element children: blank text, comments, processing instructions
+ * and XInclude markers are fine; anything else is an error. */
 static ssStatus check_other_node(readCtx *c, xmlNodePtr n, const xEl *parent)
 {
-  switch (n->type) {
-  case XML_TEXT_NODE:
-  case XML_CDATA_SECTION_NODE:
-    if (is_blank(n->content)) return SS_OK;
-    {
-      const char *t = (const char *)n->content;
-      while (is_space(*t)) t++;
-      int len = 0;
-      while (t[len] && !is_space(t[len]) && len < 30) len++;
-      return fail(c, SS_ERR_PARSE, line_of(n) ? line_of(n) : parent->line,
-                  "unexpected text '%.*s' inside <%s> (values go in "
-                  "attributes)", len, t, parent->name);
-    }
-  case XML_COMMENT_NODE:
-  case XML_PI_NODE:
-  case XML_XINCLUDE_START:
-  case XML_XINCLUDE_END:
+  char msg[sizeof c->e.message];
+  if (n->type == XML_XINCLUDE_START || n->type == XML_XINCLUDE_END ||
+      !ss_xml_stray(n, parent->name, msg, sizeof msg))
     return SS_OK;
-  default:
-    return fail(c, SS_ERR_PARSE, line_of(n) ? line_of(n) : parent->line,
-                "unexpected content inside <%s>", parent->name);
-  }
+  return fail(c, SS_ERR_PARSE, ss_xml_line(n) ? ss_xml_line(n) : parent->line,
+              "%s", msg);
 }
 
 static ssStatus unknown_child(readCtx *c, xmlNodePtr n, const xEl *parent,
                               const char *const *allowed)
 {
   char list[400];
-  join_names(list, sizeof list, allowed);
+  ss_xml_join_names(list, sizeof list, allowed);
   if (!allowed[0])
-    return fail(c, SS_ERR_PARSE, line_of(n),
+    return fail(c, SS_ERR_PARSE, ss_xml_line(n),
                 "unknown element <%s> inside <%s> (<%s> has no child "
                 "elements)", (const char *)n->name, parent->name, parent->name);
-  return fail(c, SS_ERR_PARSE, line_of(n),
+  return fail(c, SS_ERR_PARSE, ss_xml_line(n),
               "unknown element <%s> inside <%s> (allowed: %s)",
               (const char *)n->name, parent->name, list);
 }
@@ -656,6 +588,28 @@ static ssStatus once(readCtx *c, int *seen, const xEl *e)
                 e->name, *seen);
   *seen = e->line ? e->line : -1;
   return SS_OK;
+}
+
+/* once() for the child element k, named kn, before it is opened. */
+static ssStatus once_at(readCtx *c, int *seen, xmlNodePtr k, const char *kn)
+{
+  xEl tmp;
+  tmp.line = ss_xml_line(k);
+  snprintf(tmp.name, sizeof tmp.name, "%s", kn);
+  return once(c, seen, &tmp);
+}
+
+/* In a loop over an element's children: 1 when k is an element (its name
+ * normalised into kn); otherwise 0, with k checked into *st. */
+static int child_el(readCtx *c, xmlNodePtr k, const xEl *parent,
+                    char kn[NAME_CAP], ssStatus *st)
+{
+  if (k->type != XML_ELEMENT_NODE) {
+    *st = check_other_node(c, k, parent);
+    return 0;
+  }
+  norm_name((const char *)k->name, kn);
+  return 1;
 }
 
 /* Expand [THIS_DIR]; a relative path without it is relative to the scene's
@@ -818,7 +772,7 @@ static ssStatus read_xforce(readCtx *c, xmlNodePtr n, const char *label,
   xEl e;
   memset(x, 0, sizeof *x);
   x->end = INFINITY;
-  x->line = line_of(n);
+  x->line = ss_xml_line(n);
   ssStatus st = open_leaf(c, n, label, allowed, &e);
   if (!st) st = get_vec(c, &e, "force", 3, 0, x->force);
   if (!st) st = get_vec(c, &e, "torque", 3, 0, x->torque);
@@ -874,29 +828,22 @@ static ssStatus read_body(readCtx *c, xmlNodePtr n, ssGeomType shape)
   int seen_dim = 0, seen_state = 0, seen_inertia = 0;
   double quat_read[4] = {1, 0, 0, 0};
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
-    if (k->type != XML_ELEMENT_NODE) {
-      st = check_other_node(c, k, &e);
-      continue;
-    }
     char kn[NAME_CAP];
-    norm_name((const char *)k->name, kn);
-    xEl tmp;
-    tmp.line = line_of(k);
-    snprintf(tmp.name, sizeof tmp.name, "%s", kn);
+    if (!child_el(c, k, &e, kn, &st)) continue;
     if (!strcmp(kn, "dim")) {
-      st = once(c, &seen_dim, &tmp);
+      st = once_at(c, &seen_dim, k, kn);
       if (!st) st = read_dim(c, k, e.label, &def);
     } else if (!strcmp(kn, "state")) {
-      st = once(c, &seen_state, &tmp);
+      st = once_at(c, &seen_state, k, kn);
       if (!st) st = read_state(c, k, e.label, &def);
       memcpy(quat_read, def.quat, sizeof quat_read);
     } else if (!strcmp(kn, "inertia")) {
-      st = once(c, &seen_inertia, &tmp);
+      st = once_at(c, &seen_inertia, k, kn);
       if (!st) st = read_inertia(c, k, e.label, &def);
     } else if (!strcmp(kn, "external_force")) {
       xforceDef *p = realloc(xf, (size_t)(nxf + 1) * sizeof *xf);
       if (!p) {
-        st = fail(c, SS_ERR_NOMEM, tmp.line, "out of memory");
+        st = fail(c, SS_ERR_NOMEM, ss_xml_line(k), "out of memory");
         break;
       }
       xf = p;
@@ -947,15 +894,9 @@ static ssStatus read_terrain_props(readCtx *c, xmlNodePtr n, const char *label,
   if (!st) st = get_num(c, &e, "y_size", 1, &p->y_size);
   for (int k = 0; k < 2 && !st; k++) {
     const char *used = NULL;
-    const char *v = get_alias(c, &e, k ? "y_samples" : "x_samples",
-                              k ? "y_sample" : "x_sample", &used, &st);
-    if (st) break;
-    if (!v) {
-      st = missing(c, &e, k ? "y_samples" : "x_samples");
-      break;
-    }
     long x = 0;
-    st = get_long(c, &e, used, 1, 2, INT_MAX, &x);
+    st = get_alias_long(c, &e, k ? "y_samples" : "x_samples",
+                        k ? "y_sample" : "x_sample", 2, INT_MAX, &used, &x);
     if (!st) *(k ? &p->y_samples : &p->x_samples) = (int)x;
   }
   if (!st) st = get_num(c, &e, "frequency", 0, &p->frequency);
@@ -1128,14 +1069,9 @@ static ssStatus read_heightmap(readCtx *c, xmlNodePtr n)
     long cnt[2] = {0, 0};
     for (int k = 0; k < 2 && !st; k++) {
       const char *used = NULL;
-      const char *v = get_alias(c, &e, k ? "y_sample" : "x_sample",
-                                k ? "y_samples" : "x_samples", &used, &st);
-      if (st) break;
-      if (!v) {
-        st = missing(c, &e, k ? "y_sample" : "x_sample");
-        break;
-      }
-      st = get_long(c, &e, used, 1, LONG_MIN, LONG_MAX, &cnt[k]);
+      st = get_alias_long(c, &e, k ? "y_sample" : "x_sample",
+                          k ? "y_samples" : "x_samples", LONG_MIN, LONG_MAX,
+                          &used, &cnt[k]);
       if (!st && cnt[k] < 2)
         st = fail(c, SS_ERR_VALUE, e.line,
                   "%s: %s = %ld is invalid: need at least 2 samples along %c",
@@ -1184,18 +1120,14 @@ static ssStatus read_heightmap(readCtx *c, xmlNodePtr n)
   } else if (!st && form == HF_GENERATED) {
     ssTerrainProps p;
     if (ntp > 1) {
-      xEl tmp;
-      tmp.line = line_of(tp);
-      strcpy(tmp.name, "terrain_properties");
       int seen = 0;
-      once(c, &seen, &tmp);
+      once_at(c, &seen, tp, "terrain_properties");
       for (xmlNodePtr k = tp->next; k; k = k->next)
         if (k->type == XML_ELEMENT_NODE) {
           char kn[NAME_CAP];
           norm_name((const char *)k->name, kn);
           if (!strcmp(kn, "terrain_properties")) {
-            tmp.line = line_of(k);
-            st = once(c, &seen, &tmp);
+            st = once_at(c, &seen, k, kn);
             break;
           }
         }
@@ -1217,17 +1149,10 @@ static ssStatus read_heightmap(readCtx *c, xmlNodePtr n)
   /* children: <soil>, and <terrain_properties> (read above) */
   int seen_soil = 0;
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
-    if (k->type != XML_ELEMENT_NODE) {
-      st = check_other_node(c, k, &e);
-      continue;
-    }
     char kn[NAME_CAP];
-    norm_name((const char *)k->name, kn);
+    if (!child_el(c, k, &e, kn, &st)) continue;
     if (!strcmp(kn, "soil")) {
-      xEl tmp;
-      tmp.line = line_of(k);
-      strcpy(tmp.name, "soil");
-      st = once(c, &seen_soil, &tmp);
+      st = once_at(c, &seen_soil, k, kn);
       if (!st) st = read_soil(c, k, e.label, def.nx, def.ny, &def.soilmat, &ps);
       def.soil = 1;
     } else if (!(form == HF_GENERATED && !strcmp(kn, "terrain_properties"))) {
@@ -1305,31 +1230,17 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
   int nqpos = 0, nqvel = 0, nref = 0, seen_state = 0, npd = 0;
   pendingPd pd[64];
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
-    if (k->type != XML_ELEMENT_NODE) {
-      st = check_other_node(c, k, &e);
-      continue;
-    }
     char kn[NAME_CAP];
-    norm_name((const char *)k->name, kn);
+    if (!child_el(c, k, &e, kn, &st)) continue;
     if (!strcmp(kn, "state")) {
       static const char *const sa[] = {"qpos", "qvel", "pos", "quat",
                                        "reference_qpos", NULL};
       xEl se;
       st = open_leaf(c, k, e.label, sa, &se);
       if (!st) st = once(c, &seen_state, &se);
-      const char *v;
-      if (!st && (v = el_find(&se, "qpos"))) {
-        nqpos = (int)vec_count(v);
-        st = get_array(c, &se, "qpos", nqpos, "as many", 0, &qpos);
-      }
-      if (!st && (v = el_find(&se, "qvel"))) {
-        nqvel = (int)vec_count(v);
-        st = get_array(c, &se, "qvel", nqvel, "as many", 0, &qvel);
-      }
-      if (!st && (v = el_find(&se, "reference_qpos"))) {
-        nref = (int)vec_count(v);
-        st = get_array(c, &se, "reference_qpos", nref, "as many", 0, &ref);
-      }
+      if (!st) st = get_list(c, &se, "qpos", &nqpos, &qpos);
+      if (!st) st = get_list(c, &se, "qvel", &nqvel, &qvel);
+      if (!st) st = get_list(c, &se, "reference_qpos", &nref, &ref);
       if (!st) st = get_vec(c, &se, "pos", 3, 0, def.pos);
       if (!st) st = get_vec(c, &se, "quat", 4, 0, def.quat);
       if (!st && quat_is_zero(def.quat))
@@ -1458,7 +1369,8 @@ static ssStatus refuse_media(readCtx *c, xmlNodePtr k, const char *kn,
              "objects (not supported)"
       : kn[0] == 'g' ? "granular media are not supported"
                      : "deformable objects are not supported";
-  ssStatus st = fail(c, SS_ERR_UNSUPPORTED, line_of(k), "<%s>%s%.100s%s: %s",
+  ssStatus st = fail(c, SS_ERR_UNSUPPORTED, ss_xml_line(k),
+                     "<%s>%s%.100s%s: %s",
                      kn, nm ? " '" : "", nm ? (const char *)nm : "",
                      nm ? "'" : "", why);
   if (nm) xmlFree(nm);
@@ -1476,12 +1388,8 @@ static ssStatus read_objects(readCtx *c, xmlNodePtr n)
   if (!st) st = el_allow(c, &e, none);
   int soil = has_soil_bed(n);
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
-    if (k->type != XML_ELEMENT_NODE) {
-      st = check_other_node(c, k, &e);
-      continue;
-    }
     char kn[NAME_CAP];
-    norm_name((const char *)k->name, kn);
+    if (!child_el(c, k, &e, kn, &st)) continue;
     if (!strcmp(kn, "ground")) st = read_ground(c, k);
     else if (!strcmp(kn, "box")) st = read_body(c, k, SS_GEOM_BOX);
     else if (!strcmp(kn, "sphere")) st = read_body(c, k, SS_GEOM_SPHERE);
@@ -1491,12 +1399,12 @@ static ssStatus read_objects(readCtx *c, xmlNodePtr n)
     else if (!strcmp(kn, "articulated_system")) st = read_articulated(c, k);
     else if (!strcmp(kn, "mesh")) {
       xmlChar *nm = xmlGetProp(k, BAD_CAST "name");
-      st = fail(c, SS_ERR_UNSUPPORTED, line_of(k),
+      st = fail(c, SS_ERR_UNSUPPORTED, ss_xml_line(k),
                 "<%s>%s%s%s is not supported yet (supported objects: ground, "
                 "box, sphere, cylinder, capsule, heightmap, articulated_system)", kn,
                 nm ? " '" : "", nm ? (const char *)nm : "", nm ? "'" : "");
       if (nm) xmlFree(nm);
-    } else if (in_list(kn, media_names))
+    } else if (ss_xml_in_list(kn, media_names))
       st = refuse_media(c, k, kn, soil);
     else
       st = unknown_child(c, k, &e, kids);
@@ -1525,12 +1433,8 @@ static ssStatus read_material(readCtx *c, xmlNodePtr n)
   ssStatus st = el_open(c, n, NULL, &e);
   if (!st) st = el_allow(c, &e, none);
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
-    if (k->type != XML_ELEMENT_NODE) {
-      st = check_other_node(c, k, &e);
-      continue;
-    }
     char kn[NAME_CAP];
-    norm_name((const char *)k->name, kn);
+    if (!child_el(c, k, &e, kn, &st)) continue;
     xEl x;
     if (!strcmp(kn, "default")) {
       ssMaterialPair p = c->m->material_default;
@@ -1700,12 +1604,8 @@ static ssStatus read_root(readCtx *c, xmlNodePtr root)
   if (!st) st = el_allow(c, &e, allowed);
   int seen[7] = {0};
   for (xmlNodePtr k = root->children; !st && k; k = k->next) {
-    if (k->type != XML_ELEMENT_NODE) {
-      st = check_other_node(c, k, &e);
-      continue;
-    }
     char kn[NAME_CAP];
-    norm_name((const char *)k->name, kn);
+    if (!child_el(c, k, &e, kn, &st)) continue;
     int which = -1;
     for (int i = 0; kids[i]; i++)
       if (!strcmp(kn, kids[i])) which = i;
@@ -1740,96 +1640,7 @@ static ssStatus read_root(readCtx *c, xmlNodePtr root)
 }
 
 /* ---------------------------------------------------------------------- */
-/* libxml2: safe parsing                                                   */
-
-typedef struct xmlGuard {
-  startElementNsSAX2Func start; /* libxml2's tree builder */
-  int doctype_line;  /* > 0: a DOCTYPE was met (parsing stopped there) */
-  int entity_refused;
-  int have_error;
-  int error_line;
-  char error_msg[400];
-} xmlGuard;
-
-static xmlGuard *guard_of(void *ctx)
-{
-  xmlParserCtxtPtr p = (xmlParserCtxtPtr)ctx;
-  return p ? (xmlGuard *)p->_private : NULL;
-}
-
-/* Structured error handler: keep the first error, print nothing. */
-static void on_xml_error(void *data, xmlErrorPtr err)
-{
-  xmlGuard *g = (xmlGuard *)data;
-  if (!g || !err || err->level < XML_ERR_ERROR || g->have_error) return;
-  g->have_error = 1;
-  g->error_line = err->line;
-  snprintf(g->error_msg, sizeof g->error_msg, "%s",
-           err->message ? err->message : "malformed XML");
-  size_t n = strlen(g->error_msg);
-  while (n > 0 && (g->error_msg[n - 1] == '\n' || g->error_msg[n - 1] == ' '))
-    g->error_msg[--n] = 0;
-}
-
-static void on_generic_error(void *data, const char *msg, ...)
-{
-  (void)data;
-  (void)msg;
-}
-
-/* Any DOCTYPE stops the parser before its internal subset is read. */
-static void on_internal_subset(void *ctx, const xmlChar *name,
-                               const xmlChar *external_id,
-                               const xmlChar *system_id)
-{
-  (void)name;
-  (void)external_id;
-  (void)system_id;
-  xmlParserCtxtPtr p = (xmlParserCtxtPtr)ctx;
-  xmlGuard *g = guard_of(ctx);
-  if (g && !g->doctype_line)
-    g->doctype_line = p && p->input && p->input->line > 0 ? p->input->line : 1;
-  xmlStopParser(p);
-}
-
-/* Build the element as usual, then record the line of its '<' in the
- * node's application pointer.  The parser is at the end of the start tag;
- * a start tag holds no other '<' (attribute values cannot), so the tag
- * begins at the last '<' before the current position. */
-static void on_start_element(void *ctx, const xmlChar *localname,
-                             const xmlChar *prefix, const xmlChar *uri,
-                             int nb_namespaces, const xmlChar **namespaces,
-                             int nb_attributes, int nb_defaulted,
-                             const xmlChar **attributes)
-{
-  xmlParserCtxtPtr p = (xmlParserCtxtPtr)ctx;
-  xmlGuard *g = guard_of(ctx);
-  if (!g || !g->start) return;
-  g->start(ctx, localname, prefix, uri, nb_namespaces, namespaces,
-           nb_attributes, nb_defaulted, attributes);
-  xmlNodePtr node = p->node;
-  xmlParserInputPtr in = p->input;
-  if (!node || !in || !in->cur || !in->base || in->line <= 0) return;
-  const xmlChar *q = in->cur;
-  int nl = 0;
-  while (q > in->base && q[-1] != '<') {
-    q--;
-    if (*q == '\n') nl++;
-  }
-  int line = q > in->base && in->line - nl > 0 ? in->line - nl : in->line;
-  node->_private = (void *)(intptr_t)line;
-}
-
-/* Deny-by-default external entity loader: nothing is ever fetched. */
-static xmlParserInputPtr deny_entity_loader(const char *url, const char *id,
-                                            xmlParserCtxtPtr ctxt)
-{
-  (void)url;
-  (void)id;
-  xmlGuard *g = guard_of(ctxt);
-  if (g) g->entity_refused = 1;
-  return NULL;
-}
+/* parsing                                                                 */
 
 static ssStatus parse_xml(readCtx *c, const char *buf, size_t len,
                           xmlDocPtr *out)
@@ -1840,87 +1651,28 @@ static ssStatus parse_xml(readCtx *c, const char *buf, size_t len,
   if (len > (size_t)SS_SCENE_MAX_BYTES)
     return fail(c, SS_ERR_IO, 0, "scene is %zu bytes, larger than the limit "
                 "of %ld", len, (long)SS_SCENE_MAX_BYTES);
-  xmlInitParser();
-  xmlGuard g;
-  memset(&g, 0, sizeof g);
-
-  /* libxml2's handlers are global: install ours for this parse only */
-  xmlStructuredErrorFunc old_serror = xmlStructuredError;
-  void *old_sctx = xmlStructuredErrorContext;
-  xmlGenericErrorFunc old_gerror = xmlGenericError;
-  void *old_gctx = xmlGenericErrorContext;
-  xmlExternalEntityLoader old_loader = xmlGetExternalEntityLoader();
-  xmlSetStructuredErrorFunc(&g, on_xml_error);
-  xmlSetGenericErrorFunc(NULL, on_generic_error);
-  xmlSetExternalEntityLoader(deny_entity_loader);
-
-  ssStatus st = SS_OK;
-  xmlParserCtxtPtr p = xmlCreateMemoryParserCtxt(buf, (int)len);
-  if (!p) {
-    st = fail(c, SS_ERR_NOMEM, 0, "out of memory starting the XML parser");
-  } else {
-    p->_private = &g;
-    if (p->sax) {
-      p->sax->internalSubset = on_internal_subset;
-      g.start = p->sax->startElementNs;
-      if (g.start) p->sax->startElementNs = on_start_element;
-    }
-    /* never XML_PARSE_NOENT, XML_PARSE_DTDLOAD, XML_PARSE_DTDATTR or
-     * XML_PARSE_XINCLUDE; HUGE: see scene.h */
-    xmlCtxtUseOptions(p, XML_PARSE_NONET | XML_PARSE_HUGE |
-                             XML_PARSE_BIG_LINES);
-    xmlParseDocument(p);
-    xmlDocPtr doc = p->myDoc;
-    p->myDoc = NULL;
-    if (g.doctype_line) {
-      st = fail(c, SS_ERR_PARSE, g.doctype_line,
+  /* huge: see scene.h */
+  ssXmlResult r;
+  *out = ss_xml_parse(buf, len, 1, &r);
+  switch (r.fail) {
+  case SS_XML_OK:
+    return SS_OK;
+  case SS_XML_NOMEM:
+    return fail(c, SS_ERR_NOMEM, 0, "out of memory starting the XML parser");
+  case SS_XML_DOCTYPE:
+    return fail(c, SS_ERR_PARSE, r.line,
                 "DOCTYPE declarations are not allowed in scene files (no DTDs, "
                 "no entities)");
-    } else if (!p->wellFormed || !doc) {
-      if (g.have_error) {
-        st = fail(c, SS_ERR_PARSE, g.error_line, "XML syntax error: %s",
-                  g.error_msg);
-      } else {
-        xmlErrorPtr le = xmlCtxtGetLastError(p);
-        st = fail(c, SS_ERR_PARSE, le ? le->line : 0, "XML syntax error: %s",
-                  le && le->message ? le->message : "malformed document");
-        size_t n = strlen(c->e.message);
-        while (n > 0 && c->e.message[n - 1] == '\n') c->e.message[--n] = 0;
-      }
-    } else if (doc->intSubset || doc->extSubset || g.entity_refused) {
-      st = fail(c, SS_ERR_PARSE, 1,
-                "DOCTYPE declarations are not allowed in scene files (no DTDs, "
-                "no entities)");
-    } else if (!xmlDocGetRootElement(doc)) {
-      st = fail(c, SS_ERR_PARSE, 1, "no root element: expected <raisim>");
-    }
-    if (st != SS_OK) {
-      if (doc) xmlFreeDoc(doc);
-    } else {
-      *out = doc;
-    }
-    xmlFreeParserCtxt(p);
+  case SS_XML_SYNTAX:
+    return fail(c, SS_ERR_PARSE, r.line, "XML syntax error: %s", r.message);
+  case SS_XML_NO_ROOT:
+    break;
   }
-
-  xmlSetExternalEntityLoader(old_loader);
-  xmlSetGenericErrorFunc(old_gctx, old_gerror);
-  xmlSetStructuredErrorFunc(old_sctx, old_serror);
-  return st;
+  return fail(c, SS_ERR_PARSE, r.line, "no root element: expected <raisim>");
 }
 
 /* ---------------------------------------------------------------------- */
 /* entry points                                                            */
-
-static void this_dir(const char *path, char *dir, size_t cap)
-{
-  const char *slash = path ? strrchr(path, '/') : NULL;
-  if (!slash)
-    snprintf(dir, cap, ".");
-  else if (slash == path)
-    snprintf(dir, cap, "/");
-  else
-    snprintf(dir, cap, "%.*s", (int)(slash - path), path);
-}
 
 static void ctx_free(readCtx *c)
 {
@@ -1938,15 +1690,10 @@ static ssStatus load(const char *buf, size_t len, const char *path,
   readCtx c;
   memset(&c, 0, sizeof c);
   c.path = path;
-  this_dir(path, c.dir, sizeof c.dir);
+  ss_scene_path_dir(path, c.dir, sizeof c.dir);
 
   ssCLocale loc;
-  if (ss_scene_c_locale_push(&loc) != 0) {
-    struct lconv *lc = localeconv();
-    if (!lc || !lc->decimal_point || strcmp(lc->decimal_point, "."))
-      return ss_error_set(err, SS_ERR_STATE, path, 0,
-                          "cannot switch to the C locale to read numbers");
-  }
+  if (ss_scene_c_locale_begin(&loc, path, err) != SS_OK) return SS_ERR_STATE;
 
   ssData *d = NULL;
   ssStatus st = parse_xml(&c, buf, len, &c.doc);

@@ -3,24 +3,22 @@
  *
  * The accepted format, the tree rules, the mesh path rules and the error
  * conventions are described in urdf.h.  The reader parses the whole document
- * with libxml2 (safely, as scene_read.c does), then walks it in passes:
+ * with libxml2 (safely: xml_safe.h), then walks it in passes:
  * named materials, links, joints, the tree (roots, cycles, order, the
  * "world" link), mass checks, then constraints and springs, which name links
  * and joints by their final indices.  Every element is checked against a
  * list of allowed attributes and children so that typos are reported
  * instead of ignored. */
 #include "urdf.h"
+#include "scene.h"
 #include "ss_math.h"
+#include "xml_safe.h"
 
 #include <libxml/parser.h>
-#include <libxml/parserInternals.h>
 #include <libxml/tree.h>
-#include <libxml/xmlerror.h>
 
 #include <errno.h>
-#include <fcntl.h>
 #include <limits.h>
-#include <locale.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
@@ -33,122 +31,6 @@
 /* attributes per element kept (none of ours allows nearly as many) */
 #define MAX_ATTR 24
 #define NAME_LEN 128
-
-/* ---------------------------------------------------------------------- */
-/* files, locale, numbers (the logic of scene_read.c, kept local)          */
-
-static ssStatus read_file(const char *path, long max_bytes, char **buf,
-                          size_t *len, ssError *err)
-{
-  *buf = NULL;
-  *len = 0;
-  if (!path || !*path)
-    return ss_error_set(err, SS_ERR_IO, "", 0, "no URDF file name given");
-  /* O_NONBLOCK: opening a FIFO must not wait for a writer */
-  int fd = open(path, O_RDONLY | O_NONBLOCK);
-  if (fd < 0)
-    return ss_error_set(err, SS_ERR_IO, path, 0, "cannot open: %s",
-                        strerror(errno));
-  struct stat st;
-  if (fstat(fd, &st) != 0) {
-    int e = errno;
-    close(fd);
-    return ss_error_set(err, SS_ERR_IO, path, 0, "cannot read: %s",
-                        strerror(e));
-  }
-  if (!S_ISREG(st.st_mode)) {
-    close(fd);
-    return ss_error_set(err, SS_ERR_IO, path, 0,
-                        "cannot read: not a regular file");
-  }
-  if (st.st_size > max_bytes) {
-    close(fd);
-    return ss_error_set(err, SS_ERR_IO, path, 0,
-                        "file is %lld bytes, larger than the limit of %ld",
-                        (long long)st.st_size, max_bytes);
-  }
-  size_t n = (size_t)st.st_size;
-  char *b = malloc(n + 1);
-  if (!b) {
-    close(fd);
-    return ss_error_set(err, SS_ERR_NOMEM, path, 0,
-                        "out of memory reading %zu bytes", n);
-  }
-  size_t got = 0;
-  while (got < n) {
-    ssize_t r = read(fd, b + got, n - got);
-    if (r < 0 && errno == EINTR) continue;
-    if (r < 0) {
-      int e = errno;
-      free(b);
-      close(fd);
-      return ss_error_set(err, SS_ERR_IO, path, 0, "cannot read: %s",
-                          strerror(e));
-    }
-    if (r == 0) break;
-    got += (size_t)r;
-  }
-  close(fd);
-  b[got] = 0;
-  *buf = b;
-  *len = got;
-  return SS_OK;
-}
-
-typedef struct cLocale {
-  locale_t loc, old;
-} cLocale;
-
-static int c_locale_push(cLocale *l)
-{
-  l->loc = (locale_t)0;
-  l->old = (locale_t)0;
-  locale_t c = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
-  if (c == (locale_t)0) return -1;
-  l->old = uselocale(c);
-  l->loc = c;
-  return 0;
-}
-
-static void c_locale_pop(cLocale *l)
-{
-  if (l->loc == (locale_t)0) return;
-  uselocale(l->old);
-  freelocale(l->loc);
-  l->loc = (locale_t)0;
-}
-
-static int is_digit(char ch) { return ch >= '0' && ch <= '9'; }
-
-/* One decimal number in exactly [s, end): 0 ok, 1 not a number, 2 out of
- * range.  The grammar check keeps out nan, inf, hexadecimal and junk. */
-static int parse_double(const char *s, const char *end, double *out)
-{
-  const char *p = s;
-  if (p < end && (*p == '+' || *p == '-')) p++;
-  int nd = 0;
-  while (p < end && is_digit(*p)) p++, nd++;
-  if (p < end && *p == '.') {
-    p++;
-    while (p < end && is_digit(*p)) p++, nd++;
-  }
-  if (nd == 0) return 1;
-  if (p < end && (*p == 'e' || *p == 'E')) {
-    p++;
-    if (p < end && (*p == '+' || *p == '-')) p++;
-    int ne = 0;
-    while (p < end && is_digit(*p)) p++, ne++;
-    if (ne == 0) return 1;
-  }
-  if (p != end) return 1;
-  char *e = NULL;
-  errno = 0;
-  double v = strtod(s, &e);
-  if (e != end) return 1;
-  if (!isfinite(v) || (errno == ERANGE && fabs(v) > 1)) return 2;
-  *out = v;
-  return 0;
-}
 
 /* ---------------------------------------------------------------------- */
 /* reader context and messages                                             */
@@ -249,17 +131,6 @@ typedef struct xEl {
   xmlChar *owned[MAX_ATTR];
 } xEl;
 
-/* The line where an element's start tag begins, recorded while parsing
- * (libxml2's own node line is where the start tag ends and stops at
- * 65535). */
-static int line_of(xmlNodePtr n)
-{
-  if (n->type == XML_ELEMENT_NODE && n->_private)
-    return (int)(intptr_t)n->_private;
-  long l = xmlGetLineNo(n);
-  return l > 0 && l < INT_MAX ? (int)l : 0;
-}
-
 static void el_free(xEl *e)
 {
   for (int i = 0; i < e->nattr; i++)
@@ -273,7 +144,7 @@ static ssStatus el_open(uCtx *c, xmlNodePtr node, const char *parent_label,
   memset(e, 0, sizeof *e);
   e->node = node;
   e->name = (const char *)node->name;
-  e->line = line_of(node);
+  e->line = ss_xml_line(node);
   if (parent_label)
     snprintf(e->label, sizeof e->label, "%s <%s>", parent_label, e->name);
   else
@@ -284,43 +155,18 @@ static ssStatus el_open(uCtx *c, xmlNodePtr node, const char *parent_label,
                   "%s: too many attributes (at most %d)", e->label, MAX_ATTR);
     xAttr *x = &e->attr[e->nattr];
     x->name = (const char *)a->name;
-    if (a->children && a->children->type == XML_TEXT_NODE &&
-        !a->children->next && a->children->content) {
-      x->val = (const char *)a->children->content;
-    } else {
-      xmlChar *v = xmlNodeListGetString(c->doc, a->children, 1);
-      e->owned[e->nattr] = v;
-      x->val = v ? (const char *)v : "";
-    }
+    x->val = ss_xml_attr_text(c->doc, a, &e->owned[e->nattr]);
     e->nattr++;
   }
   return SS_OK;
 }
 
-static void join_names(char *out, size_t cap, const char *const *names)
-{
-  size_t k = 0;
-  out[0] = 0;
-  for (int i = 0; names[i]; i++) {
-    int n = snprintf(out + k, cap - k, "%s%s", i ? ", " : "", names[i]);
-    if (n < 0 || (size_t)n >= cap - k) break;
-    k += (size_t)n;
-  }
-}
-
-static int in_list(const char *name, const char *const *list)
-{
-  for (int i = 0; list[i]; i++)
-    if (!strcmp(list[i], name)) return 1;
-  return 0;
-}
-
 static ssStatus el_allow(uCtx *c, xEl *e, const char *const *allowed)
 {
   for (int i = 0; i < e->nattr; i++)
-    if (!in_list(e->attr[i].name, allowed)) {
+    if (!ss_xml_in_list(e->attr[i].name, allowed)) {
       char list[400];
-      join_names(list, sizeof list, allowed);
+      ss_xml_join_names(list, sizeof list, allowed);
       return fail(c, SS_ERR_PARSE, e->line,
                   "%s: unknown attribute '%s' (allowed: %s)", e->label,
                   e->attr[i].name, allowed[0] ? list : "none");
@@ -341,51 +187,13 @@ static ssStatus missing(uCtx *c, const xEl *e, const char *name)
               e->label, name);
 }
 
-static int is_space(char ch)
-{
-  return ch == ' ' || ch == '\t' || ch == '\n' || ch == '\r';
-}
-
-/* Next value of a vector: separated by white space or one comma.  Returns
- * 1 with [*tb, *te), 0 at the end, -1 on an empty value. */
-static int vec_next(const char **pp, int first, const char **tb,
-                    const char **te)
-{
-  const char *p = *pp;
-  while (is_space(*p)) p++;
-  if (*p == ',') {
-    if (first) return -1;
-    p++;
-    while (is_space(*p)) p++;
-    if (*p == 0 || *p == ',') return -1;
-  }
-  if (*p == 0) {
-    *pp = p;
-    return 0;
-  }
-  *tb = p;
-  while (*p && !is_space(*p) && *p != ',') p++;
-  *te = p;
-  *pp = p;
-  return 1;
-}
-
-static long vec_count(const char *v)
-{
-  const char *p = v, *tb, *te;
-  long n = 0;
-  int r;
-  while ((r = vec_next(&p, n == 0, &tb, &te)) == 1) n++;
-  return r < 0 ? -1 : n;
-}
-
 /* Parse n values (or, when n1 > 0, either n1 or n values; *got tells which)
  * of attribute `name`. */
 static ssStatus parse_values(uCtx *c, const xEl *e, const char *name,
                              const char *v, int n, int n1, int *got,
                              double *out)
 {
-  long cnt = vec_count(v);
+  long cnt = ss_xml_vec_count(v);
   if (cnt < 0)
     return fail(c, SS_ERR_PARSE, e->line,
                 "%s: attribute '%s' = '%.40s' has an empty value (values are "
@@ -401,8 +209,8 @@ static ssStatus parse_values(uCtx *c, const xEl *e, const char *name,
   }
   const char *p = v, *tb = NULL, *te = NULL;
   for (long k = 0; k < cnt; k++) {
-    vec_next(&p, k == 0, &tb, &te);
-    int r = parse_double(tb, te, &out[k]);
+    ss_xml_vec_next(&p, k == 0, &tb, &te);
+    int r = ss_scene_parse_double(tb, te, &out[k]);
     if (r) {
       int len = (int)(te - tb) > 40 ? 40 : (int)(te - tb);
       char where[64] = "";
@@ -465,38 +273,14 @@ static ssStatus get_name(uCtx *c, const xEl *e, const char *attr,
   return SS_OK;
 }
 
-static int is_blank(const xmlChar *s)
-{
-  if (!s) return 1;
-  for (; *s; s++)
-    if (!is_space((char)*s)) return 0;
-  return 1;
-}
-
 /* Non-element children: blank text, comments and processing instructions
  * are fine; anything else is an error. */
 static ssStatus check_other_node(uCtx *c, xmlNodePtr n, const xEl *parent)
 {
-  switch (n->type) {
-  case XML_TEXT_NODE:
-  case XML_CDATA_SECTION_NODE:
-    if (is_blank(n->content)) return SS_OK;
-    {
-      const char *t = (const char *)n->content;
-      while (is_space(*t)) t++;
-      int len = 0;
-      while (t[len] && !is_space(t[len]) && len < 30) len++;
-      return fail(c, SS_ERR_PARSE, line_of(n) ? line_of(n) : parent->line,
-                  "unexpected text '%.*s' inside <%s> (values go in "
-                  "attributes)", len, t, parent->name);
-    }
-  case XML_COMMENT_NODE:
-  case XML_PI_NODE:
-    return SS_OK;
-  default:
-    return fail(c, SS_ERR_PARSE, line_of(n) ? line_of(n) : parent->line,
-                "unexpected content inside <%s>", parent->name);
-  }
+  char msg[sizeof c->e.message];
+  if (!ss_xml_stray(n, parent->name, msg, sizeof msg)) return SS_OK;
+  return fail(c, SS_ERR_PARSE, ss_xml_line(n) ? ss_xml_line(n) : parent->line,
+              "%s", msg);
 }
 
 /* A namespaced element (xacro:macro) or one of URDF's we do not read. */
@@ -504,19 +288,19 @@ static ssStatus unknown_child(uCtx *c, xmlNodePtr n, const xEl *parent,
                               const char *const *allowed)
 {
   if (n->ns && n->ns->prefix)
-    return fail(c, SS_ERR_PARSE, line_of(n),
+    return fail(c, SS_ERR_PARSE, ss_xml_line(n),
                 "unknown element <%s:%s> inside <%s> (namespaced elements "
                 "are not URDF; expand xacro files first)",
                 (const char *)n->ns->prefix, (const char *)n->name,
                 parent->name);
   if (!allowed[0])
-    return fail(c, SS_ERR_PARSE, line_of(n),
+    return fail(c, SS_ERR_PARSE, ss_xml_line(n),
                 "unknown element <%s> inside <%s> (<%s> has no child "
                 "elements)", (const char *)n->name, parent->name,
                 parent->name);
   char list[400];
-  join_names(list, sizeof list, allowed);
-  return fail(c, SS_ERR_PARSE, line_of(n),
+  ss_xml_join_names(list, sizeof list, allowed);
+  return fail(c, SS_ERR_PARSE, ss_xml_line(n),
               "unknown element <%s> inside <%s> (allowed: %s)",
               (const char *)n->name, parent->name, list);
 }
@@ -783,26 +567,19 @@ static ssStatus resolve_mesh(uCtx *c, const xEl *e, const char *fn,
       return fail(c, SS_ERR_VALUE, e->line, "%s: mesh path '%.300s' is too long",
                   e->label, fn);
     ncand = 2;
-  } else if (!strncmp(fn, "file://", 7)) {
-    const char *p = fn + 7;
+  } else if (strstr(fn, "://") && strncmp(fn, "file://", 7)) {
+    return fail(c, SS_ERR_UNSUPPORTED, e->line,
+                "%s: filename = '%.300s' uses an unsupported URI scheme "
+                "(allowed: package://, file://, plain paths)", e->label, fn);
+  } else {
+    /* file://PATH or a plain PATH: absolute, or relative to the URDF */
+    const char *p = strncmp(fn, "file://", 7) ? fn : fn + 7;
     if (!*p)
       return fail(c, SS_ERR_PARSE, e->line, "%s: filename = '%s' names no file",
                   e->label, fn);
     int bad = p[0] == '/' ? snprintf(cand[0], sizeof cand[0], "%s", p) >=
                                 (int)sizeof cand[0]
                           : join_path(cand[0], sizeof cand[0], c->dir, p);
-    if (bad)
-      return fail(c, SS_ERR_VALUE, e->line, "%s: mesh path '%.300s' is too long",
-                  e->label, fn);
-    ncand = 1;
-  } else if (strstr(fn, "://")) {
-    return fail(c, SS_ERR_UNSUPPORTED, e->line,
-                "%s: filename = '%.300s' uses an unsupported URI scheme "
-                "(allowed: package://, file://, plain paths)", e->label, fn);
-  } else {
-    int bad = fn[0] == '/' ? snprintf(cand[0], sizeof cand[0], "%s", fn) >=
-                                 (int)sizeof cand[0]
-                           : join_path(cand[0], sizeof cand[0], c->dir, fn);
     if (bad)
       return fail(c, SS_ERR_VALUE, e->line, "%s: mesh path '%.300s' is too long",
                   e->label, fn);
@@ -912,7 +689,7 @@ static ssStatus read_geometry(uCtx *c, xmlNodePtr n, const char *label,
     if (!known) {
       st = unknown_child(c, k, &e, kids);
     } else if (nshape++) {
-      st = fail(c, SS_ERR_PARSE, line_of(k),
+      st = fail(c, SS_ERR_PARSE, ss_xml_line(k),
                 "%s: more than one shape (<%s>); a <geometry> holds exactly "
                 "one of box, sphere, cylinder, capsule, mesh", e.label,
                 (const char *)k->name);
@@ -1077,7 +854,7 @@ static ssStatus read_link(uCtx *c, xmlNodePtr n)
   if (grow((void **)&c->link, &c->caplink, c->nlink, sizeof *c->link) ||
       grow((void **)&c->link_extra, &c->capextra, c->nlink,
            sizeof *c->link_extra))
-    return nomem(c, line_of(n));
+    return nomem(c, ss_xml_line(n));
   ssUrdfLink *l = &c->link[c->nlink];
   memset(l, 0, sizeof *l);
   l->com_quat[0] = 1;
@@ -1104,7 +881,8 @@ static ssStatus read_link(uCtx *c, xmlNodePtr n)
       continue;
     }
     if (is_el(k, "inertial") || is_el(k, "visual") || is_el(k, "collision"))
-      if (!c->link_extra[c->nlink - 1]) c->link_extra[c->nlink - 1] = line_of(k);
+      if (!c->link_extra[c->nlink - 1])
+        c->link_extra[c->nlink - 1] = ss_xml_line(k);
     if (is_el(k, "inertial")) {
       xEl x;
       if (!(st = el_open(c, k, label, &x))) st = once(c, &seen_i, &x);
@@ -1186,7 +964,7 @@ static ssStatus read_joint(uCtx *c, xmlNodePtr n)
                                       "spring_mount", NULL};
   static const char *const a_mimic[] = {"joint", "multiplier", "offset", NULL};
   if (grow((void **)&c->joint, &c->capjoint, c->njoint, sizeof *c->joint))
-    return nomem(c, line_of(n));
+    return nomem(c, ss_xml_line(n));
   ssUrdfJoint *j = &c->joint[c->njoint++];
   memset(j, 0, sizeof *j);
   j->quat[0] = 1;
@@ -1846,7 +1624,7 @@ static ssStatus read_robot(uCtx *c, xmlNodePtr root, ssUrdf *u)
                                         "ros2_control", "sensor", "mujoco",
                                         NULL};
   if (!is_el(root, "robot"))
-    return fail(c, SS_ERR_PARSE, line_of(root),
+    return fail(c, SS_ERR_PARSE, ss_xml_line(root),
                 "root element is <%s>, expected <robot>",
                 (const char *)root->name);
   xEl e;
@@ -1882,91 +1660,7 @@ static ssStatus read_robot(uCtx *c, xmlNodePtr root, ssUrdf *u)
 }
 
 /* ---------------------------------------------------------------------- */
-/* libxml2: safe parsing (as in scene_read.c)                              */
-
-typedef struct xmlGuard {
-  startElementNsSAX2Func start; /* libxml2's tree builder */
-  int doctype_line;
-  int entity_refused;
-  int have_error;
-  int error_line;
-  char error_msg[400];
-} xmlGuard;
-
-static xmlGuard *guard_of(void *ctx)
-{
-  xmlParserCtxtPtr p = (xmlParserCtxtPtr)ctx;
-  return p ? (xmlGuard *)p->_private : NULL;
-}
-
-static void on_xml_error(void *data, xmlErrorPtr err)
-{
-  xmlGuard *g = (xmlGuard *)data;
-  if (!g || !err || err->level < XML_ERR_ERROR || g->have_error) return;
-  g->have_error = 1;
-  g->error_line = err->line;
-  snprintf(g->error_msg, sizeof g->error_msg, "%s",
-           err->message ? err->message : "malformed XML");
-  size_t n = strlen(g->error_msg);
-  while (n > 0 && (g->error_msg[n - 1] == '\n' || g->error_msg[n - 1] == ' '))
-    g->error_msg[--n] = 0;
-}
-
-static void on_generic_error(void *data, const char *msg, ...)
-{
-  (void)data;
-  (void)msg;
-}
-
-/* Any DOCTYPE stops the parser before its internal subset is read. */
-static void on_internal_subset(void *ctx, const xmlChar *name,
-                               const xmlChar *external_id,
-                               const xmlChar *system_id)
-{
-  (void)name;
-  (void)external_id;
-  (void)system_id;
-  xmlParserCtxtPtr p = (xmlParserCtxtPtr)ctx;
-  xmlGuard *g = guard_of(ctx);
-  if (g && !g->doctype_line)
-    g->doctype_line = p && p->input && p->input->line > 0 ? p->input->line : 1;
-  xmlStopParser(p);
-}
-
-/* Build the element as usual, then record the line of its '<'. */
-static void on_start_element(void *ctx, const xmlChar *localname,
-                             const xmlChar *prefix, const xmlChar *uri,
-                             int nb_namespaces, const xmlChar **namespaces,
-                             int nb_attributes, int nb_defaulted,
-                             const xmlChar **attributes)
-{
-  xmlParserCtxtPtr p = (xmlParserCtxtPtr)ctx;
-  xmlGuard *g = guard_of(ctx);
-  if (!g || !g->start) return;
-  g->start(ctx, localname, prefix, uri, nb_namespaces, namespaces,
-           nb_attributes, nb_defaulted, attributes);
-  xmlNodePtr node = p->node;
-  xmlParserInputPtr in = p->input;
-  if (!node || !in || !in->cur || !in->base || in->line <= 0) return;
-  const xmlChar *q = in->cur;
-  int nl = 0;
-  while (q > in->base && q[-1] != '<') {
-    q--;
-    if (*q == '\n') nl++;
-  }
-  int line = q > in->base && in->line - nl > 0 ? in->line - nl : in->line;
-  node->_private = (void *)(intptr_t)line;
-}
-
-static xmlParserInputPtr deny_entity_loader(const char *url, const char *id,
-                                            xmlParserCtxtPtr ctxt)
-{
-  (void)url;
-  (void)id;
-  xmlGuard *g = guard_of(ctxt);
-  if (g) g->entity_refused = 1;
-  return NULL;
-}
+/* parsing                                                                 */
 
 static ssStatus parse_xml(uCtx *c, const char *buf, size_t len,
                           xmlDocPtr *out)
@@ -1977,85 +1671,28 @@ static ssStatus parse_xml(uCtx *c, const char *buf, size_t len,
   if (len > (size_t)SS_URDF_MAX_BYTES)
     return fail(c, SS_ERR_IO, 0, "URDF is %zu bytes, larger than the limit "
                 "of %ld", len, (long)SS_URDF_MAX_BYTES);
-  xmlInitParser();
-  xmlGuard g;
-  memset(&g, 0, sizeof g);
-
-  xmlStructuredErrorFunc old_serror = xmlStructuredError;
-  void *old_sctx = xmlStructuredErrorContext;
-  xmlGenericErrorFunc old_gerror = xmlGenericError;
-  void *old_gctx = xmlGenericErrorContext;
-  xmlExternalEntityLoader old_loader = xmlGetExternalEntityLoader();
-  xmlSetStructuredErrorFunc(&g, on_xml_error);
-  xmlSetGenericErrorFunc(NULL, on_generic_error);
-  xmlSetExternalEntityLoader(deny_entity_loader);
-
-  ssStatus st = SS_OK;
-  xmlParserCtxtPtr p = xmlCreateMemoryParserCtxt(buf, (int)len);
-  if (!p) {
-    st = fail(c, SS_ERR_NOMEM, 0, "out of memory starting the XML parser");
-  } else {
-    p->_private = &g;
-    if (p->sax) {
-      p->sax->internalSubset = on_internal_subset;
-      g.start = p->sax->startElementNs;
-      if (g.start) p->sax->startElementNs = on_start_element;
-    }
-    /* never XML_PARSE_NOENT, XML_PARSE_DTDLOAD, XML_PARSE_DTDATTR or
-     * XML_PARSE_XINCLUDE; libxml2's default size limits stay on */
-    xmlCtxtUseOptions(p, XML_PARSE_NONET | XML_PARSE_BIG_LINES);
-    xmlParseDocument(p);
-    xmlDocPtr doc = p->myDoc;
-    p->myDoc = NULL;
-    if (g.doctype_line) {
-      st = fail(c, SS_ERR_PARSE, g.doctype_line,
+  /* libxml2's default size limits stay on */
+  ssXmlResult r;
+  *out = ss_xml_parse(buf, len, 0, &r);
+  switch (r.fail) {
+  case SS_XML_OK:
+    return SS_OK;
+  case SS_XML_NOMEM:
+    return fail(c, SS_ERR_NOMEM, 0, "out of memory starting the XML parser");
+  case SS_XML_DOCTYPE:
+    return fail(c, SS_ERR_PARSE, r.line,
                 "DOCTYPE declarations are not allowed in URDF files (no DTDs, "
                 "no entities)");
-    } else if (!p->wellFormed || !doc) {
-      if (g.have_error) {
-        st = fail(c, SS_ERR_PARSE, g.error_line, "XML syntax error: %s",
-                  g.error_msg);
-      } else {
-        xmlErrorPtr le = xmlCtxtGetLastError(p);
-        st = fail(c, SS_ERR_PARSE, le ? le->line : 0, "XML syntax error: %s",
-                  le && le->message ? le->message : "malformed document");
-        size_t n = strlen(c->e.message);
-        while (n > 0 && c->e.message[n - 1] == '\n') c->e.message[--n] = 0;
-      }
-    } else if (doc->intSubset || doc->extSubset || g.entity_refused) {
-      st = fail(c, SS_ERR_PARSE, 1,
-                "DOCTYPE declarations are not allowed in URDF files (no DTDs, "
-                "no entities)");
-    } else if (!xmlDocGetRootElement(doc)) {
-      st = fail(c, SS_ERR_PARSE, 1, "no root element: expected <robot>");
-    }
-    if (st != SS_OK) {
-      if (doc) xmlFreeDoc(doc);
-    } else {
-      *out = doc;
-    }
-    xmlFreeParserCtxt(p);
+  case SS_XML_SYNTAX:
+    return fail(c, SS_ERR_PARSE, r.line, "XML syntax error: %s", r.message);
+  case SS_XML_NO_ROOT:
+    break;
   }
-
-  xmlSetExternalEntityLoader(old_loader);
-  xmlSetGenericErrorFunc(old_gctx, old_gerror);
-  xmlSetStructuredErrorFunc(old_sctx, old_serror);
-  return st;
+  return fail(c, SS_ERR_PARSE, r.line, "no root element: expected <robot>");
 }
 
 /* ---------------------------------------------------------------------- */
 /* entry points                                                            */
-
-static void this_dir(const char *path, char *dir, size_t cap)
-{
-  const char *slash = path ? strrchr(path, '/') : NULL;
-  if (!slash)
-    snprintf(dir, cap, ".");
-  else if (slash == path)
-    snprintf(dir, cap, "/");
-  else
-    snprintf(dir, cap, "%.*s", (int)(slash - path), path);
-}
 
 static void ctx_free(uCtx *c)
 {
@@ -2087,15 +1724,10 @@ static ssStatus load(const char *buf, size_t len, const char *path,
   memset(&c, 0, sizeof c);
   c.path = path;
   c.res_dir = res_dir;
-  this_dir(path, c.dir, sizeof c.dir);
+  ss_scene_path_dir(path, c.dir, sizeof c.dir);
 
-  cLocale loc;
-  if (c_locale_push(&loc) != 0) {
-    struct lconv *lc = localeconv();
-    if (!lc || !lc->decimal_point || strcmp(lc->decimal_point, "."))
-      return ss_error_set(err, SS_ERR_STATE, path, 0,
-                          "cannot switch to the C locale to read numbers");
-  }
+  ssCLocale loc;
+  if (ss_scene_c_locale_begin(&loc, path, err) != SS_OK) return SS_ERR_STATE;
   ssUrdf *u = calloc(1, sizeof *u);
   ssStatus st = u ? SS_OK : fail(&c, SS_ERR_NOMEM, 0, "out of memory");
   if (!st) {
@@ -2105,7 +1737,7 @@ static ssStatus load(const char *buf, size_t len, const char *path,
   if (!st) st = read_robot(&c, xmlDocGetRootElement(c.doc), u);
   ssError e = c.e;
   ctx_free(&c);
-  c_locale_pop(&loc);
+  ss_scene_c_locale_pop(&loc);
   if (st) {
     ss_urdf_free(u);
     if (err) *err = e;
@@ -2138,7 +1770,9 @@ ssStatus ss_urdf_load(const char *path, const char *res_dir, ssUrdf **out,
   *out = NULL;
   char *buf = NULL;
   size_t len = 0;
-  ssStatus st = read_file(path, SS_URDF_MAX_BYTES, &buf, &len, err);
+  if (!path || !*path)
+    return ss_error_set(err, SS_ERR_IO, "", 0, "no URDF file name given");
+  ssStatus st = ss_read_file(path, SS_URDF_MAX_BYTES, &buf, &len, err);
   if (st != SS_OK) return st;
   st = load(buf, len, path, res_dir, out, err);
   free(buf);

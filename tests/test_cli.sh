@@ -16,67 +16,12 @@ top_builddir=${top_builddir:-.}
 SOILSIM=$top_builddir/soilsim
 PLATE=$top_srcdir/scenes/plate.xml
 
-if [ ! -x "$SOILSIM" ]; then
-  echo "Bail out! $SOILSIM is not built"
-  exit 1
-fi
-
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/soilsim-cli.XXXXXX") || {
-  echo "Bail out! mktemp -d failed"
-  exit 1
-}
+# the harness: $tmp, run, check, skip, rc_is, err_has, ...
+TAP_NAME=cli
+. "$top_srcdir/tests/tap.sh"
 trap 'rm -rf "$tmp"' EXIT
 trap 'exit 130' INT TERM HUP
 
-# Every run is bounded so that a hang fails instead of stalling make check.
-TIMEOUT=""
-if command -v timeout >/dev/null 2>&1; then TIMEOUT="timeout 120"; fi
-
-n=0
-nfail=0
-last_cmd=""
-rc=0
-
-# run ARGS...: soilsim with stdout/stderr in $tmp/out, $tmp/err; sets rc.
-# CI is cleared so that nothing depends on the caller's environment.
-run() {
-  last_cmd="soilsim $*"
-  # shellcheck disable=SC2086
-  CI='' $TIMEOUT "$SOILSIM" "$@" >"$tmp/out" 2>"$tmp/err"
-  rc=$?
-}
-
-# check DESC EXPR: one TAP line; EXPR is evaluated by the shell.
-check() {
-  n=$((n + 1))
-  desc=$(printf '%s' "$1" | sed 's/#/\\#/g')
-  if eval "$2"; then
-    echo "ok $n - $desc"
-  else
-    echo "not ok $n - $desc"
-    nfail=$((nfail + 1))
-    echo "#   last command: $last_cmd (exit $rc)"
-    sed -n '1,8s/^/#   stderr: /p' "$tmp/err"
-    sed -n '1,4s/^/#   stdout: /p' "$tmp/out"
-  fi
-}
-
-skip() {
-  n=$((n + 1))
-  echo "ok $n # SKIP $1"
-}
-
-rc_is() { [ "$rc" -eq "$1" ]; }
-err_has() { grep -qF -- "$1" "$tmp/err"; }
-out_has() { grep -qF -- "$1" "$tmp/out"; }
-no_file() { [ ! -e "$1" ]; }
-# no temporary files of the atomic writer left in a folder
-no_tmp() {
-  for f in "$1"/*.tmp[0-9]* "$1"/.*.tmp[0-9]*; do
-    [ -e "$f" ] && return 1
-  done
-  return 0
-}
 usage_error() { rc_is 2 && err_has "try 'soilsim --help'"; }
 
 # ---------------------------------------------------------------------
@@ -146,11 +91,9 @@ for f in "$top_srcdir"/tests/data/bad/*.xml; do
   [ -f "$f" ] || continue
   nbad=$((nbad + 1))
   b=$(basename "$f")
-  first=$(sed -n 1p "$f")
-  line=$(printf '%s\n' "$first" |
-    sed -n 's/^<!-- *expect: *\([0-9][0-9]*\): .*-->.*$/\1/p')
-  sub=$(printf '%s\n' "$first" |
-    sed -n 's/^<!-- *expect: *[0-9][0-9]*: *\(.*[^ ]\) *-->.*$/\1/p')
+  expect_line "$f"
+  line=$expect_n
+  sub=$expect_sub
   if [ -z "$line" ] || [ -z "$sub" ]; then
     check "bad/$b has an expect line ('<!-- expect: LINE: SUBSTRING -->')" false
     continue

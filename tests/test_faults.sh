@@ -31,15 +31,9 @@ case $top_srcdir in /*) ;; *) top_srcdir=$(cd "$top_srcdir" && pwd) ;; esac
 PLATE=$top_srcdir/scenes/plate.xml
 ARM_URDF=$top_srcdir/assets/plate_arm/plate_arm.urdf
 
-if [ ! -x "$SOILSIM" ]; then
-  echo "Bail out! $SOILSIM is not built"
-  exit 1
-fi
-
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/soilsim-faults.XXXXXX") || {
-  echo "Bail out! mktemp -d failed"
-  exit 1
-}
+# the harness: $tmp, run, check, skip, rc_is, err_has, ...
+TAP_NAME=faults
+. "$top_srcdir/tests/tap.sh"
 # other users (nobody, below) must be able to reach the files in it
 chmod 755 "$tmp"
 cleanup() {
@@ -48,22 +42,6 @@ cleanup() {
 }
 trap cleanup EXIT
 trap 'exit 130' INT TERM HUP
-
-TIMEOUT=""
-if command -v timeout >/dev/null 2>&1; then TIMEOUT="timeout 120"; fi
-
-n=0
-nfail=0
-last_cmd=""
-rc=0
-
-# run ARGS...: soilsim with stdout/stderr in $tmp/out, $tmp/err; sets rc.
-run() {
-  last_cmd="soilsim $*"
-  # shellcheck disable=SC2086
-  CI='' $TIMEOUT "$SOILSIM" "$@" >"$tmp/out" 2>"$tmp/err"
-  rc=$?
-}
 
 # run_as USER_PREFIX ARGS...: the same, through a prefix such as setpriv
 run_as() {
@@ -75,35 +53,6 @@ run_as() {
   rc=$?
 }
 
-check() {
-  n=$((n + 1))
-  desc=$(printf '%s' "$1" | sed 's/#/\\#/g')
-  if eval "$2"; then
-    echo "ok $n - $desc"
-  else
-    echo "not ok $n - $desc"
-    nfail=$((nfail + 1))
-    echo "#   last command: $last_cmd (exit $rc)"
-    sed -n '1,8s/^/#   stderr: /p' "$tmp/err"
-    sed -n '1,4s/^/#   stdout: /p' "$tmp/out"
-  fi
-}
-
-skip() {
-  n=$((n + 1))
-  echo "ok $n # SKIP $1"
-}
-
-rc_is() { [ "$rc" -eq "$1" ]; }
-err_has() { grep -qF -- "$1" "$tmp/err"; }
-no_file() { [ ! -e "$1" ]; }
-# no temporary files of the atomic writer (PATH.tmpPID) left in a folder
-no_tmp() {
-  for f in "$1"/*.tmp[0-9]* "$1"/.*.tmp[0-9]*; do
-    [ -e "$f" ] && return 1
-  done
-  return 0
-}
 # a bounded wait: TIMEOUT on its own
 bounded() { [ "$rc" -ne 124 ] && [ "$rc" -ne 137 ]; }
 
@@ -338,11 +287,9 @@ for f in "$top_srcdir"/tests/data/blowup/*.xml; do
   [ -f "$f" ] || continue
   nblow=$((nblow + 1))
   b=$(basename "$f")
-  first=$(sed -n 1p "$f")
-  step=$(printf '%s\n' "$first" |
-    sed -n 's/^<!-- *expect: *\([0-9][0-9]*\): .*-->.*$/\1/p')
-  sub=$(printf '%s\n' "$first" |
-    sed -n 's/^<!-- *expect: *[0-9][0-9]*: *\(.*[^ ]\) *-->.*$/\1/p')
+  expect_line "$f"
+  step=$expect_n
+  sub=$expect_sub
   if [ -z "$step" ] || [ -z "$sub" ]; then
     check "blowup/$b has an expect line ('<!-- expect: STEP: SUBSTRING -->')" false
     continue

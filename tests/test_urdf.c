@@ -12,8 +12,8 @@
 #include "mesh.h"
 #include "ss_math.h"
 #include "tap.h"
+#include "catalogue.h"
 
-#include <dirent.h>
 #include <locale.h>
 #include <math.h>
 #include <stdio.h>
@@ -29,24 +29,6 @@ static const char *srcdir(void)
 static void data_path(char *out, size_t cap, const char *rel)
 {
   snprintf(out, cap, "%s/tests/data/urdf/%s", srcdir(), rel);
-}
-
-static char *slurp(const char *path, size_t *len)
-{
-  FILE *f = fopen(path, "rb");
-  if (!f) return NULL;
-  fseek(f, 0, SEEK_END);
-  long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char *b = malloc((size_t)n + 1);
-  if (b && fread(b, 1, (size_t)n, f) != (size_t)n) {
-    free(b);
-    b = NULL;
-  }
-  fclose(f);
-  if (b) b[n] = 0;
-  if (len) *len = (size_t)n;
-  return b;
 }
 
 static ssStatus load_str(const char *xml, const char *path, ssUrdf **u,
@@ -992,55 +974,20 @@ static void test_watertight(void)
 /* ---------------------------------------------------------------------- */
 /* catalogue of bad URDFs                                                  */
 
-static int cmp_str(const void *a, const void *b)
+static ssStatus load_bad_urdf(const char *path, ssError *e, int *nothing)
 {
-  return strcmp(*(char *const *)a, *(char *const *)b);
+  ssUrdf *u = NULL;
+  ssStatus st = ss_urdf_load(path, NULL, &u, e);
+  *nothing = u == NULL;
+  ss_urdf_free(u);
+  return st;
 }
 
 static void test_bad_catalogue(void)
 {
   char dir[1024];
   data_path(dir, sizeof dir, "bad");
-  DIR *dp = opendir(dir);
-  if (!ok(dp != NULL, "bad-URDF catalogue found at %s", dir)) return;
-  char **names = NULL;
-  int n = 0;
-  struct dirent *de;
-  while ((de = readdir(dp))) {
-    size_t l = strlen(de->d_name);
-    if (l < 6 || strcmp(de->d_name + l - 5, ".urdf")) continue;
-    names = realloc(names, (size_t)(n + 1) * sizeof *names);
-    names[n++] = strdup(de->d_name);
-  }
-  closedir(dp);
-  qsort(names, (size_t)n, sizeof *names, cmp_str);
-  ok(n >= 30, "catalogue holds %d bad URDFs (at least 30)", n);
-  for (int k = 0; k < n; k++) {
-    char path[1400];
-    snprintf(path, sizeof path, "%s/%s", dir, names[k]);
-    char *txt = slurp(path, NULL);
-    int line = 0, off = 0;
-    char want[512] = "";
-    if (!txt || sscanf(txt, "<!-- expect: %d: %n", &line, &off) < 1 || off == 0) {
-      ok(0, "%s: first line is <!-- expect: LINE: SUBSTRING -->", names[k]);
-      free(txt);
-      free(names[k]);
-      continue;
-    }
-    const char *s = txt + off, *end = strstr(s, " -->");
-    if (end && end - s < (long)sizeof want) memcpy(want, s, (size_t)(end - s));
-    free(txt);
-    ssUrdf *u = NULL;
-    ssError e;
-    memset(&e, 0, sizeof e);
-    ssStatus st = ss_urdf_load(path, NULL, &u, &e);
-    int good = st != SS_OK && u == NULL && e.line == line && !strcmp(e.file, path) &&
-               want[0] && strstr(e.message, want);
-    ok(good, "%s: fails at line %d with '%s'", names[k], line, want);
-    if (!good) diag("got status %d at %s:%d: %s", (int)st, e.file, e.line, e.message);
-    free(names[k]);
-  }
-  free(names);
+  catalogue_check(dir, ".urdf", "URDF", 30, load_bad_urdf);
 }
 
 int main(void)

@@ -9,6 +9,7 @@
 #include "png_io.h"
 #include "ss_math.h"
 #include "tap.h"
+#include "catalogue.h"
 
 #include <libxml/parser.h>
 
@@ -46,24 +47,6 @@ static int write_file(const char *path, const char *text)
   size_t n = strlen(text);
   int ok_ = fwrite(text, 1, n, f) == n;
   return fclose(f) == 0 && ok_ ? 0 : -1;
-}
-
-static char *slurp(const char *path, size_t *len)
-{
-  FILE *f = fopen(path, "rb");
-  if (!f) return NULL;
-  fseek(f, 0, SEEK_END);
-  long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char *b = malloc((size_t)n + 1);
-  if (b && fread(b, 1, (size_t)n, f) != (size_t)n) {
-    free(b);
-    b = NULL;
-  }
-  fclose(f);
-  if (b) b[n] = 0;
-  if (len) *len = (size_t)n;
-  return b;
 }
 
 static int same_file(const char *a, const char *b)
@@ -666,58 +649,22 @@ static void test_hostile(void)
 /* ---------------------------------------------------------------------- */
 /* catalogue of bad scenes                                                 */
 
-static int cmp_str(const void *a, const void *b)
+static ssStatus load_bad_scene(const char *path, ssError *e, int *nothing)
 {
-  return strcmp(*(char *const *)a, *(char *const *)b);
+  ssModel *m = NULL;
+  ssData *d = NULL;
+  ssStatus st = ss_scene_load(path, &m, &d, e);
+  *nothing = m == NULL && d == NULL;
+  ss_data_free(d);
+  ss_model_free(m);
+  return st;
 }
 
 static void test_bad_catalogue(void)
 {
   char dir[1024];
   snprintf(dir, sizeof dir, "%s/tests/data/bad", srcdir());
-  DIR *dp = opendir(dir);
-  if (!ok(dp != NULL, "bad-scene catalogue found at %s", dir)) return;
-  char **names = NULL;
-  int n = 0;
-  struct dirent *de;
-  while ((de = readdir(dp))) {
-    size_t l = strlen(de->d_name);
-    if (l < 5 || strcmp(de->d_name + l - 4, ".xml")) continue;
-    names = realloc(names, (size_t)(n + 1) * sizeof *names);
-    names[n++] = strdup(de->d_name);
-  }
-  closedir(dp);
-  qsort(names, (size_t)n, sizeof *names, cmp_str);
-  ok(n >= 25, "catalogue holds %d bad scenes (at least 25)", n);
-  for (int k = 0; k < n; k++) {
-    char path[1400];
-    snprintf(path, sizeof path, "%s/%s", dir, names[k]);
-    char *txt = slurp(path, NULL);
-    int line = 0, off = 0;
-    char want[512] = "";
-    if (!txt || sscanf(txt, "<!-- expect: %d: %n", &line, &off) < 1 || off == 0) {
-      ok(0, "%s: first line is <!-- expect: LINE: SUBSTRING -->", names[k]);
-      free(txt);
-      continue;
-    }
-    const char *s = txt + off, *end = strstr(s, " -->");
-    if (end && end - s < (long)sizeof want) memcpy(want, s, (size_t)(end - s));
-    free(txt);
-    ssModel *m = NULL;
-    ssData *d = NULL;
-    ssError e;
-    memset(&e, 0, sizeof e);
-    ssStatus st = ss_scene_load(path, &m, &d, &e);
-    int good = st != SS_OK && m == NULL && d == NULL && e.line == line &&
-               !strcmp(e.file, path) && want[0] && strstr(e.message, want);
-    ok(good, "%s: fails at line %d with '%s'", names[k], line, want);
-    if (!good)
-      diag("got status %d at %s:%d: %s", (int)st, e.file, e.line, e.message);
-    ss_data_free(d);
-    ss_model_free(m);
-    free(names[k]);
-  }
-  free(names);
+  catalogue_check(dir, ".xml", "scene", 25, load_bad_scene);
 }
 
 /* ---------------------------------------------------------------------- */

@@ -1,0 +1,291 @@
+/* xml_safe.c -- the safe libxml2 parse and the helpers the world XML and
+ * URDF readers share (xml_safe.h). */
+#include "xml_safe.h"
+
+#include <libxml/parser.h>
+#include <libxml/parserInternals.h>
+#include <libxml/xmlerror.h>
+
+#include <limits.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+/* ---------------------------------------------------------------------- */
+/* libxml2: safe parsing                                                   */
+
+typedef struct xmlGuard {
+  startElementNsSAX2Func start; /* libxml2's tree builder */
+  int doctype_line;  /* > 0: a DOCTYPE was met (parsing stopped there) */
+  int entity_refused;
+  int have_error;
+  int error_line;
+  char error_msg[400];
+} xmlGuard;
+
+static xmlGuard *guard_of(void *ctx)
+{
+  xmlParserCtxtPtr p = (xmlParserCtxtPtr)ctx;
+  return p ? (xmlGuard *)p->_private : NULL;
+}
+
+/* Structured error handler: keep the first error, print nothing. */
+static void on_xml_error(void *data, xmlErrorPtr err)
+{
+  xmlGuard *g = (xmlGuard *)data;
+  if (!g || !err || err->level < XML_ERR_ERROR || g->have_error) return;
+  g->have_error = 1;
+  g->error_line = err->line;
+  snprintf(g->error_msg, sizeof g->error_msg, "%s",
+           err->message ? err->message : "malformed XML");
+  size_t n = strlen(g->error_msg);
+  while (n > 0 && (g->error_msg[n - 1] == '\n' || g->error_msg[n - 1] == ' '))
+    g->error_msg[--n] = 0;
+}
+
+static void on_generic_error(void *data, const char *msg, ...)
+{
+  (void)data;
+  (void)msg;
+}
+
+/* Any DOCTYPE stops the parser before its internal subset is read. */
+static void on_internal_subset(void *ctx, const xmlChar *name,
+                               const xmlChar *external_id,
+                               const xmlChar *system_id)
+{
+  (void)name;
+  (void)external_id;
+  (void)system_id;
+  xmlParserCtxtPtr p = (xmlParserCtxtPtr)ctx;
+  xmlGuard *g = guard_of(ctx);
+  if (g && !g->doctype_line)
+    g->doctype_line = p && p->input && p->input->line > 0 ? p->input->line : 1;
+  xmlStopParser(p);
+}
+
+/* Build the element as usual, then record the line of its '<' in the
+ * node's application pointer.  The parser is at the end of the start tag;
+ * a start tag holds no other '<' (attribute values cannot), so the tag
+ * begins at the last '<' before the current position. */
+static void on_start_element(void *ctx, const xmlChar *localname,
+                             const xmlChar *prefix, const xmlChar *uri,
+                             int nb_namespaces, const xmlChar **namespaces,
+                             int nb_attributes, int nb_defaulted,
+                             const xmlChar **attributes)
+{
+  xmlParserCtxtPtr p = (xmlParserCtxtPtr)ctx;
+  xmlGuard *g = guard_of(ctx);
+  if (!g || !g->start) return;
+  g->start(ctx, localname, prefix, uri, nb_namespaces, namespaces,
+           nb_attributes, nb_defaulted, attributes);
+  xmlNodePtr node = p->node;
+  xmlParserInputPtr in = p->input;
+  if (!node || !in || !in->cur || !in->base || in->line <= 0) return;
+  const xmlChar *q = in->cur;
+  int nl = 0;
+  while (q > in->base && q[-1] != '<') {
+    q--;
+    if (*q == '\n') nl++;
+  }
+  int line = q > in->base && in->line - nl > 0 ? in->line - nl : in->line;
+  node->_private = (void *)(intptr_t)line;
+}
+
+/* Deny-by-default external entity loader: nothing is ever fetched. */
+static xmlParserInputPtr deny_entity_loader(const char *url, const char *id,
+                                            xmlParserCtxtPtr ctxt)
+{
+  (void)url;
+  (void)id;
+  xmlGuard *g = guard_of(ctxt);
+  if (g) g->entity_refused = 1;
+  return NULL;
+}
+
+/* What went wrong with a finished parse, into *r (SS_XML_OK: nothing). */
+static void judge(xmlParserCtxtPtr p, xmlDocPtr doc, const xmlGuard *g,
+                  ssXmlResult *r)
+{
+  if (g->doctype_line) {
+    r->fail = SS_XML_DOCTYPE;
+    r->line = g->doctype_line;
+  } else if (!p->wellFormed || !doc) {
+    r->fail = SS_XML_SYNTAX;
+    if (g->have_error) {
+      r->line = g->error_line;
+      snprintf(r->message, sizeof r->message, "%s", g->error_msg);
+    } else {
+      xmlErrorPtr le = xmlCtxtGetLastError(p);
+      r->line = le ? le->line : 0;
+      snprintf(r->message, sizeof r->message, "%s",
+               le && le->message ? le->message : "malformed document");
+      size_t n = strlen(r->message);
+      while (n > 0 && r->message[n - 1] == '\n') r->message[--n] = 0;
+    }
+  } else if (doc->intSubset || doc->extSubset || g->entity_refused) {
+    r->fail = SS_XML_DOCTYPE;
+    r->line = 1;
+  } else if (!xmlDocGetRootElement(doc)) {
+    r->fail = SS_XML_NO_ROOT;
+    r->line = 1;
+  }
+}
+
+xmlDocPtr ss_xml_parse(const char *buf, size_t len, int huge, ssXmlResult *r)
+{
+  memset(r, 0, sizeof *r);
+  xmlInitParser();
+  xmlGuard g;
+  memset(&g, 0, sizeof g);
+
+  /* libxml2's handlers are global: install ours for this parse only */
+  xmlStructuredErrorFunc old_serror = xmlStructuredError;
+  void *old_sctx = xmlStructuredErrorContext;
+  xmlGenericErrorFunc old_gerror = xmlGenericError;
+  void *old_gctx = xmlGenericErrorContext;
+  xmlExternalEntityLoader old_loader = xmlGetExternalEntityLoader();
+  xmlSetStructuredErrorFunc(&g, on_xml_error);
+  xmlSetGenericErrorFunc(NULL, on_generic_error);
+  xmlSetExternalEntityLoader(deny_entity_loader);
+
+  xmlDocPtr doc = NULL;
+  xmlParserCtxtPtr p = xmlCreateMemoryParserCtxt(buf, (int)len);
+  if (!p) {
+    r->fail = SS_XML_NOMEM;
+  } else {
+    p->_private = &g;
+    if (p->sax) {
+      p->sax->internalSubset = on_internal_subset;
+      g.start = p->sax->startElementNs;
+      if (g.start) p->sax->startElementNs = on_start_element;
+    }
+    /* never XML_PARSE_NOENT, XML_PARSE_DTDLOAD, XML_PARSE_DTDATTR or
+     * XML_PARSE_XINCLUDE */
+    xmlCtxtUseOptions(p, XML_PARSE_NONET | XML_PARSE_BIG_LINES |
+                             (huge ? XML_PARSE_HUGE : 0));
+    xmlParseDocument(p);
+    doc = p->myDoc;
+    p->myDoc = NULL;
+    judge(p, doc, &g, r);
+    if (r->fail != SS_XML_OK && doc) {
+      xmlFreeDoc(doc);
+      doc = NULL;
+    }
+    xmlFreeParserCtxt(p);
+  }
+
+  xmlSetExternalEntityLoader(old_loader);
+  xmlSetGenericErrorFunc(old_gctx, old_gerror);
+  xmlSetStructuredErrorFunc(old_sctx, old_serror);
+  return doc;
+}
+
+int ss_xml_line(xmlNodePtr n)
+{
+  if (n->type == XML_ELEMENT_NODE && n->_private)
+    return (int)(intptr_t)n->_private;
+  long l = xmlGetLineNo(n);
+  return l > 0 && l < INT_MAX ? (int)l : 0;
+}
+
+/* ---------------------------------------------------------------------- */
+/* attributes, children, value lists                                      */
+
+/* XML white space */
+static int is_space(char ch)
+{
+  return ch == ' ' || ch == '\t' || ch == '\n' || ch == '\r';
+}
+
+static int is_blank(const xmlChar *s)
+{
+  if (!s) return 1;
+  for (; *s; s++)
+    if (!is_space((char)*s)) return 0;
+  return 1;
+}
+
+const char *ss_xml_attr_text(xmlDocPtr doc, xmlAttrPtr a, xmlChar **owned)
+{
+  *owned = NULL;
+  if (a->children && a->children->type == XML_TEXT_NODE &&
+      !a->children->next && a->children->content)
+    return (const char *)a->children->content;
+  xmlChar *v = xmlNodeListGetString(doc, a->children, 1);
+  *owned = v;
+  return v ? (const char *)v : "";
+}
+
+int ss_xml_stray(xmlNodePtr n, const char *parent, char *msg, size_t cap)
+{
+  switch (n->type) {
+  case XML_TEXT_NODE:
+  case XML_CDATA_SECTION_NODE:
+    if (is_blank(n->content)) return 0;
+    {
+      const char *t = (const char *)n->content;
+      while (is_space(*t)) t++;
+      int len = 0;
+      while (t[len] && !is_space(t[len]) && len < 30) len++;
+      snprintf(msg, cap, "unexpected text '%.*s' inside <%s> (values go in "
+               "attributes)", len, t, parent);
+      return 1;
+    }
+  case XML_COMMENT_NODE:
+  case XML_PI_NODE:
+    return 0;
+  default:
+    snprintf(msg, cap, "unexpected content inside <%s>", parent);
+    return 1;
+  }
+}
+
+int ss_xml_vec_next(const char **pp, int first, const char **tb,
+                    const char **te)
+{
+  const char *p = *pp;
+  while (is_space(*p)) p++;
+  if (*p == ',') {
+    if (first) return -1;
+    p++;
+    while (is_space(*p)) p++;
+    if (*p == 0 || *p == ',') return -1;
+  }
+  if (*p == 0) {
+    *pp = p;
+    return 0;
+  }
+  *tb = p;
+  while (*p && !is_space(*p) && *p != ',') p++;
+  *te = p;
+  *pp = p;
+  return 1;
+}
+
+long ss_xml_vec_count(const char *v)
+{
+  const char *p = v, *tb, *te;
+  long n = 0;
+  int r;
+  while ((r = ss_xml_vec_next(&p, n == 0, &tb, &te)) == 1) n++;
+  return r < 0 ? -1 : n;
+}
+
+int ss_xml_in_list(const char *name, const char *const *list)
+{
+  for (int i = 0; list[i]; i++)
+    if (!strcmp(list[i], name)) return 1;
+  return 0;
+}
+
+void ss_xml_join_names(char *out, size_t cap, const char *const *names)
+{
+  size_t k = 0;
+  out[0] = 0;
+  for (int i = 0; names[i]; i++) {
+    int n = snprintf(out + k, cap - k, "%s%s", i ? ", " : "", names[i]);
+    if (n < 0 || (size_t)n >= cap - k) break;
+    k += (size_t)n;
+  }
+}
