@@ -955,8 +955,9 @@ int ss_model_add_articulated(ssModel *m, const ssUrdf *u, const ssArtDef *def,
   }
   if (def->qpos && def->nqpos != nq) {
     ss_error_set(err, SS_ERR_VALUE, f, line,
-                 "articulated_system '%s': qpos has %d values, expected %d",
-                 def->name, def->nqpos, nq);
+                 "articulated_system '%s': %s has %d values, expected %d",
+                 def->name, def->qpos_name ? def->qpos_name : "qpos",
+                 def->nqpos, nq);
     return -1;
   }
   if (def->qvel && def->nqvel != nv) {

@@ -33,6 +33,8 @@ typedef struct ssArtDef {
   const double *qpos;    /* optional full initial qpos (nq), NULL = URDF zero
                             pose placed at pos/quat */
   int nqpos;
+  const char *qpos_name; /* what errors call qpos (e.g. "reference_qpos");
+                            NULL = "qpos" */
   const double *qvel;    /* optional (nv) */
   int nqvel;
   const char *material;  /* rigid material of all colliders */

@@ -1295,6 +1295,7 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
      * scene started from), then the state moves to qpos */
     def.qpos = ref ? ref : qpos;
     def.nqpos = ref ? nref : nqpos;
+    def.qpos_name = ref ? "reference_qpos" : "qpos";
     def.qvel = qvel;
     def.nqvel = nqvel;
     def.urdf_path = path;
