@@ -70,10 +70,6 @@ void ss_dyn_contact_jacobian(const ssModel *m, ssData *d, int b,
                              const double p[3], const double frame[9],
                              double *J, double *W, double G[9])
 {
-  if (m->sys_type[m->body_sys[b]] == SS_SYS_ARTICULATED) {
-    ss_art_contact_jacobian(m, d, b, p, frame, J, W, G);
-    return;
-  }
   double r[3], inv_m = 1.0 / m->body_mass[b];
   const double *Iinv = d->body_iinv + 9 * b;
   ss_v3_sub(r, p, d->body_xipos + 3 * b);
