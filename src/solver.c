@@ -354,6 +354,14 @@ static void contact_velocity(const ssModel *m, const ssData *d,
   }
   const double *J = d->jac + c->jadr, *u = d->qvel + c->vadr;
   int nv = c->nv;
+  if (nv == 6) {
+    /* a single rigid body */
+    for (int k = 0; k < 3; k++) {
+      const double *j = J + 6 * k;
+      v[k] = j[0] * u[0] + j[1] * u[1] + j[2] * u[2] + j[3] * u[3] + j[4] * u[4] + j[5] * u[5];
+    }
+    return;
+  }
   for (int k = 0; k < 3; k++) {
     double s = 0;
     for (int i = 0; i < nv; i++) s += J[k * nv + i] * u[i];
@@ -375,6 +383,11 @@ static void apply_impulse(const ssModel *m, ssData *d, const ssContact *c,
   }
   const double *W = d->jac + c->jadr + 3 * c->nv;
   double *u = d->qvel + c->vadr;
+  if (c->nv == 6) {
+    for (int i = 0; i < 6; i++)
+      u[i] += W[3 * i] * dl[0] + W[3 * i + 1] * dl[1] + W[3 * i + 2] * dl[2];
+    return;
+  }
   for (int i = 0; i < c->nv; i++)
     u[i] += W[3 * i] * dl[0] + W[3 * i + 1] * dl[1] + W[3 * i + 2] * dl[2];
 }
@@ -430,6 +443,29 @@ static void row_key(const ssData *d, const ssContact *c, ssWarmEntry *k)
   k->geom = c->type == SS_CONTACT_PD ? -2 : -3;
 }
 
+/* The cache entry of key, or NULL.  Contacts come in runs of ascending
+ * keys (one collider's points in vertex order), so the search walks on
+ * from the previous hit (*cursor) while the keys ascend, a few entries at
+ * most, and falls back to bisection when they do not. */
+static const ssWarmEntry *find_warm(const ssData *d, const ssWarmEntry *key,
+                                    int *cursor)
+{
+  int p = *cursor, n = d->nwarm;
+  if (p < n && cmp_warm(d->warm + p, key) <= 0) {
+    for (int k = 0; k < 8 && p < n; k++, p++) {
+      int c = cmp_warm(d->warm + p, key);
+      if (c == 0) {
+        *cursor = p + 1;
+        return d->warm + p;
+      }
+      if (c > 0) return NULL; /* passed it: not cached */
+    }
+  }
+  const ssWarmEntry *e = bsearch(key, d->warm, (size_t)n, sizeof *key, cmp_warm);
+  if (e) *cursor = (int)(e - d->warm) + 1;
+  return e;
+}
+
 /* Initial impulses from last step's tractions, scaled by the current area
  * and time step and projected into the current bounds; joint rows start
  * from last step's impulse rate. */
@@ -437,6 +473,7 @@ static void warm_start(const ssModel *m, ssData *d)
 {
   const double dt = m->opt.timestep;
   Group g = {NULL, 0, NULL, NULL, {0}, {0}};
+  int cursor = 0;
   for (int i = 0; i < d->ncontact; i++) {
     ssContact *c = d->contact + i;
     c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
@@ -444,7 +481,7 @@ static void warm_start(const ssModel *m, ssData *d)
       continue;
     ssWarmEntry key = {c->vertex, c->geom, {0, 0, 0}};
     if (c->type != SS_CONTACT_SOIL) row_key(d, c, &key);
-    const ssWarmEntry *e = bsearch(&key, d->warm, (size_t)d->nwarm, sizeof key, cmp_warm);
+    const ssWarmEntry *e = find_warm(d, &key, &cursor);
     if (!e) continue;
     if (c->type == SS_CONTACT_PD) {
       double l = e->traction[0] * dt;
@@ -522,7 +559,11 @@ static ssStatus store_warm(const ssModel *m, ssData *d, ssError *err)
       e->traction[1] = e->traction[2] = 0;
     }
   }
-  if (n) qsort(d->warm, (size_t)n, sizeof *d->warm, cmp_warm);
+  /* one collider's entries come in order already: sort only when the
+   * list is not (several colliders, joint rows) */
+  int sorted = 1;
+  for (int i = 1; i < n && sorted; i++) sorted = cmp_warm(d->warm + i - 1, d->warm + i) < 0;
+  if (!sorted) qsort(d->warm, (size_t)n, sizeof *d->warm, cmp_warm);
   d->nwarm = n;
   return SS_OK;
 }

@@ -201,19 +201,29 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
   for (int j = j0; j <= j1; j++) {
     double y = y0 + j * dy;
     double cy0 = j == 0 ? y : y - 0.5 * dy, cy1 = j == ny - 1 ? y : y + 0.5 * dy;
+    /* cells whose x range lies inside both chords of the row's band lie
+     * inside the (convex) footprint: fully covered, no clipping; a margin
+     * of 1e-9 dx leaves the cells on the footprint's edge to the clipping */
+    double in0 = INFINITY, in1 = -INFINITY, a0, a1, b0, b1;
+    if (ss_poly_chord(&fp, cy0, &a0, &a1) && ss_poly_chord(&fp, cy1, &b0, &b1)) {
+      in0 = fmax(a0, b0) + 1e-9 * dx;
+      in1 = fmin(a1, b1) - 1e-9 * dx;
+    }
     for (int i = i0; i <= i1; i++) {
       double x = x0 + i * dx;
       double cx0 = i == 0 ? x : x - 0.5 * dx, cx1 = i == nx - 1 ? x : x + 0.5 * dx;
-      double qx, qy;
-      double area = ss_poly_rect_area(&fp, cx0, cx1, cy0, cy1, &qx, &qy);
-      if (!(area > tiny)) continue;
-      /* the point represents the covered part of the cell: the vertex when
-       * the cell is fully covered, else the covered part's centroid (a
-       * vertex on or outside the footprint's edge would see a side face) */
-      double full = (cx1 - cx0) * (cy1 - cy0);
-      if (area >= full * (1 - 1e-9)) {
-        qx = x;
-        qy = y;
+      double qx = x, qy = y, full = (cx1 - cx0) * (cy1 - cy0), area = full;
+      if (!(cx0 > in0 && cx1 < in1)) {
+        area = ss_poly_rect_area(&fp, cx0, cx1, cy0, cy1, &qx, &qy);
+        if (!(area > tiny)) continue;
+        /* the point represents the covered part of the cell: the vertex
+         * when the cell is fully covered, else the covered part's centroid
+         * (a vertex on or outside the footprint's edge would see a side
+         * face) */
+        if (area >= full * (1 - 1e-9)) {
+          qx = x;
+          qy = y;
+        }
       }
       double zl;
       if (m->geom_type[g] == SS_GEOM_MESH) {
@@ -419,7 +429,10 @@ void ss_terrain_update(const ssModel *m, ssData *d)
     const ssContact *c = d->contact + i;
     if (c->type == SS_CONTACT_SOIL && c->loaded) d->soil_loaded[n++] = c->vertex;
   }
-  if (n) qsort(d->soil_loaded, (size_t)n, sizeof(int), cmp_int);
+  /* one collider's vertices come in order already */
+  int sorted = 1;
+  for (int i = 1; i < n && sorted; i++) sorted = d->soil_loaded[i - 1] < d->soil_loaded[i];
+  if (!sorted) qsort(d->soil_loaded, (size_t)n, sizeof(int), cmp_int);
   int u = 0;
   for (int i = 0; i < n; i++)
     if (u == 0 || d->soil_loaded[u - 1] != d->soil_loaded[i])
