@@ -62,12 +62,12 @@ static void fcross(double r[6], const double a[6], const double f[6])
   memcpy(r, t, sizeof t);
 }
 
-static void m6v(double r[6], const double M[36], const double v[6])
+static inline void m6v(double r[6], const double M[36], const double v[6])
 {
+  /* same summation order as a running sum from 0 */
   for (int i = 0; i < 6; i++) {
-    double s = 0;
-    for (int j = 0; j < 6; j++) s += M[6 * i + j] * v[j];
-    r[i] = s;
+    const double *a = M + 6 * i;
+    r[i] = a[0] * v[0] + a[1] * v[1] + a[2] * v[2] + a[3] * v[3] + a[4] * v[4] + a[5] * v[5];
   }
 }
 
