@@ -402,9 +402,10 @@ typedef struct Group {
   double F[6];
 } Group;
 
-/* shorter runs keep the full update: opening (J_b u) and closing (Y F)
- * a group cost about one full visit each */
-enum { MIN_GROUP = 4 };
+/* a lone contact keeps the full update: opening a group (J_b u) and
+ * closing it (Y F) cost what one full visit costs (J_b u, then Y X^T dl),
+ * so a group pays from two contacts on */
+enum { MIN_GROUP = 2 };
 
 static int group_open(const ssModel *m, ssData *d, Group *g,
                       const ssContact *c, int end)
