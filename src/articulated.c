@@ -62,12 +62,12 @@ static void fcross(double r[6], const double a[6], const double f[6])
   memcpy(r, t, sizeof t);
 }
 
-static void m6v(double r[6], const double M[36], const double v[6])
+static inline void m6v(double r[6], const double M[36], const double v[6])
 {
+  /* same summation order as a running sum from 0 */
   for (int i = 0; i < 6; i++) {
-    double s = 0;
-    for (int j = 0; j < 6; j++) s += M[6 * i + j] * v[j];
-    r[i] = s;
+    const double *a = M + 6 * i;
+    r[i] = a[0] * v[0] + a[1] * v[1] + a[2] * v[2] + a[3] * v[3] + a[4] * v[4] + a[5] * v[5];
   }
 }
 
@@ -676,32 +676,28 @@ static void body_response(const ssModel *m, ssArtWork *w, int lb)
   w->Yok[lb] = 1;
 }
 
-void ss_art_contact_jacobian(const ssModel *m, ssData *d, int b,
-                             const double p[3], const double frame[9],
-                             double *J, double *W, double G[9])
+void ss_art_link_block(const ssModel *m, ssData *d, int b, const double **Y,
+                       const double **Lam)
 {
-  int s = m->body_sys[b];
-  ssArtWork *w = d->art[s];
-  int n = w->nv, lb = b - w->b0;
+  ssArtWork *w = d->art[m->body_sys[b]];
+  int lb = b - w->b0;
   body_response(m, w, lb);
-  /* X (3 x 6): contact-frame velocity of the point from a spatial velocity */
-  double X[18];
+  *Y = w->Y + (size_t)lb * w->nv * 6;
+  *Lam = w->Lam + 36 * lb;
+}
+
+void ss_art_contact_rows(const ssModel *m, ssData *d, int b,
+                         const double p[3], const double frame[9],
+                         double X[18], double G[9])
+{
+  const double *Y, *Lam;
+  ss_art_link_block(m, d, b, &Y, &Lam);
+  /* contact-frame velocity of the point from a spatial velocity */
   for (int i = 0; i < 3; i++) {
     const double *f = frame + 3 * i;
     ss_v3_cross(X + 6 * i, p, f);
     memcpy(X + 6 * i + 3, f, 3 * sizeof(double));
   }
-  memset(J, 0, 3 * (size_t)n * sizeof(double));
-  for (int a = b; a >= 0; a = m->body_parent[a]) {
-    int nd = m->body_ndof[a];
-    if (!nd) continue;
-    int k0 = m->body_dofadr[a] - w->v0;
-    for (int k = k0; k < k0 + nd; k++)
-      for (int i = 0; i < 3; i++) J[i * n + k] = dot6(X + 6 * i, w->S + 6 * k);
-  }
-  const double *Y = w->Y + (size_t)lb * n * 6, *Lam = w->Lam + 36 * lb;
-  for (int k = 0; k < n; k++)
-    for (int i = 0; i < 3; i++) W[3 * k + i] = dot6(Y + 6 * k, X + 6 * i);
   double LX[18];
   for (int i = 0; i < 3; i++) m6v(LX + 6 * i, Lam, X + 6 * i);
   for (int i = 0; i < 3; i++)
@@ -726,10 +722,10 @@ void ss_art_dof_jacobian(const ssModel *m, ssData *d, int s, int dof,
   G[0] = col[k];
 }
 
-void ss_art_point_velocity(const ssModel *m, const ssData *d, int b,
-                           const double p[3], double v[3])
+void ss_art_link_velocity(const ssModel *m, const ssData *d, int b,
+                          double V[6])
 {
-  ssArtWork *w = d->art[m->body_sys[b]];
+  const ssArtWork *w = d->art[m->body_sys[b]];
   const double *u = d->qvel + w->v0;
   double sv[6] = {0, 0, 0, 0, 0, 0};
   for (int a = b; a >= 0; a = m->body_parent[a]) {
@@ -739,7 +735,14 @@ void ss_art_point_velocity(const ssModel *m, const ssData *d, int b,
     for (int k = k0; k < k0 + nd; k++)
       for (int i = 0; i < 6; i++) sv[i] += w->S[6 * k + i] * u[k];
   }
-  double wp[3];
+  memcpy(V, sv, sizeof sv);
+}
+
+void ss_art_point_velocity(const ssModel *m, const ssData *d, int b,
+                           const double p[3], double v[3])
+{
+  double sv[6], wp[3];
+  ss_art_link_velocity(m, d, b, sv);
   ss_v3_cross(wp, sv, p);
   ss_v3_add(v, sv + 3, wp);
 }
@@ -1186,7 +1189,7 @@ ssStatus ss_art_rows(const ssModel *m, ssData *d, ssError *err)
     int b = m->pd_body[k], s = m->body_sys[b];
     if (!d->sys_active[s]) continue;
     int nv = m->sys_nv[s], dof = m->body_dofadr[b];
-    ssContact *c = ss_contact_new(d, nv);
+    ssContact *c = ss_contact_new(d, 6L * nv);
     if (!c) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
     const double *g = m->pd_gain + 3 * k, *t = d->pd_target + 2 * k;
     double q = d->qpos[m->body_qadr[b]];
@@ -1194,6 +1197,7 @@ ssStatus ss_art_rows(const ssModel *m, ssData *d, ssError *err)
     c->type = SS_CONTACT_PD;
     c->sys = s;
     c->vadr = m->sys_vadr[s];
+    c->nv = nv;
     c->geom = -1;
     c->hfield = -1;
     c->vertex = -1;
@@ -1215,11 +1219,12 @@ ssStatus ss_art_rows(const ssModel *m, ssData *d, ssError *err)
       double vin = side == 0 ? u : -u;
       if (gap + dt * vin > 0 && gap > 0) continue;
       int nv = m->sys_nv[s];
-      ssContact *c = ss_contact_new(d, nv);
+      ssContact *c = ss_contact_new(d, 6L * nv);
       if (!c) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
       c->type = SS_CONTACT_LIMIT;
       c->sys = s;
       c->vadr = m->sys_vadr[s];
+      c->nv = nv;
       c->geom = -1;
       c->hfield = -1;
       c->vertex = -1;

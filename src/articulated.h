@@ -13,7 +13,10 @@
  * keeps the tree's sparsity), and the loop closures K are eliminated by
  * projection in the M' metric.  Contacts see the projected response
  * W = P M'^-1 J^T through a per-body six-component reduction
- * Y_b = P M'^-1 J_b^T, so a contact costs O(nv) however many share a link. */
+ * Y_b = P M'^-1 J_b^T (the six spatial directions projected once per link
+ * and step), so a contact stores only its 3 x 6 spatial rows and the
+ * solver sweeps the contacts of one link against the link's 6 x 6 block
+ * J_b Y_b (solver.h). */
 #ifndef SS_ARTICULATED_H
 #define SS_ARTICULATED_H
 
@@ -67,10 +70,21 @@ void ss_art_forward(const ssModel *m, ssData *d, int sys);
  * Returns SS_ERR_NUMERIC when the mass matrix is not positive definite. */
 ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int sys,
                               ssError *err);
-/* Contact rows of a world point on body b: J (3 x nv), W (nv x 3), G. */
-void ss_art_contact_jacobian(const ssModel *m, ssData *d, int b,
-                             const double p[3], const double frame[9],
-                             double *J, double *W, double G[9]);
+/* The response block of link b for this step, computed once per step and
+ * shared by all contacts on the link: Y (nv x 6, row k: the velocity of
+ * dof k per unit spatial impulse, loop closures eliminated) and the 6 x 6
+ * block Lam = J_b Y, the link's spatial velocity per unit spatial impulse. */
+void ss_art_link_block(const ssModel *m, ssData *d, int b, const double **Y,
+                       const double **Lam);
+/* Spatial velocity J_b u of link b (world, about the origin: omega; v_O). */
+void ss_art_link_velocity(const ssModel *m, const ssData *d, int b,
+                          double V[6]);
+/* Contact rows of a world point on link b: X (3 x 6) maps the link's
+ * spatial velocity to the contact-frame velocity of the point (the
+ * contact's Jacobian is X J_b, its response Y X^T), and G = X Lam X^T. */
+void ss_art_contact_rows(const ssModel *m, ssData *d, int b,
+                         const double p[3], const double frame[9],
+                         double X[18], double G[9]);
 /* Row of one degree of freedom (PD, limits): J = e_k, W = P M'^-1 e_k. */
 void ss_art_dof_jacobian(const ssModel *m, ssData *d, int sys, int dof,
                          double *J, double *W, double G[9]);

@@ -343,6 +343,29 @@ double ss_poly_rect_area(const ssPoly2 *p, double x0, double x1, double y0,
   return fabs(0.5 * a2);
 }
 
+int ss_poly_chord(const ssPoly2 *p, double y, double *x0, double *x1)
+{
+  double lo = INFINITY, hi = -INFINITY;
+  for (int i = 0, j = p->n - 1; i < p->n; j = i++) {
+    double ya = p->y[j], yb = p->y[i];
+    if ((ya > y && yb > y) || (ya < y && yb < y)) continue;
+    double x;
+    if (ya == yb) {
+      /* an edge along the line: both ends */
+      lo = fmin(lo, fmin(p->x[i], p->x[j]));
+      hi = fmax(hi, fmax(p->x[i], p->x[j]));
+      continue;
+    }
+    x = p->x[j] + (y - ya) / (yb - ya) * (p->x[i] - p->x[j]);
+    lo = fmin(lo, x);
+    hi = fmax(hi, x);
+  }
+  if (!(hi >= lo)) return 0;
+  *x0 = lo;
+  *x1 = hi;
+  return 1;
+}
+
 int ss_poly_contains(const ssPoly2 *p, double x, double y)
 {
   if (p->n < 3) return 0;

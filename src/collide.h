@@ -43,6 +43,9 @@ double ss_poly_area(const ssPoly2 *p);
  * area is > 0 and cx, cy are not NULL they receive its centroid. */
 double ss_poly_rect_area(const ssPoly2 *p, double x0, double x1, double y0,
                          double y1, double *cx, double *cy);
+/* The chord [*x0, *x1] of a convex polygon on the line at height y;
+ * 0 when the line misses it. */
+int ss_poly_chord(const ssPoly2 *p, double y, double *x0, double *x1);
 /* 1 if (x, y) lies inside or on the polygon. */
 int ss_poly_contains(const ssPoly2 *p, double x, double y);
 /* Lowest point of the shape's surface on the vertical line through (x, y):

@@ -70,19 +70,17 @@ void ss_dyn_contact_jacobian(const ssModel *m, ssData *d, int b,
                              const double p[3], const double frame[9],
                              double *J, double *W, double G[9])
 {
-  if (m->sys_type[m->body_sys[b]] == SS_SYS_ARTICULATED) {
-    ss_art_contact_jacobian(m, d, b, p, frame, J, W, G);
-    return;
-  }
   double r[3], inv_m = 1.0 / m->body_mass[b];
   const double *Iinv = d->body_iinv + 9 * b;
   ss_v3_sub(r, p, d->body_xipos + 3 * b);
   double ang[3][3], wang[3][3];
+#pragma GCC unroll 3
   for (int k = 0; k < 3; k++) {
     const double *f = frame + 3 * k;
     ss_v3_cross(ang[k], r, f);
     ss_m3_mulv(wang[k], Iinv, ang[k]);
     /* J row k = [f, r x f]; W column k = [f / m, I^-1 (r x f)] */
+#pragma GCC unroll 3
     for (int i = 0; i < 3; i++) {
       J[6 * k + i] = f[i];
       J[6 * k + 3 + i] = ang[k][i];
@@ -90,7 +88,9 @@ void ss_dyn_contact_jacobian(const ssModel *m, ssData *d, int b,
       W[3 * (3 + i) + k] = wang[k][i];
     }
   }
+#pragma GCC unroll 3
   for (int a = 0; a < 3; a++)
+#pragma GCC unroll 3
     for (int c = 0; c < 3; c++)
       G[3 * a + c] = ss_v3_dot(frame + 3 * a, frame + 3 * c) * inv_m +
                      ss_v3_dot(ang[a], wang[c]);

@@ -8,9 +8,9 @@
 /* qvel <- qvel + dt M^-1 (gravity + external forces - gyroscopic terms),
  * for articulated systems with their force elements and loop closures. */
 ssStatus ss_dyn_free_velocity(const ssModel *m, ssData *d, ssError *err);
-/* Contact Jacobian rows (frame rows n, t1, t2) of a point on body b:
- * J (3 x nv) and W = M^-1 J^T (nv x 3) over the body's system, and
- * G = J W (3 x 3). */
+/* Contact Jacobian rows (frame rows n, t1, t2) of a point on single rigid
+ * body b: J (3 x 6) and W = M^-1 J^T (6 x 3), and G = J W (3 x 3).
+ * Articulated links use ss_art_contact_rows. */
 void ss_dyn_contact_jacobian(const ssModel *m, ssData *d, int body,
                              const double point[3], const double frame[9],
                              double *J, double *W, double G[9]);

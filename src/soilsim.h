@@ -443,6 +443,9 @@ typedef struct ssData {
   double *qvel_free;      /* (nv) velocity before contact impulses */
   int nwarm, cap_warm;
   ssWarmEntry *warm;      /* (nwarm) warm-start cache */
+  int solver_full;        /* 1: every contact updates the full velocity
+                             (no packed link groups); the reference path of
+                             the tests, equal to the default at round-off */
   ssStepStats stats;
 } ssData;
 

@@ -8,6 +8,7 @@
  * rigid points a Coulomb cone.  The system velocity u is updated after each
  * contact by W (lambda_new - lambda_old). */
 #include "solver.h"
+#include "articulated.h"
 #include "ss_math.h"
 
 #include <float.h>
@@ -743,7 +744,7 @@ static void limit_row(ssContact *c, const double v0[3])
   c->lambda[0] = l > 0 ? l : 0;
 }
 
-ssContact *ss_contact_new(ssData *d, int nv)
+ssContact *ss_contact_new(ssData *d, long njac)
 {
   if (d->ncontact == d->cap_contact) {
     int c = d->cap_contact ? 2 * d->cap_contact : 256;
@@ -754,9 +755,9 @@ ssContact *ss_contact_new(ssData *d, int nv)
   }
   ssContact *c = d->contact + d->ncontact;
   long jadr = d->ncontact ? d->contact[d->ncontact - 1].jadr +
-                                6 * (long)d->contact[d->ncontact - 1].nv
+                                d->contact[d->ncontact - 1].jlen
                           : 0;
-  size_t need = (size_t)jadr + 6 * (size_t)nv;
+  size_t need = (size_t)jadr + (size_t)njac;
   if (need > d->cap_jac) {
     size_t cap = d->cap_jac ? 2 * d->cap_jac : 4096;
     while (cap < need) cap *= 2;
@@ -766,8 +767,9 @@ ssContact *ss_contact_new(ssData *d, int nv)
     d->cap_jac = cap;
   }
   memset(c, 0, sizeof *c);
+  c->link = -1;
   c->jadr = jadr;
-  c->nv = nv;
+  c->jlen = njac;
   d->ncontact++;
   return c;
 }
@@ -775,10 +777,52 @@ ssContact *ss_contact_new(ssData *d, int nv)
 /* ---------------------------------------------------------------------- */
 /* sweeps                                                                  */
 
-static void contact_velocity(const ssData *d, const ssContact *c, double v[3])
+/* contact-frame velocity X V of a link contact from a spatial velocity */
+static void rows_velocity(const double *X, const double V[6], double v[3])
 {
+  for (int k = 0; k < 3; k++) {
+    const double *x = X + 6 * k;
+    v[k] = x[0] * V[0] + x[1] * V[1] + x[2] * V[2] + x[3] * V[3] + x[4] * V[4] + x[5] * V[5];
+  }
+}
+
+/* spatial impulse X^T dl of a link contact */
+static void rows_impulse(const double *X, const double dl[3], double w[6])
+{
+  for (int i = 0; i < 6; i++) w[i] = X[i] * dl[0] + X[6 + i] * dl[1] + X[12 + i] * dl[2];
+}
+
+/* u += Y w over the system's velocities */
+static void link_apply(ssData *d, const ssContact *c, const double *Y,
+                       const double w[6])
+{
+  double *u = d->qvel + c->vadr;
+  for (int k = 0; k < c->nv; k++) {
+    const double *y = Y + 6 * k;
+    u[k] += y[0] * w[0] + y[1] * w[1] + y[2] * w[2] + y[3] * w[3] + y[4] * w[4] + y[5] * w[5];
+  }
+}
+
+/* the contact's velocity J u, from the full velocity */
+static void contact_velocity(const ssModel *m, const ssData *d,
+                             const ssContact *c, double v[3])
+{
+  if (c->link >= 0) {
+    double V[6];
+    ss_art_link_velocity(m, d, c->link, V);
+    rows_velocity(d->jac + c->jadr, V, v);
+    return;
+  }
   const double *J = d->jac + c->jadr, *u = d->qvel + c->vadr;
   int nv = c->nv;
+  if (nv == 6) {
+    /* a single rigid body */
+    for (int k = 0; k < 3; k++) {
+      const double *j = J + 6 * k;
+      v[k] = j[0] * u[0] + j[1] * u[1] + j[2] * u[2] + j[3] * u[3] + j[4] * u[4] + j[5] * u[5];
+    }
+    return;
+  }
   for (int k = 0; k < 3; k++) {
     double s = 0;
     for (int i = 0; i < nv; i++) s += J[k * nv + i] * u[i];
@@ -786,12 +830,64 @@ static void contact_velocity(const ssData *d, const ssContact *c, double v[3])
   }
 }
 
-static void apply_impulse(ssData *d, const ssContact *c, const double dl[3])
+/* u += W dl, the full velocity update of one contact */
+static void apply_impulse(const ssModel *m, ssData *d, const ssContact *c,
+                          const double dl[3])
 {
+  if (c->link >= 0) {
+    const double *Y, *Lam;
+    double w[6];
+    ss_art_link_block(m, d, c->link, &Y, &Lam);
+    rows_impulse(d->jac + c->jadr, dl, w);
+    link_apply(d, c, Y, w);
+    return;
+  }
   const double *W = d->jac + c->jadr + 3 * c->nv;
   double *u = d->qvel + c->vadr;
+  if (c->nv == 6) {
+    for (int i = 0; i < 6; i++)
+      u[i] += W[3 * i] * dl[0] + W[3 * i + 1] * dl[1] + W[3 * i + 2] * dl[2];
+    return;
+  }
   for (int i = 0; i < c->nv; i++)
     u[i] += W[3 * i] * dl[0] + W[3 * i + 1] * dl[1] + W[3 * i + 2] * dl[2];
+}
+
+/* A packed group: consecutive contacts on one link swept against the
+ * link's spatial velocity; F is the group's spatial impulse not yet in u. */
+typedef struct Group {
+  const ssContact *first; /* NULL: no group open */
+  int end;                /* index of the group's last contact */
+  const double *Y, *Lam;  /* the link's block */
+  double V[6];            /* J_b u with F applied */
+  double F[6];
+} Group;
+
+/* a lone contact keeps the full update: opening a group (J_b u) and
+ * closing it (Y F) cost what one full visit costs (J_b u, then Y X^T dl),
+ * so a group pays from two contacts on */
+enum { MIN_GROUP = 2 };
+
+static int group_open(const ssModel *m, ssData *d, Group *g,
+                      const ssContact *c, int end)
+{
+  ss_art_link_block(m, d, c->link, &g->Y, &g->Lam);
+  /* a response block that is not finite (a degenerate link) is left to
+   * the full update, which reports it through the velocities */
+  for (int k = 0; k < 36; k++)
+    if (!isfinite(g->Lam[k])) return 0;
+  g->first = c;
+  g->end = end;
+  ss_art_link_velocity(m, d, c->link, g->V);
+  memset(g->F, 0, sizeof g->F);
+  return 1;
+}
+
+static void group_close(ssData *d, Group *g)
+{
+  if (!g->first) return;
+  link_apply(d, g->first, g->Y, g->F);
+  g->first = NULL;
 }
 
 static int cmp_warm(const void *a, const void *b)
@@ -809,12 +905,37 @@ static void row_key(const ssData *d, const ssContact *c, ssWarmEntry *k)
   k->geom = c->type == SS_CONTACT_PD ? -2 : -3;
 }
 
+/* The cache entry of key, or NULL.  Contacts come in runs of ascending
+ * keys (one collider's points in vertex order), so the search walks on
+ * from the previous hit (*cursor) while the keys ascend, a few entries at
+ * most, and falls back to bisection when they do not. */
+static const ssWarmEntry *find_warm(const ssData *d, const ssWarmEntry *key,
+                                    int *cursor)
+{
+  int p = *cursor, n = d->nwarm;
+  if (p < n && cmp_warm(d->warm + p, key) <= 0) {
+    for (int k = 0; k < 8 && p < n; k++, p++) {
+      int c = cmp_warm(d->warm + p, key);
+      if (c == 0) {
+        *cursor = p + 1;
+        return d->warm + p;
+      }
+      if (c > 0) return NULL; /* passed it: not cached */
+    }
+  }
+  const ssWarmEntry *e = bsearch(key, d->warm, (size_t)n, sizeof *key, cmp_warm);
+  if (e) *cursor = (int)(e - d->warm) + 1;
+  return e;
+}
+
 /* Initial impulses from last step's tractions, scaled by the current area
  * and time step and projected into the current bounds; joint rows start
  * from last step's impulse rate. */
 static void warm_start(const ssModel *m, ssData *d)
 {
   const double dt = m->opt.timestep;
+  Group g = {NULL, 0, NULL, NULL, {0}, {0}};
+  int cursor = 0;
   for (int i = 0; i < d->ncontact; i++) {
     ssContact *c = d->contact + i;
     c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
@@ -822,7 +943,7 @@ static void warm_start(const ssModel *m, ssData *d)
       continue;
     ssWarmEntry key = {c->vertex, c->geom, {0, 0, 0}};
     if (c->type != SS_CONTACT_SOIL) row_key(d, c, &key);
-    const ssWarmEntry *e = bsearch(&key, d->warm, (size_t)d->nwarm, sizeof key, cmp_warm);
+    const ssWarmEntry *e = find_warm(d, &key, &cursor);
     if (!e) continue;
     if (c->type == SS_CONTACT_PD) {
       double l = e->traction[0] * dt;
@@ -843,8 +964,24 @@ static void warm_start(const ssModel *m, ssData *d)
       c->lambda[1] = lt0;
       c->lambda[2] = lt1;
     }
-    if (c->nv) apply_impulse(d, c, c->lambda);
+    if (!c->nv) continue;
+    if (c->link >= 0 && !d->solver_full) {
+      /* a link run's impulses reach u once, at the run's end */
+      if (!g.first || g.first->link != c->link) {
+        group_close(d, &g);
+        g.first = c;
+        ss_art_link_block(m, d, c->link, &g.Y, &g.Lam);
+        memset(g.F, 0, sizeof g.F);
+      }
+      double w[6];
+      rows_impulse(d->jac + c->jadr, c->lambda, w);
+      for (int k = 0; k < 6; k++) g.F[k] += w[k];
+    } else {
+      group_close(d, &g);
+      apply_impulse(m, d, c, c->lambda);
+    }
   }
+  group_close(d, &g);
 }
 
 static int cached(const ssContact *c)
@@ -884,18 +1021,26 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
       e->traction[1] = e->traction[2] = 0;
     }
   }
-  if (n) qsort(d->warm, (size_t)n, sizeof *d->warm, cmp_warm);
+  /* one collider's entries come in order already: sort only when the
+   * list is not (several colliders, joint rows) */
+  int sorted = 1;
+  for (int i = 1; i < n && sorted; i++) sorted = cmp_warm(d->warm + i - 1, d->warm + i) < 0;
+  if (!sorted) qsort(d->warm, (size_t)n, sizeof *d->warm, cmp_warm);
   d->nwarm = n;
   return SS_OK;
 }
 
-/* one Gauss-Seidel visit: new impulse of contact c with the others held */
-static void visit(const ssModel *m, ssData *d, ssContact *c, double *dmax,
-                  double *lmax)
+/* one Gauss-Seidel visit: new impulse of contact c with the others held;
+ * inside an open group g the contact sees and moves the link's spatial
+ * velocity only */
+static void visit(const ssModel *m, ssData *d, ssContact *c, Group *g,
+                  double *dmax, double *lmax)
 {
   const double dt = m->opt.timestep, stol = m->opt.scalar_tolerance;
+  int packed = g->first != NULL;
   double v[3] = {0, 0, 0}, v0[3], old[3];
-  if (c->nv) contact_velocity(d, c, v);
+  if (packed) rows_velocity(d->jac + c->jadr, g->V, v);
+  else if (c->nv) contact_velocity(m, d, c, v);
   memcpy(old, c->lambda, sizeof old);
   ss_m3_mulv(v0, c->G, old);
   ss_v3_sub(v0, v, v0);
@@ -909,7 +1054,19 @@ static void visit(const ssModel *m, ssData *d, ssContact *c, double *dmax,
   }
   double dl[3];
   ss_v3_sub(dl, c->lambda, old);
-  if (c->nv) apply_impulse(d, c, dl);
+  if (packed) {
+    if (dl[0] != 0 || dl[1] != 0 || dl[2] != 0) {
+      double w[6];
+      rows_impulse(d->jac + c->jadr, dl, w);
+      for (int k = 0; k < 6; k++) g->F[k] += w[k];
+      for (int r = 0; r < 6; r++) {
+        const double *L = g->Lam + 6 * r;
+        g->V[r] += L[0] * w[0] + L[1] * w[1] + L[2] * w[2] + L[3] * w[3] + L[4] * w[4] + L[5] * w[5];
+      }
+    }
+  } else if (c->nv) {
+    apply_impulse(m, d, c, dl);
+  }
   double dn = fabs(dl[0]) + fabs(dl[1]) + fabs(dl[2]);
   double ln = fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]);
   if (dn > *dmax) *dmax = dn;
@@ -932,15 +1089,37 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   while (first_row > 0 && (d->contact[first_row - 1].type == SS_CONTACT_PD ||
                            d->contact[first_row - 1].type == SS_CONTACT_LIMIT))
     first_row--;
+  int rows = first_row < d->ncontact;
+
+  /* runs of contacts on one link (packed groups) */
+  for (int i = first_row - 1; i >= 0; i--) {
+    ssContact *c = d->contact + i;
+    c->run = 1;
+    if (c->link >= 0 && i + 1 < first_row && c[1].link == c->link) c->run += c[1].run;
+  }
+  int pack = !d->solver_full;
+
   int sweeps = d->ncontact ? m->opt.solver_max_sweeps : 0;
+  Group g = {NULL, 0, NULL, NULL, {0}, {0}};
   for (int sweep = 0; sweep < sweeps; sweep++) {
     double dmax = 0, lmax = 0;
     for (int i = 0; i < d->ncontact; i++) {
-      visit(m, d, d->contact + i, &dmax, &lmax);
-      if (i < first_row && first_row < d->ncontact && (i & 63) == 63)
+      ssContact *c = d->contact + i;
+      if (g.first && i > g.end) group_close(d, &g);
+      if (!g.first && pack && i < first_row && c->link >= 0 && c->run >= MIN_GROUP) {
+        /* a group ends where the joint rows are revisited */
+        int end = i + c->run - 1;
+        if (rows && end > (i | 63)) end = i | 63;
+        if (end - i + 1 >= MIN_GROUP) group_open(m, d, &g, c, end);
+      }
+      visit(m, d, c, &g, &dmax, &lmax);
+      if (i < first_row && rows && (i & 63) == 63) {
+        group_close(d, &g);
         for (int r = first_row; r < d->ncontact; r++)
-          visit(m, d, d->contact + r, &dmax, &lmax);
+          visit(m, d, d->contact + r, &g, &dmax, &lmax);
+      }
     }
+    group_close(d, &g);
     st->sweeps = sweep + 1;
     st->residual = lmax > 0 ? dmax / lmax : 0;
     if (st->residual <= tol) break;
@@ -948,10 +1127,19 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   st->converged = st->residual <= tol;
 
   /* end-of-step contact velocities for the soil update */
+  int link = -1;
+  double V[6];
   for (int i = 0; i < d->ncontact; i++) {
     ssContact *c = d->contact + i;
     double v[3] = {0, 0, 0};
-    if (c->nv) contact_velocity(d, c, v);
+    if (c->link >= 0) {
+      /* one spatial velocity per link run */
+      if (c->link != link) ss_art_link_velocity(m, d, c->link, V);
+      link = c->link;
+      rows_velocity(d->jac + c->jadr, V, v);
+    } else if (c->nv) {
+      contact_velocity(m, d, c, v);
+    }
     memcpy(c->v, v, sizeof v);
     c->loaded = c->type == SS_CONTACT_SOIL && c->lambda[0] > 0 &&
                 -(c->g0 + dt * v[0]) > 0;

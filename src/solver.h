@@ -4,8 +4,16 @@
  * a static support (a soil bed, a rigid height map, a ground plane).  A
  * contact carries its Jacobian J (3 x nv of its system, rows = contact
  * frame n, t1, t2) and W = M^-1 J^T (nv x 3), so the velocity response to
- * an impulse is J W.  Articulated systems plug in through the same J/W
- * (with loop closures eliminated in W); single rigid bodies have nv = 6. */
+ * an impulse is J W; single rigid bodies and joint rows store J and W.  A
+ * contact on an articulated link stores only its spatial rows X (3 x 6):
+ * its Jacobian is X J_b and its response Y_b X^T, with the link's block
+ * Y_b = P M'^-1 J_b^T (nv x 6, loop closures eliminated) and
+ * Lam_b = J_b Y_b (6 x 6) computed once per step per link.  A run of
+ * consecutive contacts on one link is swept as a packed group: the link's
+ * spatial velocity V = J_b u is updated by Lam_b X^T dl after each visit
+ * (exact block Gauss-Seidel, every other contact held) and the group's
+ * accumulated spatial impulse reaches u (Y_b F) once, when the group
+ * ends. */
 #ifndef SS_SOLVER_H
 #define SS_SOLVER_H
 
@@ -25,7 +33,11 @@ struct ssContact {
   int hfield;        /* bed or rigid height map; -1 for a ground plane */
   int vertex;        /* soil: absolute index into the soil arrays */
   int vadr, nv;      /* the system's velocity block */
-  long jadr;         /* offset of J (3 nv) then W (nv x 3) in ssData.jac */
+  int link;          /* articulated link whose block serves the contact, or
+                        -1 (J and W stored) */
+  int run;           /* solver: contacts from this one on the same link */
+  long jadr, jlen;   /* offset and length in ssData.jac: J (3 nv) then
+                        W (nv x 3), or X (3 x 6) for a link contact */
   double pos[3];     /* contact point, world */
   double frame[9];   /* rows n, t1, t2 (world); n = bed +z / surface normal */
   double area;       /* soil: quadrature weight A (m^2) */
@@ -50,9 +62,10 @@ struct ssWarmEntry {
   double traction[3];/* impulse / (area dt), contact frame (Pa) */
 };
 
-/* Room for one more contact (zeroed) with a Jacobian block for a system of
- * nv velocities; NULL when out of memory. */
-ssContact *ss_contact_new(ssData *d, int nv);
+/* Room for one more contact (zeroed, link = -1) with njac doubles of
+ * Jacobian storage in d->jac (6 nv for J and W, 18 for a link contact's
+ * X); NULL when out of memory. */
+ssContact *ss_contact_new(ssData *d, long njac);
 
 /* Solve all contacts in d->contact; d->qvel holds the free velocity on entry
  * and the end-of-step velocity on return.  Fills d->stats.  The warm-start

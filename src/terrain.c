@@ -14,6 +14,7 @@
  * Only vertices inside the collider's bounding box are visited, so the cost
  * follows the contacts, not the bed size. */
 #include "terrain.h"
+#include "articulated.h"
 #include "collide.h"
 #include "dynamics.h"
 #include "mesh.h"
@@ -29,14 +30,28 @@ void ss_hfield_frame(const ssData *d, int h, double R[9], double p[3])
   ss_v3_copy(p, d->hfield_pos + 3 * h);
 }
 
+/* Jacobian storage of a contact of system sys (see ss_contact_new) */
+static long contact_jlen(const ssModel *m, int sys)
+{
+  if (sys < 0 || m->sys_nv[sys] == 0) return 0;
+  return m->sys_type[sys] == SS_SYS_ARTICULATED ? 18 : 6L * m->sys_nv[sys];
+}
+
 /* fill the system-dependent part of a contact: Jacobian, response, G */
 static void attach(const ssModel *m, ssData *d, ssContact *c, int sys)
 {
-  if (sys >= 0 && c->nv > 0) {
+  if (sys >= 0 && m->sys_nv[sys] > 0) {
+    int b = m->geom_body[c->geom];
     c->sys = sys;
     c->vadr = m->sys_vadr[sys];
-    double *J = d->jac + c->jadr, *W = J + 3 * c->nv;
-    ss_dyn_contact_jacobian(m, d, m->geom_body[c->geom], c->pos, c->frame, J, W, c->G);
+    c->nv = m->sys_nv[sys];
+    double *J = d->jac + c->jadr;
+    if (m->sys_type[sys] == SS_SYS_ARTICULATED) {
+      c->link = b;
+      ss_art_contact_rows(m, d, b, c->pos, c->frame, J, c->G);
+    } else {
+      ss_dyn_contact_jacobian(m, d, b, c->pos, c->frame, J, J + 3 * c->nv, c->G);
+    }
   } else {
     c->sys = -1;
     c->nv = 0;
@@ -177,7 +192,7 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
   double width = ss_shape_width(&s, up);
   double frame[9];
   frame_from_bed(R, frame);
-  int nv = sys >= 0 ? m->sys_nv[sys] : 0;
+  long njac = contact_jlen(m, sys);
   const double *z0 = m->hfield_data + adr;
   const double *sp = d->soil_plastic + adr, *jj = d->soil_shear + adr;
   double tiny = 1e-12 * dx * dy;
@@ -185,19 +200,29 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
   for (int j = j0; j <= j1; j++) {
     double y = y0 + j * dy;
     double cy0 = j == 0 ? y : y - 0.5 * dy, cy1 = j == ny - 1 ? y : y + 0.5 * dy;
+    /* cells whose x range lies inside both chords of the row's band lie
+     * inside the (convex) footprint: fully covered, no clipping; a margin
+     * of 1e-9 dx leaves the cells on the footprint's edge to the clipping */
+    double in0 = INFINITY, in1 = -INFINITY, a0, a1, b0, b1;
+    if (ss_poly_chord(&fp, cy0, &a0, &a1) && ss_poly_chord(&fp, cy1, &b0, &b1)) {
+      in0 = fmax(a0, b0) + 1e-9 * dx;
+      in1 = fmin(a1, b1) - 1e-9 * dx;
+    }
     for (int i = i0; i <= i1; i++) {
       double x = x0 + i * dx;
       double cx0 = i == 0 ? x : x - 0.5 * dx, cx1 = i == nx - 1 ? x : x + 0.5 * dx;
-      double qx, qy;
-      double area = ss_poly_rect_area(&fp, cx0, cx1, cy0, cy1, &qx, &qy);
-      if (!(area > tiny)) continue;
-      /* the point represents the covered part of the cell: the vertex when
-       * the cell is fully covered, else the covered part's centroid (a
-       * vertex on or outside the footprint's edge would see a side face) */
-      double full = (cx1 - cx0) * (cy1 - cy0);
-      if (area >= full * (1 - 1e-9)) {
-        qx = x;
-        qy = y;
+      double qx = x, qy = y, full = (cx1 - cx0) * (cy1 - cy0), area = full;
+      if (!(cx0 > in0 && cx1 < in1)) {
+        area = ss_poly_rect_area(&fp, cx0, cx1, cy0, cy1, &qx, &qy);
+        if (!(area > tiny)) continue;
+        /* the point represents the covered part of the cell: the vertex
+         * when the cell is fully covered, else the covered part's centroid
+         * (a vertex on or outside the footprint's edge would see a side
+         * face) */
+        if (area >= full * (1 - 1e-9)) {
+          qx = x;
+          qy = y;
+        }
       }
       double zl;
       if (m->geom_type[g] == SS_GEOM_MESH) {
@@ -209,7 +234,7 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       double floor_z = z0[k] - sp[k];
       double g0 = zl - floor_z;
       if (g0 > margin) continue;
-      ssContact *c = ss_contact_new(d, nv);
+      ssContact *c = ss_contact_new(d, njac);
       if (!c) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
       c->type = SS_CONTACT_SOIL;
       c->geom = g;
@@ -281,13 +306,13 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
   int npt = ss_shape_candidates(&s, up, pts, 32);
   int mat = h >= 0 ? m->hfield_material[h] : m->plane_material[plane];
   const ssMaterialPair *pair = ss_model_pair(m, m->geom_material[g], mat);
-  int nv = sys >= 0 ? m->sys_nv[sys] : 0;
+  long njac = contact_jlen(m, sys);
   for (int k = 0; k < npt; k++) {
     double zs = 0, nl[3] = {0, 0, 1};
     if (h >= 0 && !hfield_sample(m, h, pts[k][0], pts[k][1], &zs, nl)) continue;
     double gap = (pts[k][2] - zs) * nl[2];
     if (gap > margin) continue;
-    ssContact *c = ss_contact_new(d, nv);
+    ssContact *c = ss_contact_new(d, njac);
     if (!c) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
     c->type = SS_CONTACT_RIGID;
     c->geom = g;
@@ -304,7 +329,7 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
      * fraction of a penetration, or bounce */
     double dt = m->opt.timestep;
     c->vn_target = gap >= 0 ? -gap / dt : -m->opt.rigid_erp * gap / dt;
-    if (sys >= 0 && nv > 0 && gap <= m->opt.contact_margin) {
+    if (njac > 0 && gap <= m->opt.contact_margin) {
       double v[3];
       ss_dyn_point_velocity(m, d, m->geom_body[g], c->pos, v);
       double vn = ss_v3_dot(v, nw);
@@ -403,7 +428,10 @@ void ss_terrain_update(const ssModel *m, ssData *d)
     const ssContact *c = d->contact + i;
     if (c->type == SS_CONTACT_SOIL && c->loaded) d->soil_loaded[n++] = c->vertex;
   }
-  if (n) qsort(d->soil_loaded, (size_t)n, sizeof(int), cmp_int);
+  /* one collider's vertices come in order already */
+  int sorted = 1;
+  for (int i = 1; i < n && sorted; i++) sorted = d->soil_loaded[i - 1] < d->soil_loaded[i];
+  if (!sorted) qsort(d->soil_loaded, (size_t)n, sizeof(int), cmp_int);
   int u = 0;
   for (int i = 0; i < n; i++)
     if (u == 0 || d->soil_loaded[u - 1] != d->soil_loaded[i])

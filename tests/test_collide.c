@@ -340,6 +340,19 @@ static void test_poly_clip(void)
   ok(!ss_poly_contains(&sq, 1.001, 0.5) && !ss_poly_contains(&sq, -0.5, -0.5),
      "contains: outside points");
   ok(!ss_poly_contains(&tri, 0.6, 0.6), "contains: outside the hypotenuse");
+
+  /* chords: the full-cell shortcut of the soil quadrature */
+  double x0 = -9, x1 = -9;
+  ok(ss_poly_chord(&tri, 0.25, &x0, &x1) && x0 == 0 && x1 == 0.75,
+     "chord of the triangle at y = 0.25: [0, 0.75]");
+  ok(ss_poly_chord(&cw, 1, &x0, &x1) && x0 == 0 && x1 == 1,
+     "chord along an edge of a CW square: the edge");
+  ok(ss_poly_chord(&tri, 1, &x0, &x1) && x0 == 0 && x1 == 0, "chord through a vertex: a point");
+  ok(!ss_poly_chord(&sq, 1.5, &x0, &x1) && !ss_poly_chord(&sq, -0.1, &x0, &x1),
+     "lines that miss: no chord");
+  ssPoly2 dia = {4, {0, 1, 0, -1}, {-1, 0, 1, 0}};
+  ok(ss_poly_chord(&dia, 0.5, &x0, &x1) && fabs(x0 + 0.5) <= 1e-16 && fabs(x1 - 0.5) <= 1e-16,
+     "chord of a diamond at y = 0.5: [-0.5, 0.5]");
 }
 
 /* vertical ray casts against closed forms */

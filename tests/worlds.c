@@ -188,3 +188,41 @@ ssUrdf *fourpad64(void)
   return u;
 }
 
+
+/* ---------------------------------------------------------------------- */
+/* the solver's packed link groups against the full per-contact update     */
+
+double solver_paths_difference(ssModel *m, ssData *d, int sweeps, int *ncontact)
+{
+  ssError e;
+  unsigned char *buf = NULL;
+  size_t len = 0;
+  int keep_sweeps = m->opt.solver_max_sweeps;
+  double keep_tol = m->opt.solver_tolerance, worst = -1;
+  /* exactly `sweeps` sweeps on both paths: no early stop at round-off */
+  m->opt.solver_max_sweeps = sweeps;
+  m->opt.solver_tolerance = 1e-300;
+  int nv = m->nv, full = d->solver_full;
+  double *u = malloc((size_t)(nv ? nv : 1) * sizeof(double));
+  if (!u || ss_checkpoint_save_buffer(m, d, &buf, &len, &e) != SS_OK) goto out;
+  d->solver_full = 0;
+  if (ss_step(m, d, &e) != SS_OK) goto out;
+  memcpy(u, d->qvel, (size_t)nv * sizeof(double));
+  if (ncontact) *ncontact = d->ncontact;
+  if (ss_checkpoint_load_buffer(m, d, buf, len, &e) != SS_OK) goto out;
+  d->solver_full = 1;
+  if (ss_step(m, d, &e) != SS_OK) goto out;
+  double du = 0, un = 0;
+  for (int i = 0; i < nv; i++) {
+    du = fmax(du, fabs(d->qvel[i] - u[i]));
+    un = fmax(un, fabs(u[i]));
+  }
+  worst = un > 0 ? du / un : du;
+out:
+  d->solver_full = full;
+  m->opt.solver_max_sweeps = keep_sweeps;
+  m->opt.solver_tolerance = keep_tol;
+  free(buf);
+  free(u);
+  return worst;
+}

@@ -28,5 +28,11 @@ int add_mast(ssUrdf *u, int on, int nlinks, double mass, const double at[3]);
 ssUrdf *carrier60(void);
 ssUrdf *carrier60_pinned(void);
 ssUrdf *fourpad64(void);
+/* One step of d taken twice from the same state with `sweeps` sweeps each:
+ * with the solver's packed link groups, then with the full per-contact
+ * update (d->solver_full).  Returns the largest difference of the
+ * end-of-step velocities relative to the largest velocity (-1 on
+ * failure); d holds the full path's step.  *ncontact: its contacts. */
+double solver_paths_difference(ssModel *m, ssData *d, int sweeps, int *ncontact);
 
 #endif
