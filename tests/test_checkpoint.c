@@ -13,6 +13,7 @@
 #include "solver.h"
 #include "ss_math.h"
 #include "tap.h"
+#include "worlds.h"
 
 #include <stddef.h>
 #include <stdint.h>
@@ -110,17 +111,6 @@ static int identical(const ssModel *m, const ssData *a, const ssData *b)
 /* ---------------------------------------------------------------------- */
 /* worlds built in code                                                    */
 
-static ssSoilMaterial test_soil(void)
-{
-  ssSoilMaterial s = ss_soil_material_default();
-  s.bekker_kc = 0;
-  s.bekker_kphi = 1e5;
-  s.sinkage_exponent = 1;
-  s.elastic_stiffness = 2e6;
-  s.damping = 1e4;
-  return s;
-}
-
 /* A 20 kg plate on an n x n soil bed of side size; with pull != 0, a
  * horizontal force pull (N) along x from t = 0.03 s: the dragged plate. */
 static int build_plate(int n, double size, double pull, ssModel **mout,
@@ -139,7 +129,7 @@ static int build_plate(int n, double size, double pull, ssModel **mout,
   hd.x_size = hd.y_size = size;
   hd.height = z;
   hd.soil = 1;
-  hd.soilmat = test_soil();
+  hd.soilmat = plate_soil();
   int bed = ss_model_add_hfield(m, &hd, &e);
   free(z);
   ssBodyDef bd = ss_body_def_default();

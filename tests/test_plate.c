@@ -4,6 +4,7 @@
 #include "solver.h"
 #include "ss_math.h"
 #include "tap.h"
+#include "worlds.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -16,19 +17,6 @@ typedef struct {
   int plate, bed;
 } World;
 
-static ssSoilMaterial plate_soil(void)
-{
-  ssSoilMaterial s = ss_soil_material_default();
-  s.bekker_kc = 0;
-  s.bekker_kphi = 1e5;
-  s.sinkage_exponent = 1;
-  s.elastic_stiffness = 2e6;
-  /* overdamped settling (critical ~ 5800 Pa s/m for this plate): the
-   * quasi-static reference of DESIGN 2.7 without overshoot */
-  s.damping = 1e4;
-  return s;
-}
-
 /* a flat bed (size x size, spacing h) and a box plate lx x ly x 0.05 */
 static World make_world(ssSoilMaterial soil, double size, double h, double lx,
                         double ly, double mass, double ox, double oy,
@@ -37,17 +25,7 @@ static World make_world(ssSoilMaterial soil, double size, double h, double lx,
   World w;
   ssError e;
   w.m = ss_model_new();
-  int n = (int)lround(size / h) + 1;
-  double *z = calloc((size_t)n * n, sizeof(double));
-  ssHfieldDef hd = ss_hfield_def_default();
-  hd.name = "bed";
-  hd.nx = hd.ny = n;
-  hd.x_size = hd.y_size = size;
-  hd.height = z;
-  hd.soil = 1;
-  hd.soilmat = soil;
-  w.bed = ss_model_add_hfield(w.m, &hd, &e);
-  free(z);
+  w.bed = add_bed(w.m, size, h, soil);
   ssBodyDef bd = ss_body_def_default();
   bd.name = "plate";
   bd.shape = SS_GEOM_BOX;

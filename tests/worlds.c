@@ -79,7 +79,20 @@ int add_joint(ssUrdf *u, const char *name, int type, int parent,
   return u->njoint++;
 }
 
-int add_soil_bed(ssModel *m, double size, double h)
+ssSoilMaterial plate_soil(void)
+{
+  ssSoilMaterial s = ss_soil_material_default();
+  s.bekker_kc = 0;
+  s.bekker_kphi = 1e5;
+  s.sinkage_exponent = 1;
+  s.elastic_stiffness = 2e6;
+  /* overdamped settling (critical ~ 5800 Pa s/m for the plate): the
+   * quasi-static reference of DESIGN 2.7 without overshoot */
+  s.damping = 1e4;
+  return s;
+}
+
+int add_bed(ssModel *m, double size, double h, ssSoilMaterial soil)
 {
   ssError e;
   int n = (int)lround(size / h) + 1;
@@ -90,14 +103,15 @@ int add_soil_bed(ssModel *m, double size, double h)
   hd.x_size = hd.y_size = size;
   hd.height = z;
   hd.soil = 1;
-  hd.soilmat.bekker_kc = 0;
-  hd.soilmat.bekker_kphi = 1e5;
-  hd.soilmat.sinkage_exponent = 1;
-  hd.soilmat.elastic_stiffness = 2e6;
-  hd.soilmat.damping = 1e4;
+  hd.soilmat = soil;
   int k = ss_model_add_hfield(m, &hd, &e);
   free(z);
   return k;
+}
+
+int add_soil_bed(ssModel *m, double size, double h)
+{
+  return add_bed(m, size, h, plate_soil());
 }
 
 /* a chain of revolute links with joint springs, standing on link `on` */

@@ -18,9 +18,12 @@ void add_box(ssUrdf *u, int link, double x, double y, double z,
              const double pos[3]);
 int add_joint(ssUrdf *u, const char *name, int type, int parent, int child,
               const double pos[3], const double axis[3]);
-/* a flat size x size soil bed at spacing h with the soil of DESIGN 2.7
- * (k_c 0, k_phi 1e5, n 1, K_e 2e6) and D = 1e4 so the plate settles
- * without overshoot */
+/* the soil of DESIGN 2.7 (k_c 0, k_phi 1e5, n 1, K_e 2e6) with D = 1e4 so
+ * the plate settles without overshoot */
+ssSoilMaterial plate_soil(void);
+/* a flat size x size soil bed named "bed" at spacing h: of soil, or of
+ * plate_soil() */
+int add_bed(ssModel *m, double size, double h, ssSoilMaterial soil);
 int add_soil_bed(ssModel *m, double size, double h);
 /* a chain of nlinks sprung revolute joints standing on link `on` */
 int add_mast(ssUrdf *u, int on, int nlinks, double mass, const double at[3]);
