@@ -16,15 +16,14 @@
 #include <string.h>
 
 typedef struct wBuf {
-  ssAtomicFile *f;
-  int bad;
+  ssAtomicFile *f;     /* keeps the first write error; later writes do nothing */
   size_t n;
   char b[1 << 16];
 } wBuf;
 
 static void w_flush(wBuf *w)
 {
-  if (w->n && !w->bad && ss_atomic_write(w->f, w->b, w->n) != 0) w->bad = 1;
+  if (w->n) ss_atomic_write(w->f, w->b, w->n);
   w->n = 0;
 }
 
@@ -33,7 +32,7 @@ static void w_put(wBuf *w, const char *s, size_t n)
   if (n > sizeof w->b - w->n) {
     w_flush(w);
     if (n > sizeof w->b) {
-      if (!w->bad && ss_atomic_write(w->f, s, n) != 0) w->bad = 1;
+      ss_atomic_write(w->f, s, n);
       return;
     }
   }
@@ -482,7 +481,6 @@ ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
     return st;
   }
   w->f = &f;
-  w->bad = 0;
   w->n = 0;
 
   ssCLocale loc;
