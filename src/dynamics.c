@@ -8,6 +8,7 @@
  * by the exact exponential map of omega dt. */
 #include "dynamics.h"
 #include "articulated.h"
+#include "mesh.h"
 #include "ss_math.h"
 
 #include <string.h>
@@ -113,6 +114,29 @@ void ss_dyn_point_velocity(const ssModel *m, const ssData *d, int b,
   ss_v3_sub(r, p, d->body_xipos + 3 * b);
   ss_v3_cross(wr, u + 3, r);
   ss_v3_add(v, u, wr);
+}
+
+double ss_dyn_geom_radius(const ssModel *m, int g)
+{
+  const double *s = m->geom_size + 3 * g;
+  switch (m->geom_type[g]) {
+  case SS_GEOM_BOX: return 0.5 * sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+  case SS_GEOM_SPHERE: return s[0];
+  case SS_GEOM_CYLINDER: return sqrt(s[0] * s[0] + 0.25 * s[1] * s[1]);
+  case SS_GEOM_CAPSULE: return s[0] + 0.5 * s[1];
+  case SS_GEOM_MESH: {
+    int k = m->geom_mesh ? m->geom_mesh[g] : -1;
+    if (k < 0 || k >= m->nmesh || !m->mesh[k]) return 0;
+    const ssMesh *me = m->mesh[k];
+    double r2 = 0;
+    for (int i = 0; i < 3; i++) {
+      double a = fmax(fabs(me->lo[i]), fabs(me->hi[i]));
+      r2 += a * a;
+    }
+    return sqrt(r2);
+  }
+  default: return s[0];
+  }
 }
 
 double ss_dyn_geom_speed(const ssModel *m, const ssData *d, int g,

@@ -17,6 +17,9 @@ void ss_dyn_contact_jacobian(const ssModel *m, ssData *d, int body,
 /* Velocity of a world point on body b. */
 void ss_dyn_point_velocity(const ssModel *m, const ssData *d, int body,
                            const double point[3], double v[3]);
+/* Radius of a sphere about geom g's origin that holds the whole geom (a
+ * mesh: its farthest bounding-box corner). */
+double ss_dyn_geom_radius(const ssModel *m, int g);
 /* A bound on the speed of any point of geom g (radius: its bounding
  * radius about the geom centre). */
 double ss_dyn_geom_speed(const ssModel *m, const ssData *d, int g,

@@ -16,6 +16,7 @@
  * sample of the vertex values per pixel. */
 #include "render.h"
 
+#include "dynamics.h"
 #include "mesh.h"
 #include "png_io.h"
 #include "ss_math.h"
@@ -732,32 +733,6 @@ static int geom_drawn(const ssRenderer *r, const ssModel *m, const ssData *d,
   return 1;
 }
 
-/* Radius of a sphere about the geom's origin that holds the whole geom. */
-static double geom_radius(const ssModel *m, int g)
-{
-  const double *s = m->geom_size + 3 * g;
-  switch (m->geom_type[g]) {
-  case SS_GEOM_BOX: return 0.5 * sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
-  case SS_GEOM_SPHERE: return s[0];
-  case SS_GEOM_CYLINDER: return sqrt(s[0] * s[0] + 0.25 * s[1] * s[1]);
-  case SS_GEOM_MESH: {
-    int k = m->geom_mesh ? m->geom_mesh[g] : -1;
-    if (k < 0 || k >= m->nmesh || !m->mesh[k]) break;
-    const ssMesh *me = m->mesh[k];
-    double rad = 0;
-    for (int c = 0; c < 8; c++) {
-      double q[3] = {(c & 1) ? me->hi[0] : me->lo[0], (c & 2) ? me->hi[1] : me->lo[1],
-                     (c & 4) ? me->hi[2] : me->lo[2]};
-      double n = ss_v3_norm(q);
-      if (n > rad && isfinite(n)) rad = n;
-    }
-    return rad;
-  }
-  default: break;
-  }
-  return s[0] + 0.5 * s[1];
-}
-
 void ss_render_free(ssRenderer *r)
 {
   if (!r) return;
@@ -1004,7 +979,7 @@ static void camera_auto(const ssRenderer *r, const ssModel *m,
     int any = 0;
     for (int g = 0; g < m->ngeom; g++) {
       if (!geom_drawn(r, m, d, g)) continue;
-      double rad = geom_radius(m, g);
+      double rad = ss_dyn_geom_radius(m, g);
       for (int i = 0; i < 3; i++) {
         lo[i] = fmin(lo[i], d->geom_xpos[3 * g + i] - rad);
         hi[i] = fmax(hi[i], d->geom_xpos[3 * g + i] + rad);
@@ -1380,7 +1355,7 @@ static void scene_bounds(const ssRenderer *r, const ssModel *m,
   }
   for (int g = 0; g < m->ngeom; g++) {
     if (!geom_drawn(r, m, d, g)) continue;
-    double rad = geom_radius(m, g);
+    double rad = ss_dyn_geom_radius(m, g);
     for (int i = 0; i < 3; i++) {
       lo[i] = fmin(lo[i], d->geom_xpos[3 * g + i] - rad);
       hi[i] = fmax(hi[i], d->geom_xpos[3 * g + i] + rad);

@@ -106,28 +106,6 @@ static int mesh_depth(const ssModel *m, const ssData *d, int g,
   return 1;
 }
 
-static double geom_radius(const ssModel *m, int g)
-{
-  const double *s = m->geom_size + 3 * g;
-  switch (m->geom_type[g]) {
-  case SS_GEOM_BOX: return 0.5 * sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
-  case SS_GEOM_SPHERE: return s[0];
-  case SS_GEOM_CYLINDER: return sqrt(s[0] * s[0] + 0.25 * s[1] * s[1]);
-  case SS_GEOM_CAPSULE: return s[0] + 0.5 * s[1];
-  case SS_GEOM_MESH: {
-    /* farthest bounding-box corner from the geom's origin */
-    const ssMesh *me = m->mesh[m->geom_mesh[g]];
-    double r2 = 0;
-    for (int k = 0; k < 3; k++) {
-      double a = fmax(fabs(me->lo[k]), fabs(me->hi[k]));
-      r2 += a * a;
-    }
-    return sqrt(r2);
-  }
-  default: return s[0];
-  }
-}
-
 /* How far a collider can travel towards a support in one step plus the
  * configured margin: points closer than this become contacts, so no
  * contact is missed by the implicit end-of-step solve. */
@@ -135,7 +113,7 @@ static double geom_margin(const ssModel *m, const ssData *d, int g, int sys)
 {
   double reach = m->opt.contact_margin;
   if (sys >= 0 && m->sys_nv[sys] > 0)
-    reach += m->opt.timestep * ss_dyn_geom_speed(m, d, g, geom_radius(m, g));
+    reach += m->opt.timestep * ss_dyn_geom_speed(m, d, g, ss_dyn_geom_radius(m, g));
   return reach;
 }
 
