@@ -114,7 +114,7 @@ static int build(const Opt *o, ssModel **mout, ssData **dout, char *why, size_t 
     def.pos[2] = !strcmp(o->body, "multilink") ? 0.12 : 0.025;
     if (!strcmp(o->body, "multilink")) bed = 1.4 * o->bed_scale;
     sys = ss_model_add_articulated(m, u, &def, &e);
-    urdf_free(u);
+    ss_urdf_free(u);
   }
   add_soil_bed(m, bed, h);
   m->opt.terrain_warm_start = o->warm;

@@ -158,7 +158,7 @@ static void test_pendulum(void)
   double scale = 2 * G * 0.5 * (1 - cos(q0));
   ok(emax < 0.02 * scale, "pendulum energy bounded (max drift %.3g of %.3g J)", emax, scale);
   drop(&w);
-  urdf_free(u);
+  ss_urdf_free(u);
 
   /* double pendulum */
   u = urdf_new();
@@ -227,7 +227,7 @@ static void test_pendulum(void)
   }
   ok(drift[1] < 0.2 * drift[0], "chaotic double pendulum: drift falls with the step (%.3g J -> %.3g J)",
      drift[0], drift[1]);
-  urdf_free(u);
+  ss_urdf_free(u);
 }
 
 /* four-bar: ground a = 0.4 (A at origin, D at x = 0.4), crank b = 0.1,
@@ -306,7 +306,7 @@ static void test_fourbar(void)
   ok(m2->nsys == 0 && m2->nbody == 0 && m2->ngeom == 0 && m2->neq == 0 && m2->nq == 0,
      "  and the failed add leaves nothing half-built in the model");
   ss_model_free(m2);
-  urdf_free(u);
+  ss_urdf_free(u);
 }
 
 static void test_pd_and_springs(void)
@@ -339,7 +339,7 @@ static void test_pd_and_springs(void)
   steps(&w, 500);
   close_enough(w.d->qvel[0], 4.0 * 0.5, 1e-9, "effort limit respected: omega = (effort / I) t");
   drop(&w);
-  urdf_free(u);
+  ss_urdf_free(u);
 
   /* a 5 kg slider on a vertical prismatic joint hanging from a coil-over
    * of 2000 N/m: static deflection m g / k */
@@ -370,7 +370,7 @@ static void test_pd_and_springs(void)
   steps(&w, 4000);
   close_enough(w.d->qpos[0], 0.1 - 5 * G / 1000, 1e-6, "joint spring deflection = load / stiffness");
   drop(&w);
-  urdf_free(u);
+  ss_urdf_free(u);
 }
 
 /* a free box as a single body and as a one-link floating articulated
@@ -410,7 +410,7 @@ static void test_free_both_ways(void)
   ss_data_free(d);
   ss_model_free(m);
   drop(&w);
-  urdf_free(u);
+  ss_urdf_free(u);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -449,7 +449,7 @@ static void test_on_soil(void)
                "60-DOF plate carrier settles at the analytic sinkage");
   close_enough(-(w.d->qpos[2] - 0.025), s_ref, 0.01 * s_ref, "  its plate sinks 8.175 mm");
   drop(&w);
-  urdf_free(u);
+  ss_urdf_free(u);
 
   /* 64 DOF: the four-pad body; pads' bottoms on the surface: frame at
    * 0.1 + 0.02 */
@@ -469,7 +469,7 @@ static void test_on_soil(void)
   ok(worst < 0.01 * s_ref, "64-DOF four-pad body: every pad at the analytic sinkage (worst error %.3g mm)",
      worst * 1e3);
   drop(&w);
-  urdf_free(u);
+  ss_urdf_free(u);
 
   /* the carrier with eight joint-coupling relations */
   u = carrier60_pinned();
@@ -480,7 +480,7 @@ static void test_on_soil(void)
   steps(&w, 1500);
   close_enough(-(w.d->qpos[2] - 0.025), s_ref, 0.01 * s_ref, "pinned carrier settles at the analytic sinkage");
   drop(&w);
-  urdf_free(u);
+  ss_urdf_free(u);
 }
 
 /* The packed link groups of the solver: a link's block reconstructs the
@@ -547,7 +547,7 @@ static void test_packed_groups(void)
        "%s: packed and full solver paths agree over 6 sweeps (%d contacts, %.3g relative)",
        name[k], nc, diff);
     drop(&w);
-    urdf_free(u);
+    ss_urdf_free(u);
   }
 }
 
@@ -588,7 +588,7 @@ static void test_distance_equality(void)
   ok(worst < 1e-6 && werr < 1e-6,
      "distance closure as a massless coupler: closure %.3g m, output angle error %.3g rad", worst, werr);
   drop(&w);
-  urdf_free(u);
+  ss_urdf_free(u);
 
   u = urdf_new();
   int base = add_link(u, "base", 1, NULL, 0.01, 0.01, 0.01);
@@ -611,7 +611,7 @@ static void test_distance_equality(void)
   close_enough(w.d->qpos[0], 2 * w.d->qpos[1] + 0.1, 1e-9, "equality closure q1 = 2 q2 + 0.1 holds");
   close_enough(w.d->qvel[0], 3.0, 1e-6, "  the coupled wheel turns at twice the driven speed");
   drop(&w);
-  urdf_free(u);
+  ss_urdf_free(u);
 }
 
 /* a pendulum released horizontally against a joint limit at -0.5 rad
@@ -637,7 +637,7 @@ static void test_limit(void)
   ok(qmin > -0.5 - 1e-3, "the joint limit holds (lowest angle %.6f rad, limit -0.5)", qmin);
   close_enough(w.d->qpos[0], -0.5, 1e-4, "  the pendulum rests on its limit");
   drop(&w);
-  urdf_free(u);
+  ss_urdf_free(u);
 }
 
 /* a link whose collider is a triangle mesh (a 0.4 x 0.6 x 0.05 box made of
@@ -671,7 +671,7 @@ static void test_mesh_on_soil(void)
   close_enough(w.d->stats.soil_contact_area, 0.24, 1e-9, "  its loaded area is the true 0.24 m^2");
   drop(&w);
   (void)plate;
-  urdf_free(u);
+  ss_urdf_free(u);
 }
 
 int main(void)

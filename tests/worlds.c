@@ -23,16 +23,6 @@ ssUrdf *urdf_new(void)
   return u;
 }
 
-void urdf_free(ssUrdf *u)
-{
-  for (int i = 0; i < u->nlink; i++) free(u->link[i].geom);
-  free(u->link);
-  free(u->joint);
-  free(u->closure);
-  free(u->spring);
-  free(u);
-}
-
 /* a link of mass m with its COM at com and principal inertia (ix, iy, iz) */
 int add_link(ssUrdf *u, const char *name, double m, const double com[3],
                     double ix, double iy, double iz)

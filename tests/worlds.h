@@ -9,9 +9,9 @@ extern const double W_X[3], W_Y[3], W_Z[3];
 /* pad centres of fourpad64(), frame coordinates */
 extern const double FOURPAD_CX[4], FOURPAD_CY[4];
 
-/* an in-memory URDF (room for 64 links/joints, 16 closures and springs) */
+/* an in-memory URDF (room for 64 links/joints, 16 closures and springs),
+ * freed with ss_urdf_free */
 ssUrdf *urdf_new(void);
-void urdf_free(ssUrdf *u);
 int add_link(ssUrdf *u, const char *name, double m, const double com[3],
              double ix, double iy, double iz);
 void add_box(ssUrdf *u, int link, double x, double y, double z,
