@@ -289,7 +289,11 @@ static int bench_contact_law(const Opt *o)
     for (int it = 0; it < o->steps; it++) {
       const double *vi = in + 3 * (size_t)it * N;
       for (int i = 0; i < N; i++) {
-        if (!o->warm) c[i].lambda[0] = c[i].lambda[1] = c[i].lambda[2] = 0;
+        if (!o->warm) {
+          /* cold: no first guess and nothing cached from the last visit */
+          c[i].lambda[0] = c[i].lambda[1] = c[i].lambda[2] = 0;
+          memset(&c[i].cache, 0, sizeof c[i].cache);
+        }
         ss_solver_soil_point(&mat, dt, &c[i], vi + 3 * i, tol);
       }
     }

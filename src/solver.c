@@ -595,20 +595,51 @@ static int coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu
   return 0;
 }
 
+static int soil_point(const ssSoilMaterial *mat, ssContact *c, const double v0[3],
+                      double tol, Law *L, Mobil *J);
+
 int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
                          const double v0[3], double tol)
 {
-  const double *G = c->G;
-  double S = c->area * dt;
-  Law L = {S, dt, c->g0, c->sp,
+  ssPointCache *k = &c->cache;
+  Law L = {c->area * dt, dt, c->g0, c->sp,
            (c->width > 0 && mat->bekker_kc != 0 ? mat->bekker_kc / c->width : 0) +
                mat->bekker_kphi,
            mat->sinkage_exponent, mat->sinkage_exponent - 1,
            mat->elastic_stiffness, mat->damping, mat->sinkage_exponent == 1.0, 0, 0};
-  TBlock B;
-  tblock_init(&B, G);
+  if (k->ps > 0 && k->m1 == L.m1) {
+    L.ps = k->ps;
+    L.pv = k->pv;
+  }
   Mobil J;
   mobil_init(&J, c->j, mat->shear_displacement, dt);
+  if (k->ok && k->x0 == J.x0 && k->r == J.r) {
+    J.xa = k->xa;
+    J.ma = k->ma;
+    J.ea = k->ea;
+    J.m0 = k->m0;
+  }
+  int iters = soil_point(mat, c, v0, tol, &L, &J);
+  k->ps = L.ps;
+  k->pv = L.pv;
+  k->m1 = L.m1;
+  k->x0 = J.x0;
+  k->r = J.r;
+  k->xa = J.xa;
+  k->ma = J.ma;
+  k->ea = J.ea;
+  k->m0 = J.m0;
+  k->ok = 1;
+  return iters;
+}
+
+static int soil_point(const ssSoilMaterial *mat, ssContact *c, const double v0[3],
+                      double tol, Law *L, Mobil *J)
+{
+  const double *G = c->G;
+  double S = L->S;
+  TBlock B;
+  tblock_init(&B, G);
   /* the shear bound is tf m(sigma), tf = A dt (c + mu p_n) = A dt c + mu lambda_n */
   double tf0 = S * mat->cohesion, mu = mat->friction_coefficient;
 
@@ -618,7 +649,7 @@ int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
   int have_lt = 0;
   if (coupled && !B.inert) {
     /* cold: a start for the normal impulse with the shear held */
-    if (!(ln > 0)) ln = normal_start(&L, v0[0] + G[1] * lt[0] + G[2] * lt[1], G[0], &iters);
+    if (!(ln > 0)) ln = normal_start(L, v0[0] + G[1] * lt[0] + G[2] * lt[1], G[0], &iters);
     double ct[2] = {v0[1] + G[3] * ln, v0[2] + G[6] * ln};
     double vt0 = ct[0] + B.G[0] * lt[0] + B.G[1] * lt[1];
     double vt1 = ct[1] + B.G[2] * lt[0] + B.G[3] * lt[1];
@@ -626,7 +657,7 @@ int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
     /* cheap stick test first: beyond the bound at the guessed slip speed
      * (>= the bound at zero slip) it surely slips: the coupled Newton */
     if (ln > 0 && sig0 > 0) {
-      double Ts = tf * mobil_at(&J, sig0, &e);
+      double Ts = tf * mobil_at(J, sig0, &e);
       if (!(lt[0] != 0 || lt[1] != 0)) {
         /* no shear to go by: sigma + T(sigma) gamma = |c_t| for an
          * isotropic block of the block's compliance gamma along c_t */
@@ -636,7 +667,7 @@ int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
         if (s1 > 0.5 * sig0) sig0 = s1;
       }
       if (!stick_fits(&B, ct, Ts) &&
-          coupled_slip(&L, &B, &J, tf0, mu, v0, G, tol, ln, sig0, lam, &iters)) {
+          coupled_slip(L, &B, J, tf0, mu, v0, G, tol, ln, sig0, lam, &iters)) {
         memcpy(c->lambda, lam, sizeof lam);
         return iters;
       }
@@ -654,7 +685,7 @@ int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
     double vt0 = ct[0] + B.G[0] * lt[0] + B.G[1] * lt[1];
     double vt1 = ct[1] + B.G[2] * lt[0] + B.G[3] * lt[1];
     sigma = sqrt(vt0 * vt0 + vt1 * vt1);
-    solve_tangent(&B, &J, tf0 + mu * ln, mu, ct, tol, &sigma, &dsig, lt, dl, &iters);
+    solve_tangent(&B, J, tf0 + mu * ln, mu, ct, tol, &sigma, &dsig, lt, dl, &iters);
     have_lt = 1;
   }
   for (int outer = 0; outer < 50; outer++) {
@@ -666,7 +697,7 @@ int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
       geff = G[0];
     }
     double a = v0[0] + G[1] * (lt[0] - dl[0] * ln) + G[2] * (lt[1] - dl[1] * ln);
-    double ln_new = solve_normal(&L, a, geff, ln, tol, &iters, &at_guess);
+    double ln_new = solve_normal(L, a, geff, ln, tol, &iters, &at_guess);
     if (have_lt && (at_guess || ln_new == ln)) break;
     double prev[3] = {ln, lt[0], lt[1]};
     ln = ln_new;
@@ -674,7 +705,7 @@ int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
     if (ln > 0) {
       /* the slip speed moves with lambda_n at the rate the last solve found */
       sigma += dsig * (ln - prev[0]);
-      solve_tangent(&B, &J, tf0 + mu * ln, mu, ct, tol, &sigma, &dsig, lt, dl, &iters);
+      solve_tangent(&B, J, tf0 + mu * ln, mu, ct, tol, &sigma, &dsig, lt, dl, &iters);
     } else {
       lt[0] = lt[1] = dl[0] = dl[1] = 0;
     }

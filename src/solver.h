@@ -26,6 +26,19 @@ typedef enum ssContactType {
   SS_CONTACT_LIMIT     /* joint limit: one unilateral row */
 } ssContactType;
 
+/* The per-point solve's reusable values, kept on the contact between its
+ * visits within one step (the contact is rebuilt, zeroed, every step):
+ * the last power s^(n-1) and the last Janosi mobilisation, from which the
+ * next visit moves by short series instead of calling pow and expm1.  Each
+ * part is used only while what it was made from is unchanged (n - 1; j/K
+ * and dt/K).  Zeroed: nothing cached. */
+typedef struct ssPointCache {
+  double ps, pv, m1;        /* pv = ps^m1; ps = 0: none */
+  double x0, r;             /* j/K and dt/K the rest was made for */
+  double xa, ma, ea, m0;    /* last point x and m, e = 1 - m there; m at x0 */
+  int ok;                   /* x0 .. m0 hold values */
+} ssPointCache;
+
 struct ssContact {
   int type;          /* ssContactType */
   int sys;           /* dynamic system, -1 if the body is static */
@@ -53,6 +66,7 @@ struct ssContact {
   int dof;           /* PD, limit: global velocity index */
   double v[3];       /* contact-frame velocity at the end of the solve */
   int loaded;        /* soil: 1 if the point carries load at the end */
+  ssPointCache cache;/* soil: the point solve's values between visits */
 };
 
 /* A cached traction from the previous step (warm start). */
@@ -77,7 +91,9 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err);
 /* The per-point soil solve (exposed for tests and benchmarks): given the
  * contact's state and the velocity v0 it would have with lambda = 0 from
  * this contact (others held), find lambda.  Returns the number of inner
- * iterations. */
+ * iterations.  c->lambda is the first guess (zero: cold) and c->cache
+ * the values of the last visit (zero: none); a cold start from scratch
+ * zeroes both. */
 int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
                          const double v0[3], double tol);
 
