@@ -888,7 +888,6 @@ static void apply_impulse(const ssModel *m, ssData *d, const ssContact *c,
  * link's spatial velocity; F is the group's spatial impulse not yet in u. */
 typedef struct Group {
   const ssContact *first; /* NULL: no group open */
-  int end;                /* index of the group's last contact */
   const double *Y, *Lam;  /* the link's block */
   double V[6];            /* J_b u with F applied */
   double F[6];
@@ -908,8 +907,7 @@ enum { MIN_GROUP = 2 };
  * 34 -> 28 and plate_arm 72 -> 69 from 64 to 32. */
 enum { PIECE = 32 };
 
-static int group_open(const ssModel *m, ssData *d, Group *g,
-                      const ssContact *c, int end)
+static int group_open(const ssModel *m, ssData *d, Group *g, const ssContact *c)
 {
   ss_art_link_block(m, d, c->link, &g->Y, &g->Lam);
   /* a response block that is not finite (a degenerate link) is left to
@@ -917,7 +915,6 @@ static int group_open(const ssModel *m, ssData *d, Group *g,
   for (int k = 0; k < 36; k++)
     if (!isfinite(g->Lam[k])) return 0;
   g->first = c;
-  g->end = end;
   ss_art_link_velocity(m, d, c->link, g->V);
   memset(g->F, 0, sizeof g->F);
   return 1;
@@ -974,7 +971,7 @@ static const ssWarmEntry *find_warm(const ssData *d, const ssWarmEntry *key,
 static void warm_start(const ssModel *m, ssData *d)
 {
   const double dt = m->opt.timestep;
-  Group g = {NULL, 0, NULL, NULL, {0}, {0}};
+  Group g = {NULL, NULL, NULL, {0}, {0}};
   int cursor = 0;
   for (int i = 0; i < d->ncontact; i++) {
     ssContact *c = d->contact + i;
@@ -1141,7 +1138,7 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   int pack = !d->solver_full;
 
   int sweeps = d->ncontact ? m->opt.solver_max_sweeps : 0;
-  Group g = {NULL, 0, NULL, NULL, {0}, {0}};
+  Group g = {NULL, NULL, NULL, {0}, {0}};
   for (int sweep = 0; sweep < sweeps; sweep++) {
     double dmax = 0, lmax = 0;
     int since = 0, pending = 1;
@@ -1156,7 +1153,7 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
         end = i + (c->run + pieces - 1) / pieces - 1;
       }
       if (end > i) {
-        if (pack) group_open(m, d, &g, c, end);
+        if (pack) group_open(m, d, &g, c);
         /* symmetric Gauss-Seidel within a piece: every other sweep visits
          * it backwards, so a correction travels across the contact patch
          * both ways; the same order packed or not */
