@@ -595,44 +595,8 @@ static int coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu
   return 0;
 }
 
-static int soil_point(const ssSoilMaterial *mat, ssContact *c, const double v0[3],
-                      double tol, Law *L, Mobil *J);
-
-int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
-                         const double v0[3], double tol)
-{
-  ssPointCache *k = &c->cache;
-  Law L = {c->area * dt, dt, c->g0, c->sp,
-           (c->width > 0 && mat->bekker_kc != 0 ? mat->bekker_kc / c->width : 0) +
-               mat->bekker_kphi,
-           mat->sinkage_exponent, mat->sinkage_exponent - 1,
-           mat->elastic_stiffness, mat->damping, mat->sinkage_exponent == 1.0, 0, 0};
-  if (k->ps > 0 && k->m1 == L.m1) {
-    L.ps = k->ps;
-    L.pv = k->pv;
-  }
-  Mobil J;
-  mobil_init(&J, c->j, mat->shear_displacement, dt);
-  if (k->ok && k->x0 == J.x0 && k->r == J.r) {
-    J.xa = k->xa;
-    J.ma = k->ma;
-    J.ea = k->ea;
-    J.m0 = k->m0;
-  }
-  int iters = soil_point(mat, c, v0, tol, &L, &J);
-  k->ps = L.ps;
-  k->pv = L.pv;
-  k->m1 = L.m1;
-  k->x0 = J.x0;
-  k->r = J.r;
-  k->xa = J.xa;
-  k->ma = J.ma;
-  k->ea = J.ea;
-  k->m0 = J.m0;
-  k->ok = 1;
-  return iters;
-}
-
+/* one point's solve (strategy above) with its law and mobilisation set
+ * up, cached values included; ss_solver_soil_point below keeps them */
 static int soil_point(const ssSoilMaterial *mat, ssContact *c, const double v0[3],
                       double tol, Law *L, Mobil *J)
 {
@@ -721,6 +685,41 @@ static int soil_point(const ssSoilMaterial *mat, ssContact *c, const double v0[3
   c->lambda[0] = ln;
   c->lambda[1] = lt[0];
   c->lambda[2] = lt[1];
+  return iters;
+}
+
+int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
+                         const double v0[3], double tol)
+{
+  ssPointCache *k = &c->cache;
+  Law L = {c->area * dt, dt, c->g0, c->sp,
+           (c->width > 0 && mat->bekker_kc != 0 ? mat->bekker_kc / c->width : 0) +
+               mat->bekker_kphi,
+           mat->sinkage_exponent, mat->sinkage_exponent - 1,
+           mat->elastic_stiffness, mat->damping, mat->sinkage_exponent == 1.0, 0, 0};
+  if (k->ps > 0 && k->m1 == L.m1) {
+    L.ps = k->ps;
+    L.pv = k->pv;
+  }
+  Mobil J;
+  mobil_init(&J, c->j, mat->shear_displacement, dt);
+  if (k->ok && k->x0 == J.x0 && k->r == J.r) {
+    J.xa = k->xa;
+    J.ma = k->ma;
+    J.ea = k->ea;
+    J.m0 = k->m0;
+  }
+  int iters = soil_point(mat, c, v0, tol, &L, &J);
+  k->ps = L.ps;
+  k->pv = L.pv;
+  k->m1 = L.m1;
+  k->x0 = J.x0;
+  k->r = J.r;
+  k->xa = J.xa;
+  k->ma = J.ma;
+  k->ea = J.ea;
+  k->m0 = J.m0;
+  k->ok = 1;
   return iters;
 }
 
