@@ -964,10 +964,12 @@ static const ssWarmEntry *find_warm(const ssData *d, const ssWarmEntry *key,
   return e;
 }
 
-/* Initial impulses from last step's tractions, scaled by the current area
- * and time step and projected into the current bounds; joint rows start
- * from last step's impulse rate. */
-static void warm_start(const ssModel *m, ssData *d)
+/* Initial impulses from last step's tractions extrapolated by their rate
+ * (ssWarmEntry), scaled by the current area and time step and projected
+ * into the current bounds; joint rows start from last step's impulse
+ * rate.  converged: the cached tractions are a converged solve's (the
+ * previous step's stats), so this step may form their rate. */
+static void warm_start(const ssModel *m, ssData *d, int converged)
 {
   const double dt = m->opt.timestep;
   Group g = {NULL, NULL, NULL, {0}, {0}};
@@ -977,7 +979,7 @@ static void warm_start(const ssModel *m, ssData *d)
     c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
     if (!m->opt.terrain_warm_start || c->type == SS_CONTACT_RIGID || !d->nwarm)
       continue;
-    ssWarmEntry key = {c->vertex, c->geom, {0, 0, 0}};
+    ssWarmEntry key = {c->vertex, c->geom, {0, 0, 0}, {0, 0, 0}};
     if (c->type != SS_CONTACT_SOIL) row_key(d, c, &key);
     const ssWarmEntry *e = find_warm(d, &key, &cursor);
     if (!e) continue;
@@ -987,9 +989,12 @@ static void warm_start(const ssModel *m, ssData *d)
     } else if (c->type == SS_CONTACT_LIMIT) {
       c->lambda[0] = e->traction[0] > 0 ? e->traction[0] * dt : 0;
     } else {
-      double scale = c->area * dt;
-      double ln = e->traction[0] > 0 ? e->traction[0] * scale : 0;
-      double lt0 = e->traction[1] * scale, lt1 = e->traction[2] * scale;
+      double scale = c->area * dt, t[3];
+      for (int k = 0; k < 3; k++) t[k] = e->traction[k] + e->rate[k];
+      memcpy(c->warm_t, e->traction, sizeof c->warm_t);
+      c->warm_trend = converged;
+      double ln = t[0] > 0 ? t[0] * scale : 0;
+      double lt0 = t[1] * scale, lt1 = t[2] * scale;
       double lim = scale * ss_soil_shear_strength(&m->hfield_soilmat[c->hfield], ln / scale);
       double mag = sqrt(lt0 * lt0 + lt1 * lt1);
       if (mag > lim) {
@@ -1046,15 +1051,18 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
     ssWarmEntry *e = d->warm + n++;
     if (c->type == SS_CONTACT_SOIL) {
       double inv = 1.0 / (c->area * dt);
+      int trend = c->warm_trend && d->stats.converged;
       e->vertex = c->vertex;
       e->geom = c->geom;
-      e->traction[0] = c->lambda[0] * inv;
-      e->traction[1] = c->lambda[1] * inv;
-      e->traction[2] = c->lambda[2] * inv;
+      for (int k = 0; k < 3; k++) {
+        e->traction[k] = c->lambda[k] * inv;
+        e->rate[k] = trend ? e->traction[k] - c->warm_t[k] : 0;
+      }
     } else {
       row_key(d, c, e);
       e->traction[0] = c->lambda[0] / dt;
       e->traction[1] = e->traction[2] = 0;
+      e->rate[0] = e->rate[1] = e->rate[2] = 0;
     }
   }
   /* one collider's entries come in order already: sort only when the
@@ -1115,8 +1123,9 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   ssStepStats *st = &d->stats;
   st->sweeps = 0;
   st->residual = 0;
+  int converged = st->converged; /* the previous step's */
   st->converged = 1;
-  warm_start(m, d);
+  warm_start(m, d, converged);
 
   /* joint rows (PD, limits) are few, stiff and coupled to everything:
    * they are revisited after every piece of a link run (PIECE) and every

@@ -67,13 +67,25 @@ struct ssContact {
   double v[3];       /* contact-frame velocity at the end of the solve */
   int loaded;        /* soil: 1 if the point carries load at the end */
   ssPointCache cache;/* soil: the point solve's values between visits */
+  double warm_t[3];  /* soil: the cached traction its warm start came from */
+  int warm_trend;    /* soil: 1 when warm_t is a converged step's traction,
+                        so that this step's change can be formed */
 };
 
-/* A cached traction from the previous step (warm start). */
+/* A cached traction from the previous step (warm start).  The next step
+ * starts a soil point from traction + rate, the traction extrapolated
+ * linearly over one step, scaled and projected into the current bounds.
+ * The rate is the traction's change over the last step, kept only where
+ * both tractions are converged solutions (the point was matched, and the
+ * steps that made them both converged); otherwise 0.  A change of
+ * unconverged tractions is mostly solver error, and extrapolating it feeds
+ * that error back step after step. */
 struct ssWarmEntry {
-  int vertex;        /* absolute soil vertex */
+  int vertex;        /* absolute soil vertex (joint rows: see row_key) */
   int geom;
-  double traction[3];/* impulse / (area dt), contact frame (Pa) */
+  double traction[3];/* impulse / (area dt), contact frame (Pa); joint
+                        rows: impulse / dt in traction[0] */
+  double rate[3];    /* traction change over the last step (Pa); 0 for rows */
 };
 
 /* Room for one more contact (zeroed, link = -1) with njac doubles of

@@ -399,6 +399,107 @@ static void test_rigid(void)
   }
 }
 
+/* the cache entry with e's key, or NULL */
+static const ssWarmEntry *warm_find(const ssWarmEntry *w, int n, const ssWarmEntry *e)
+{
+  for (int k = 0; k < n; k++)
+    if (w[k].vertex == e->vertex && w[k].geom == e->geom) return w + k;
+  return NULL;
+}
+
+/* entries of d whose rate is not what the rule says (ssWarmEntry): the
+ * traction's change since old[] where both solves converged, else 0;
+ * *moving counts the nonzero rates */
+static int bad_rates(const ssData *d, const ssWarmEntry *old, int nold, int trend,
+                     int *moving)
+{
+  int bad = 0;
+  *moving = 0;
+  for (int k = 0; k < d->nwarm; k++) {
+    const ssWarmEntry *e = d->warm + k, *o = warm_find(old, nold, e);
+    for (int i = 0; i < 3; i++) {
+      double want = trend && o ? e->traction[i] - o->traction[i] : 0;
+      if (memcmp(&e->rate[i], &want, sizeof want)) bad++;
+    }
+    *moving += e->rate[0] != 0;
+  }
+  return bad;
+}
+
+/* The warm start extrapolates each soil point's converged traction by its
+ * change over the last step.  Checked: the rates the cache keeps (none
+ * from or across an unconverged solve), that the next solve starts from
+ * them (fewer sweeps than the same steps with the rates cleared), and that
+ * both reach the same answer. */
+static void test_warm_trend(void)
+{
+  World w = make_world(plate_soil(), 1.2, 0.02, 0.4, 0.6, 20, 0, 0, 0, 0);
+  ssData *d = w.d;
+  ssWarmEntry *old = NULL;
+  int nold = 0, moving, conv[3];
+  if (!run(&w, 12)) goto out;
+  old = malloc((size_t)d->nwarm * sizeof *old);
+  if (!old) goto out;
+  /* two converged steps: rates are the tractions' changes */
+  nold = d->nwarm;
+  memcpy(old, d->warm, (size_t)nold * sizeof *old);
+  conv[0] = d->stats.converged;
+  run(&w, 1);
+  conv[1] = d->stats.converged;
+  int bad = bad_rates(d, old, nold, 1, &moving);
+  ok(conv[0] && conv[1] && bad == 0 && moving > d->nwarm / 2,
+     "sinking plate: each cached rate is the traction's change over the step (%d of %d "
+     "moving, %d wrong)", moving, d->nwarm, bad);
+  /* an unconverged solve keeps no rates, nor does the step after it */
+  int sweeps = w.m->opt.solver_max_sweeps;
+  w.m->opt.solver_max_sweeps = 1;
+  run(&w, 1);
+  conv[0] = d->stats.converged;
+  w.m->opt.solver_max_sweeps = sweeps;
+  bad = bad_rates(d, old, 0, 0, &moving);
+  nold = d->nwarm;
+  old = realloc(old, (size_t)(nold ? nold : 1) * sizeof *old);
+  memcpy(old, d->warm, (size_t)nold * sizeof *old);
+  run(&w, 1);
+  conv[1] = d->stats.converged;
+  bad += bad_rates(d, old, nold, 0, &moving);
+  nold = d->nwarm;
+  memcpy(old, d->warm, (size_t)nold * sizeof *old);
+  run(&w, 1);
+  conv[2] = d->stats.converged;
+  int bad2 = bad_rates(d, old, nold, 1, &moving);
+  ok(!conv[0] && conv[1] && conv[2] && bad == 0 && bad2 == 0 && moving > 0,
+     "after a solve stopped at 1 sweep: no rates for two steps, then rates again");
+
+  /* the rates seed the solve: the same 40 steps with them cleared before
+   * every step need more sweeps and reach the same state.  Bound: an
+   * impulse error of eps = 10 tol m g dt per step moves the plate by at
+   * most sum k eps g dt^2 = N^2/2 10 tol g dt^2 */
+  World u = make_world(plate_soil(), 1.2, 0.02, 0.4, 0.6, 20, 0, 0, 0, 0);
+  World v = make_world(plate_soil(), 1.2, 0.02, 0.4, 0.6, 20, 0, 0, 0, 0);
+  double dt = u.m->opt.timestep, tol = u.m->opt.solver_tolerance;
+  long with = 0, without = 0;
+  if (run(&u, 16) && run(&v, 16)) {
+    for (int k = 0; k < 40; k++) {
+      for (int i = 0; i < v.d->nwarm; i++) memset(v.d->warm[i].rate, 0, sizeof v.d->warm[i].rate);
+      run(&u, 1);
+      run(&v, 1);
+      with += u.d->stats.sweeps;
+      without += v.d->stats.sweeps;
+    }
+  }
+  double dz = fabs(u.d->qpos[2] - v.d->qpos[2]), bound = 0.5 * 40 * 40 * 10 * tol * G * dt * dt;
+  ok(with > 0 && with < without && dz <= bound,
+     "40 steps of the sinking plate: %.2f sweeps per step from the extrapolated tractions, "
+     "%.2f from the last ones; heights %.2g m apart (bound %.2g)", with / 40.0,
+     without / 40.0, dz, bound);
+  free_world(&u);
+  free_world(&v);
+out:
+  free(old);
+  free_world(&w);
+}
+
 int main(void)
 {
   test_analytic_plate();
@@ -407,5 +508,6 @@ int main(void)
   test_impact_and_lift();
   test_drag();
   test_rigid();
+  test_warm_trend();
   return done_testing();
 }
