@@ -92,15 +92,9 @@ static const double inv_k[] = {0, 1, 1.0 / 2, 1.0 / 3, 1.0 / 4, 1.0 / 5, 1.0 / 6
 #define SERIES_MAX (1.0 / 256)
 #define EXP_SERIES_MAX (1.0 / 1024)
 
-/* the law of one point, fixed during its solve, and the cached power */
-typedef struct Law {
-  double S;          /* A dt */
-  double dt, g0, sp; /* step, start separation, rut depth */
-  double k, n, m1;   /* k_c/b + k_phi, exponent, n - 1 */
-  double Ke, D;
-  int linear;        /* n == 1 */
-  double ps, pv;     /* last power: pv = ps^(n-1); ps = 0 none yet */
-} Law;
+/* the law of one point (ssLaw, solver.h): fixed during its solve, with the
+ * cached power */
+typedef ssLaw Law;
 
 /* s^(n-1), from the last value by (1 + u)^(n-1) = sum C(n-1, k) u^k when
  * s = ps (1 + u) is near it: the binomial terms shrink by |u| each, so a few
@@ -293,15 +287,8 @@ static void mul2(const double A[4], const double x[2], double y[2])
   y[0] = y0;
 }
 
-/* The tangential block of one contact, fixed for its whole solve. */
-typedef struct TBlock {
-  double G[4];   /* G_tt */
-  double adj[4]; /* its adjugate: G_tt^-1 = adj / det, no division needed
-                    to compare |G_tt^-1 c| with a bound */
-  double det;
-  double e[2];   /* G_tn = d c_t / d lambda_n */
-  int inert;     /* G_tt = 0: no response (static body) */
-} TBlock;
+/* the tangential block of one contact (ssTBlock, solver.h) */
+typedef ssTBlock TBlock;
 
 static void tblock_init(TBlock *B, const double G[9])
 {
@@ -332,11 +319,7 @@ static inline int stick_fits(const TBlock *B, const double ct[2], double T)
  * m is carried directly (no 1 - exp cancellation at small x) and moved from
  * the last point by expm1(-d) = sum (-d)^k/k!: m' = m - e expm1(-d).
  * r = 0: constant bound (K = 0, or a rigid Coulomb contact). */
-typedef struct Mobil {
-  double r;          /* dt/K, 0 when constant */
-  double x0, m0;     /* j/K and m there (zero slip; m0 < 0 not yet known) */
-  double xa, ea, ma; /* the last point (xa < 0: none) */
-} Mobil;
+typedef ssMobil Mobil;
 
 static void mobil_init(Mobil *J, double j, double K, double dt)
 {
@@ -595,28 +578,26 @@ static int coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu
   return 0;
 }
 
-/* one point's solve (strategy above) with its law and mobilisation set
- * up, cached values included; ss_solver_soil_point below keeps them */
-static int soil_point(const ssSoilMaterial *mat, ssContact *c, const double v0[3],
-                      double tol, Law *L, Mobil *J)
+/* one point's solve (strategy above) with its state set up (point_setup) */
+static int soil_point(ssContact *c, const double v0[3], double tol)
 {
   const double *G = c->G;
-  double S = L->S;
-  TBlock B;
-  tblock_init(&B, G);
+  Law *L = &c->cache.law;
+  Mobil *J = &c->cache.mob;
+  const TBlock *B = &c->cache.tb;
   /* the shear bound is tf m(sigma), tf = A dt (c + mu p_n) = A dt c + mu lambda_n */
-  double tf0 = S * mat->cohesion, mu = mat->friction_coefficient;
+  double tf0 = c->cache.tf0, mu = c->cache.mu;
 
   int iters = 0, at_guess, coupled = G[1] != 0 || G[2] != 0;
   double ln = c->lambda[0], lt[2] = {c->lambda[1], c->lambda[2]}, dl[2] = {0, 0};
   double sigma = 0, dsig = 0;
   int have_lt = 0;
-  if (coupled && !B.inert) {
+  if (coupled && !B->inert) {
     /* cold: a start for the normal impulse with the shear held */
     if (!(ln > 0)) ln = normal_start(L, v0[0] + G[1] * lt[0] + G[2] * lt[1], G[0], &iters);
     double ct[2] = {v0[1] + G[3] * ln, v0[2] + G[6] * ln};
-    double vt0 = ct[0] + B.G[0] * lt[0] + B.G[1] * lt[1];
-    double vt1 = ct[1] + B.G[2] * lt[0] + B.G[3] * lt[1];
+    double vt0 = ct[0] + B->G[0] * lt[0] + B->G[1] * lt[1];
+    double vt1 = ct[1] + B->G[2] * lt[0] + B->G[3] * lt[1];
     double sig0 = sqrt(vt0 * vt0 + vt1 * vt1), tf = tf0 + mu * ln, lam[3], e;
     /* cheap stick test first: beyond the bound at the guessed slip speed
      * (>= the bound at zero slip) it surely slips: the coupled Newton */
@@ -626,12 +607,12 @@ static int soil_point(const ssSoilMaterial *mat, ssContact *c, const double v0[3
         /* no shear to go by: sigma + T(sigma) gamma = |c_t| for an
          * isotropic block of the block's compliance gamma along c_t */
         double Gc[2];
-        mul2(B.G, ct, Gc);
+        mul2(B->G, ct, Gc);
         double s1 = sig0 - Ts * (ct[0] * Gc[0] + ct[1] * Gc[1]) / (sig0 * sig0);
         if (s1 > 0.5 * sig0) sig0 = s1;
       }
-      if (!stick_fits(&B, ct, Ts) &&
-          coupled_slip(L, &B, J, tf0, mu, v0, G, tol, ln, sig0, lam, &iters)) {
+      if (!stick_fits(B, ct, Ts) &&
+          coupled_slip(L, B, J, tf0, mu, v0, G, tol, ln, sig0, lam, &iters)) {
         memcpy(c->lambda, lam, sizeof lam);
         return iters;
       }
@@ -646,10 +627,10 @@ static int soil_point(const ssSoilMaterial *mat, ssContact *c, const double v0[3
     /* warm: the shear at the previous normal impulse, from the slip speed
      * the previous shear impulse gives now */
     double ct[2] = {v0[1] + G[3] * ln, v0[2] + G[6] * ln};
-    double vt0 = ct[0] + B.G[0] * lt[0] + B.G[1] * lt[1];
-    double vt1 = ct[1] + B.G[2] * lt[0] + B.G[3] * lt[1];
+    double vt0 = ct[0] + B->G[0] * lt[0] + B->G[1] * lt[1];
+    double vt1 = ct[1] + B->G[2] * lt[0] + B->G[3] * lt[1];
     sigma = sqrt(vt0 * vt0 + vt1 * vt1);
-    solve_tangent(&B, J, tf0 + mu * ln, mu, ct, tol, &sigma, &dsig, lt, dl, &iters);
+    solve_tangent(B, J, tf0 + mu * ln, mu, ct, tol, &sigma, &dsig, lt, dl, &iters);
     have_lt = 1;
   }
   for (int outer = 0; outer < 50; outer++) {
@@ -669,7 +650,7 @@ static int soil_point(const ssSoilMaterial *mat, ssContact *c, const double v0[3
     if (ln > 0) {
       /* the slip speed moves with lambda_n at the rate the last solve found */
       sigma += dsig * (ln - prev[0]);
-      solve_tangent(&B, J, tf0 + mu * ln, mu, ct, tol, &sigma, &dsig, lt, dl, &iters);
+      solve_tangent(B, J, tf0 + mu * ln, mu, ct, tol, &sigma, &dsig, lt, dl, &iters);
     } else {
       lt[0] = lt[1] = dl[0] = dl[1] = 0;
     }
@@ -688,8 +669,10 @@ static int soil_point(const ssSoilMaterial *mat, ssContact *c, const double v0[3
   return iters;
 }
 
-int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
-                         const double v0[3], double tol)
+/* The point's law from the contact and its material (ssPointCache): the
+ * constants always, the reused power and mobilisation kept while what they
+ * were made from is unchanged. */
+static void point_setup(const ssSoilMaterial *mat, double dt, ssContact *c)
 {
   ssPointCache *k = &c->cache;
   Law L = {c->area * dt, dt, c->g0, c->sp,
@@ -697,30 +680,25 @@ int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
                mat->bekker_kphi,
            mat->sinkage_exponent, mat->sinkage_exponent - 1,
            mat->elastic_stiffness, mat->damping, mat->sinkage_exponent == 1.0, 0, 0};
-  if (k->ps > 0 && k->m1 == L.m1) {
-    L.ps = k->ps;
-    L.pv = k->pv;
+  if (k->law.ps > 0 && k->law.m1 == L.m1) {
+    L.ps = k->law.ps;
+    L.pv = k->law.pv;
   }
+  k->law = L;
   Mobil J;
   mobil_init(&J, c->j, mat->shear_displacement, dt);
-  if (k->ok && k->x0 == J.x0 && k->r == J.r) {
-    J.xa = k->xa;
-    J.ma = k->ma;
-    J.ea = k->ea;
-    J.m0 = k->m0;
-  }
-  int iters = soil_point(mat, c, v0, tol, &L, &J);
-  k->ps = L.ps;
-  k->pv = L.pv;
-  k->m1 = L.m1;
-  k->x0 = J.x0;
-  k->r = J.r;
-  k->xa = J.xa;
-  k->ma = J.ma;
-  k->ea = J.ea;
-  k->m0 = J.m0;
-  k->ok = 1;
-  return iters;
+  if (!(k->ready && k->mob.x0 == J.x0 && k->mob.r == J.r)) k->mob = J;
+  k->ready = 1;
+  tblock_init(&k->tb, c->G);
+  k->tf0 = L.S * mat->cohesion;
+  k->mu = mat->friction_coefficient;
+}
+
+int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
+                         const double v0[3], double tol)
+{
+  point_setup(mat, dt, c);
+  return soil_point(c, v0, tol);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -858,6 +836,23 @@ static void contact_velocity(const ssModel *m, const ssData *d,
     for (int i = 0; i < nv; i++) s += J[k * nv + i] * u[i];
     v[k] = s;
   }
+}
+
+/* A joint row (PD, limit) has one row: J's first row and W's first column
+ * (the other two are zero), so its visit reads and moves only that one. */
+static double row_velocity(const ssData *d, const ssContact *c)
+{
+  const double *J = d->jac + c->jadr, *u = d->qvel + c->vadr;
+  double s = 0;
+  for (int i = 0; i < c->nv; i++) s += J[i] * u[i];
+  return s;
+}
+
+static void row_apply(ssData *d, const ssContact *c, double dl)
+{
+  const double *W = d->jac + c->jadr + 3 * c->nv;
+  double *u = d->qvel + c->vadr;
+  for (int i = 0; i < c->nv; i++) u[i] += W[3 * i] * dl;
 }
 
 /* u += W dl, the full velocity update of one contact */
@@ -1080,17 +1075,18 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
 static void visit(const ssModel *m, ssData *d, ssContact *c, Group *g,
                   double *dmax, double *lmax)
 {
-  const double dt = m->opt.timestep, stol = m->opt.scalar_tolerance;
-  int packed = g->first != NULL;
+  const double stol = m->opt.scalar_tolerance;
+  int packed = g->first != NULL, row = c->type == SS_CONTACT_PD || c->type == SS_CONTACT_LIMIT;
   double v[3] = {0, 0, 0}, v0[3], old[3];
   if (packed) rows_velocity(d->jac + c->jadr, g->V, v);
+  else if (row) v[0] = row_velocity(d, c);
   else if (c->nv) contact_velocity(m, d, c, v);
   memcpy(old, c->lambda, sizeof old);
   ss_m3_mulv(v0, c->G, old);
   ss_v3_sub(v0, v, v0);
   switch (c->type) {
   case SS_CONTACT_SOIL:
-    ss_solver_soil_point(&m->hfield_soilmat[c->hfield], dt, c, v0, stol);
+    soil_point(c, v0, stol);
     break;
   case SS_CONTACT_RIGID: rigid_point(c, v0, stol); break;
   case SS_CONTACT_PD: pd_row(c, v0); break;
@@ -1108,6 +1104,8 @@ static void visit(const ssModel *m, ssData *d, ssContact *c, Group *g,
         g->V[r] += L[0] * w[0] + L[1] * w[1] + L[2] * w[2] + L[3] * w[3] + L[4] * w[4] + L[5] * w[5];
       }
     }
+  } else if (row) {
+    if (dl[0] != 0) row_apply(d, c, dl[0]);
   } else if (c->nv) {
     apply_impulse(m, d, c, dl);
   }
@@ -1126,6 +1124,10 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   int converged = st->converged; /* the previous step's */
   st->converged = 1;
   warm_start(m, d, converged);
+  for (int i = 0; i < d->ncontact; i++) {
+    ssContact *c = d->contact + i;
+    if (c->type == SS_CONTACT_SOIL) point_setup(&m->hfield_soilmat[c->hfield], dt, c);
+  }
 
   /* joint rows (PD, limits) are few, stiff and coupled to everything:
    * they are revisited after every piece of a link run (PIECE) and every
