@@ -688,7 +688,7 @@ void ss_art_link_block(const ssModel *m, ssData *d, int b, const double **Y,
 
 void ss_art_contact_rows(const ssModel *m, ssData *d, int b,
                          const double p[3], const double frame[9],
-                         double X[18], double G[9])
+                         double X[18], double LX[18], double G[9])
 {
   const double *Y, *Lam;
   ss_art_link_block(m, d, b, &Y, &Lam);
@@ -698,7 +698,6 @@ void ss_art_contact_rows(const ssModel *m, ssData *d, int b,
     ss_v3_cross(X + 6 * i, p, f);
     memcpy(X + 6 * i + 3, f, 3 * sizeof(double));
   }
-  double LX[18];
   for (int i = 0; i < 3; i++) m6v(LX + 6 * i, Lam, X + 6 * i);
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++) G[3 * i + j] = dot6(X + 6 * i, LX + 6 * j);

@@ -839,13 +839,13 @@ static void contact_velocity(const ssModel *m, const ssData *d,
 }
 
 /* A joint row (PD, limit) has one row: J's first row and W's first column
- * (the other two are zero), so its visit reads and moves only that one. */
+ * (the other two are zero), so its visit reads and moves only that one;
+ * that row is +-1 at the joint's dof and zero elsewhere
+ * (ss_art_dof_jacobian), so J u is one product. */
 static double row_velocity(const ssData *d, const ssContact *c)
 {
-  const double *J = d->jac + c->jadr, *u = d->qvel + c->vadr;
-  double s = 0;
-  for (int i = 0; i < c->nv; i++) s += J[i] * u[i];
-  return s;
+  int k = c->dof - c->vadr;
+  return d->jac[c->jadr + k] * d->qvel[c->dof];
 }
 
 static void row_apply(ssData *d, const ssContact *c, double dl)
@@ -1096,12 +1096,13 @@ static void visit(const ssModel *m, ssData *d, ssContact *c, Group *g,
   ss_v3_sub(dl, c->lambda, old);
   if (packed) {
     if (dl[0] != 0 || dl[1] != 0 || dl[2] != 0) {
-      double w[6];
-      rows_impulse(d->jac + c->jadr, dl, w);
-      for (int k = 0; k < 6; k++) g->F[k] += w[k];
-      for (int r = 0; r < 6; r++) {
-        const double *L = g->Lam + 6 * r;
-        g->V[r] += L[0] * w[0] + L[1] * w[1] + L[2] * w[2] + L[3] * w[3] + L[4] * w[4] + L[5] * w[5];
+      double w[6], dV[6];
+      const double *X = d->jac + c->jadr;
+      rows_impulse(X, dl, w);
+      rows_impulse(X + 18, dl, dV); /* Lam X^T dl, from LX */
+      for (int k = 0; k < 6; k++) {
+        g->F[k] += w[k];
+        g->V[k] += dV[k];
       }
     }
   } else if (row) {

@@ -8,9 +8,10 @@
  * contact on an articulated link stores only its spatial rows X (3 x 6):
  * its Jacobian is X J_b and its response Y_b X^T, with the link's block
  * Y_b = P M'^-1 J_b^T (nv x 6, loop closures eliminated) and
- * Lam_b = J_b Y_b (6 x 6) computed once per step per link.  A run of
- * consecutive contacts on one link is swept as a packed group: the link's
- * spatial velocity V = J_b u is updated by Lam_b X^T dl after each visit
+ * Lam_b = J_b Y_b (6 x 6) computed once per step per link; beside X it
+ * keeps LX (3 x 6, row i = Lam_b X_i^T).  A run of consecutive
+ * contacts on one link is swept as a packed group: the link's spatial
+ * velocity V = J_b u is updated by Lam_b X^T dl = LX^T dl after each visit
  * (exact block Gauss-Seidel, every other contact held) and the group's
  * accumulated spatial impulse reaches u (Y_b F) once, when the group
  * ends. */
@@ -121,8 +122,8 @@ struct ssWarmEntry {
 };
 
 /* Room for one more contact (zeroed, link = -1) with njac doubles of
- * Jacobian storage in d->jac (6 nv for J and W, 18 for a link contact's
- * X); NULL when out of memory. */
+ * Jacobian storage in d->jac (6 nv for J and W, 36 for a link contact's
+ * X and LX); NULL when out of memory. */
 ssContact *ss_contact_new(ssData *d, long njac);
 
 /* Solve all contacts in d->contact; d->qvel holds the free velocity on entry

@@ -34,7 +34,7 @@ void ss_hfield_frame(const ssData *d, int h, double R[9], double p[3])
 static long contact_jlen(const ssModel *m, int sys)
 {
   if (sys < 0 || m->sys_nv[sys] == 0) return 0;
-  return m->sys_type[sys] == SS_SYS_ARTICULATED ? 18 : 6L * m->sys_nv[sys];
+  return m->sys_type[sys] == SS_SYS_ARTICULATED ? 36 : 6L * m->sys_nv[sys];
 }
 
 /* fill the system-dependent part of a contact: Jacobian, response, G */
@@ -48,7 +48,7 @@ static void attach(const ssModel *m, ssData *d, ssContact *c, int sys)
     double *J = d->jac + c->jadr;
     if (m->sys_type[sys] == SS_SYS_ARTICULATED) {
       c->link = b;
-      ss_art_contact_rows(m, d, b, c->pos, c->frame, J, c->G);
+      ss_art_contact_rows(m, d, b, c->pos, c->frame, J, J + 18, c->G);
     } else {
       ss_dyn_contact_jacobian(m, d, b, c->pos, c->frame, J, J + 3 * c->nv, c->G);
     }
