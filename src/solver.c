@@ -592,6 +592,12 @@ static int soil_point(ssContact *c, const double v0[3], double tol)
   double ln = c->lambda[0], lt[2] = {c->lambda[1], c->lambda[2]}, dl[2] = {0, 0};
   double sigma = 0, dsig = 0;
   int have_lt = 0;
+  /* a point without impulse that does not reach the soil at v0 keeps none:
+   * lambda = 0 meets both laws (no sinkage, no pressure; no normal
+   * impulse, no shear) -- what the general path below returns, at the
+   * cost of one test (the points of a patch's margin, most visits of
+   * which are these) */
+  if (ln == 0 && lt[0] == 0 && lt[1] == 0 && !(-(L->g0 + L->dt * v0[0]) > 0)) return 1;
   if (coupled && !B->inert) {
     /* cold: a start for the normal impulse with the shear held */
     if (!(ln > 0)) ln = normal_start(L, v0[0] + G[1] * lt[0] + G[2] * lt[1], G[0], &iters);
