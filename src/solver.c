@@ -1055,10 +1055,16 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
       int trend = c->warm_trend && d->stats.converged;
       e->vertex = c->vertex;
       e->geom = c->geom;
+      double ch = 0, size = 0;
       for (int k = 0; k < 3; k++) {
         e->traction[k] = c->lambda[k] * inv;
         e->rate[k] = trend ? e->traction[k] - c->warm_t[k] : 0;
+        ch += fabs(e->rate[k]);
+        size += fabs(e->traction[k]);
       }
+      /* a change within the solver's tolerance is not a trend: the
+       * tractions are known to about that (a settled body's drift) */
+      if (ch <= m->opt.solver_tolerance * size) e->rate[0] = e->rate[1] = e->rate[2] = 0;
     } else {
       row_key(d, c, e);
       e->traction[0] = c->lambda[0] / dt;

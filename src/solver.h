@@ -110,9 +110,12 @@ struct ssContact {
  * linearly over one step, scaled and projected into the current bounds.
  * The rate is the traction's change over the last step, kept only where
  * both tractions are converged solutions (the point was matched, and the
- * steps that made them both converged); otherwise 0.  A change of
+ * steps that made them both converged) and the change exceeds the solver
+ * tolerance times the traction (1-norms); otherwise 0.  A change of
  * unconverged tractions is mostly solver error, and extrapolating it feeds
- * that error back step after step. */
+ * that error back step after step; a change within the tolerance (a
+ * settled body's drift) is no trend either, and extrapolating it costs
+ * the point solves an iteration. */
 struct ssWarmEntry {
   int vertex;        /* absolute soil vertex (joint rows: see row_key) */
   int geom;
