@@ -724,8 +724,13 @@ void ss_art_dof_jacobian(const ssModel *m, ssData *d, int s, int dof,
 void ss_art_link_velocity(const ssModel *m, const ssData *d, int b,
                           double V[6])
 {
+  ss_art_link_motion(m, d, b, d->qvel + d->art[m->body_sys[b]]->v0, V);
+}
+
+void ss_art_link_motion(const ssModel *m, const ssData *d, int b,
+                        const double *u, double V[6])
+{
   const ssArtWork *w = d->art[m->body_sys[b]];
-  const double *u = d->qvel + w->v0;
   double sv[6] = {0, 0, 0, 0, 0, 0};
   for (int a = b; a >= 0; a = m->body_parent[a]) {
     int nd = m->body_ndof[a];

@@ -79,6 +79,10 @@ void ss_art_link_block(const ssModel *m, ssData *d, int b, const double **Y,
 /* Spatial velocity J_b u of link b (world, about the origin: omega; v_O). */
 void ss_art_link_velocity(const ssModel *m, const ssData *d, int b,
                           double V[6]);
+/* The same for any velocities u of the link's system (its nv values): the
+ * spatial motion J_b u. */
+void ss_art_link_motion(const ssModel *m, const ssData *d, int b,
+                        const double *u, double V[6]);
 /* Contact rows of a world point on link b: X (3 x 6) maps the link's
  * spatial velocity to the contact-frame velocity of the point (the
  * contact's Jacobian is X J_b, its response Y X^T), LX (3 x 6, row i =

@@ -19,6 +19,7 @@
 #define SS_SOLVER_H
 
 #include "soilsim.h"
+#include "point.h"
 
 typedef enum ssContactType {
   SS_CONTACT_SOIL = 0, /* one soil quadrature point (DESIGN 3.1) */
@@ -26,51 +27,6 @@ typedef enum ssContactType {
   SS_CONTACT_PD,       /* joint PD controller: one bounded implicit row */
   SS_CONTACT_LIMIT     /* joint limit: one unilateral row */
 } ssContactType;
-
-/* A soil point's law (DESIGN 3.1) as its solve uses it (solver.c): set up
- * once per step from the contact and its material, plus the values the
- * solve reuses between visits -- the last power s^(n-1) and the last
- * Janosi mobilisation, from which the next visit moves by short series
- * instead of calling pow and expm1. */
-typedef struct ssLaw {
-  double S;          /* A dt */
-  double dt, g0, sp; /* step, start separation, rut depth */
-  double k, n, m1;   /* k_c/b + k_phi, exponent, n - 1 */
-  double Ke, D;
-  int linear;        /* n == 1 */
-  double ps, pv;     /* last power: pv = ps^(n-1); ps = 0 none yet */
-} ssLaw;
-
-/* Janosi mobilisation m = 1 - exp(-x), x = (j + dt sigma)/K, and e = 1 - m
- * (solver.c: mobil_at) */
-typedef struct ssMobil {
-  double r;          /* dt/K, 0 when constant */
-  double x0, m0;     /* j/K and m there (zero slip; m0 < 0 not yet known) */
-  double xa, ea, ma; /* the last point (xa < 0: none) */
-} ssMobil;
-
-/* The tangential block of one contact, fixed for its whole solve. */
-typedef struct ssTBlock {
-  double G[4];   /* G_tt */
-  double adj[4]; /* its adjugate: G_tt^-1 = adj / det, no division needed
-                    to compare |G_tt^-1 c| with a bound */
-  double det;
-  double e[2];   /* G_tn = d c_t / d lambda_n */
-  int inert;     /* G_tt = 0: no response (static body) */
-} ssTBlock;
-
-/* The point's solve state kept on the contact (the contact is rebuilt,
- * zeroed, every step).  ss_solver_solve sets it up once per step before
- * the sweeps; ss_solver_soil_point sets it up at every call, keeping the
- * reused values only while what they were made from is unchanged (n - 1;
- * j/K and dt/K).  Zeroed: nothing set up or cached. */
-typedef struct ssPointCache {
-  ssLaw law;
-  ssMobil mob;
-  ssTBlock tb;
-  double tf0, mu;           /* shear bound tf = tf0 + mu lambda_n: A dt c, mu */
-  int ready;                /* mob holds values */
-} ssPointCache;
 
 struct ssContact {
   int type;          /* ssContactType */

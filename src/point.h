@@ -1,0 +1,69 @@
+/* point.h -- the law of one contact inside the solver (point.c): the
+ * implicit soil law of one quadrature point (DESIGN 3.1), solved for its
+ * impulse with every other contact held, and the Coulomb cone of a rigid
+ * contact.  The Gauss-Seidel sweeps (solver.c) call these once per visit.
+ *
+ * Internal to the library; the layout of the contact is solver.h's. */
+#ifndef SS_POINT_H
+#define SS_POINT_H
+
+#include "soilsim.h"
+
+/* A soil point's law (DESIGN 3.1) as its solve uses it (solver.c): set up
+ * once per step from the contact and its material, plus the values the
+ * solve reuses between visits -- the last power s^(n-1) and the last
+ * Janosi mobilisation, from which the next visit moves by short series
+ * instead of calling pow and expm1. */
+typedef struct ssLaw {
+  double S;          /* A dt */
+  double dt, g0, sp; /* step, start separation, rut depth */
+  double k, n, m1;   /* k_c/b + k_phi, exponent, n - 1 */
+  double Ke, D;
+  int linear;        /* n == 1 */
+  double ps, pv;     /* last power: pv = ps^(n-1); ps = 0 none yet */
+} ssLaw;
+
+/* Janosi mobilisation m = 1 - exp(-x), x = (j + dt sigma)/K, and e = 1 - m
+ * (solver.c: mobil_at) */
+typedef struct ssMobil {
+  double r;          /* dt/K, 0 when constant */
+  double x0, m0;     /* j/K and m there (zero slip; m0 < 0 not yet known) */
+  double xa, ea, ma; /* the last point (xa < 0: none) */
+} ssMobil;
+
+/* The tangential block of one contact, fixed for its whole solve. */
+typedef struct ssTBlock {
+  double G[4];   /* G_tt */
+  double adj[4]; /* its adjugate: G_tt^-1 = adj / det, no division needed
+                    to compare |G_tt^-1 c| with a bound */
+  double det;
+  double e[2];   /* G_tn = d c_t / d lambda_n */
+  int inert;     /* G_tt = 0: no response (static body) */
+} ssTBlock;
+
+/* The point's solve state kept on the contact (the contact is rebuilt,
+ * zeroed, every step).  ss_solver_solve sets it up once per step before
+ * the sweeps; ss_solver_soil_point sets it up at every call, keeping the
+ * reused values only while what they were made from is unchanged (n - 1;
+ * j/K and dt/K).  Zeroed: nothing set up or cached. */
+typedef struct ssPointCache {
+  ssLaw law;
+  ssMobil mob;
+  ssTBlock tb;
+  double tf0, mu;           /* shear bound tf = tf0 + mu lambda_n: A dt c, mu */
+  int ready;                /* mob holds values */
+} ssPointCache;
+
+/* Set up the law of soil contact c for this step from its material
+ * (c->cache): the constants always, the reused power and mobilisation only
+ * while what they were made from is unchanged. */
+void ss_point_setup(const ssSoilMaterial *mat, double dt, ssContact *c);
+/* New impulse c->lambda of a soil contact set up by ss_point_setup, given
+ * the velocity v0 it would have without its own impulse (others held);
+ * c->lambda is the first guess.  Returns the number of inner iterations. */
+int ss_point_soil(ssContact *c, const double v0[3], double tol);
+/* New impulse c->lambda of a rigid contact: Coulomb cone with the normal
+ * velocity target c->vn_target. */
+void ss_point_rigid(ssContact *c, const double v0[3], double tol);
+
+#endif
