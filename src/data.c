@@ -64,7 +64,9 @@ void ss_data_free(ssData *d)
   free(d->art);
   free(d->hfield_pos); free(d->hfield_quat);
   free(d->soil_sinkage); free(d->soil_plastic); free(d->soil_shear);
-  free(d->contact); free(d->jac); free(d->warm); free(d->soil_loaded);
+  free(d->contact); free(d->jac); free(d->warm); free(d->warm_next);
+  free(d->soil_loaded);
+  ss_newton_work_free(d->newton);
   free(d);
 }
 

@@ -390,6 +390,8 @@ typedef struct ssStepStats {
   double soil_normal_force; /* total normal force of the loaded points (N) */
   int rigid_contacts;       /* rigid (Coulomb) contacts */
   int sweeps;               /* Gauss-Seidel sweeps used */
+  int newton;               /* iterations of the Newton phase that started
+                               the sweeps (0: it declined or did not apply) */
   double residual;          /* final relative impulse change */
   int converged;            /* 1 if the tolerance was met */
   /* wall time of each stage of the last step (s): forward kinematics, free
@@ -443,9 +445,14 @@ typedef struct ssData {
   double *qvel_free;      /* (nv) velocity before contact impulses */
   int nwarm, cap_warm;
   ssWarmEntry *warm;      /* (nwarm) warm-start cache */
+  int cap_warm_next;
+  ssWarmEntry *warm_next; /* the next cache while it is sorted (scratch) */
   int solver_full;        /* 1: every contact updates the full velocity
                              (no packed link groups); the reference path of
                              the tests, equal to the default at round-off */
+  int solver_gs_only;     /* 1: no Newton phase before the sweeps (solver.h);
+                             the reference path of the tests */
+  struct ssNewtonWork *newton; /* the Newton phase's workspace (internal) */
   ssStepStats stats;
 } ssData;
 

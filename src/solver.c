@@ -307,6 +307,39 @@ static int cached(const ssContact *c)
          (c->type == SS_CONTACT_SOIL && c->lambda[0] > 0);
 }
 
+/* the end of the ascending run of cache entries that starts at k */
+static int run_end(const ssWarmEntry *e, int k, int n)
+{
+  k++;
+  while (k < n && cmp_warm(e + k - 1, e + k) < 0) k++;
+  return k;
+}
+
+/* Sort the n cache entries of a by key (cmp_warm), b being as large;
+ * returns whichever of a and b ends holding them.  The contacts come in a
+ * few ascending runs (one per collider and bed, then the joint rows), so
+ * neighbouring runs are merged pairwise until one is left: a few passes,
+ * no general sort. */
+static ssWarmEntry *sort_runs(ssWarmEntry *a, ssWarmEntry *b, int n)
+{
+  if (run_end(a, 0, n) >= n) return a;
+  for (;;) {
+    int runs = 0;
+    for (int k = 0; k < n; runs++) {
+      int mid = run_end(a, k, n), end = mid < n ? run_end(a, mid, n) : n;
+      int i = k, j = mid, o = k;
+      while (i < mid && j < end) b[o++] = cmp_warm(a + i, a + j) <= 0 ? a[i++] : a[j++];
+      while (i < mid) b[o++] = a[i++];
+      while (j < end) b[o++] = a[j++];
+      k = end;
+    }
+    ssWarmEntry *t = a;
+    a = b;
+    b = t;
+    if (runs <= 1) return a;
+  }
+}
+
 /* keep this step's converged tractions (soil) and impulse rates (joint
  * rows) for the next one */
 ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
@@ -320,11 +353,20 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
     d->warm = p;
     d->cap_warm = n;
   }
+  if (n > d->cap_warm_next) {
+    ssWarmEntry *q = realloc(d->warm_next, (size_t)n * sizeof *q);
+    if (!q) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
+    d->warm_next = q;
+    d->cap_warm_next = n;
+  }
+  /* the entries in contact order into warm_next (the old cache is not
+   * needed any more), then sorted into warm */
+  ssWarmEntry *next = d->warm_next;
   n = 0;
   for (int i = 0; i < d->ncontact; i++) {
     const ssContact *c = d->contact + i;
     if (!cached(c)) continue;
-    ssWarmEntry *e = d->warm + n++;
+    ssWarmEntry *e = next + n++;
     if (c->type == SS_CONTACT_SOIL) {
       double inv = 1.0 / (c->area * dt);
       int trend = c->warm_trend && d->stats.converged;
@@ -347,11 +389,14 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
       e->rate[0] = e->rate[1] = e->rate[2] = 0;
     }
   }
-  /* one collider's entries come in order already: sort only when the
-   * list is not (several colliders, joint rows) */
-  int sorted = 1;
-  for (int i = 1; i < n && sorted; i++) sorted = cmp_warm(d->warm + i - 1, d->warm + i) < 0;
-  if (!sorted) qsort(d->warm, (size_t)n, sizeof *d->warm, cmp_warm);
+  if (sort_runs(next, d->warm, n) == next) {
+    /* sorted in warm_next: the buffers change places (and capacities) */
+    int cap = d->cap_warm;
+    d->warm_next = d->warm;
+    d->warm = next;
+    d->cap_warm = d->cap_warm_next;
+    d->cap_warm_next = cap;
+  }
   d->nwarm = n;
   return SS_OK;
 }
@@ -411,6 +456,8 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   st->residual = 0;
   int converged = st->converged; /* the previous step's */
   st->converged = 1;
+  st->newton = 0;
+  if (m->nv) memcpy(d->qvel_free, d->qvel, (size_t)m->nv * sizeof(double));
   warm_start(m, d, converged);
   for (int i = 0; i < d->ncontact; i++) {
     ssContact *c = d->contact + i;
@@ -434,6 +481,13 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
     if (c->link >= 0 && i + 1 < first_row && c[1].link == c->link) c->run += c[1].run;
   }
   int pack = !d->solver_full;
+
+  /* Newton on the contact links' velocities, where it applies, gives the
+   * sweeps a start that is (nearly) their answer */
+  if (!d->solver_gs_only) {
+    int its;
+    if (ss_newton_solve(m, d, first_row, &its)) st->newton = its;
+  }
 
   int sweeps = d->ncontact ? m->opt.solver_max_sweeps : 0;
   Group g = {NULL, NULL, NULL, {0}, {0}};

@@ -92,6 +92,20 @@ ssContact *ss_contact_new(ssData *d, long njac);
 ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err);
 ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err);
 
+/* The Newton phase (newton.c): when every contact is a soil point on an
+ * articulated link or a PD row and every loaded point slips, solve the
+ * step's contacts by Newton's method on the contact links' spatial
+ * velocities and the rows' velocities.  On entry d->qvel_free holds the
+ * free velocity, the contacts their first impulses and d->qvel the matching
+ * velocity; contacts [first_row, ncontact) are the joint rows.  Returns 1
+ * when the contacts hold the converged impulses and d->qvel their
+ * velocity, 0 when it declined (everything as on entry); *iterations: the
+ * Newton iterations spent either way.  The sweeps that follow judge
+ * convergence as always. */
+typedef struct ssNewtonWork ssNewtonWork;
+int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations);
+void ss_newton_work_free(ssNewtonWork *w);
+
 /* The per-point soil solve (exposed for tests and benchmarks): given the
  * contact's state and the velocity v0 it would have with lambda = 0 from
  * this contact (others held), find lambda.  Returns the number of inner

@@ -206,7 +206,9 @@ double solver_paths_difference(ssModel *m, ssData *d, int sweeps, int *ncontact)
   /* exactly `sweeps` sweeps on both paths: no early stop at round-off */
   m->opt.solver_max_sweeps = sweeps;
   m->opt.solver_tolerance = 1e-300;
-  int nv = m->nv, full = d->solver_full;
+  int nv = m->nv, full = d->solver_full, gs = d->solver_gs_only;
+  /* the sweeps alone: the Newton phase would move their start */
+  d->solver_gs_only = 1;
   double *u = malloc((size_t)(nv ? nv : 1) * sizeof(double));
   if (!u || ss_checkpoint_save_buffer(m, d, &buf, &len, &e) != SS_OK) goto out;
   d->solver_full = 0;
@@ -224,6 +226,7 @@ double solver_paths_difference(ssModel *m, ssData *d, int sweeps, int *ncontact)
   worst = un > 0 ? du / un : du;
 out:
   d->solver_full = full;
+  d->solver_gs_only = gs;
   m->opt.solver_max_sweeps = keep_sweeps;
   m->opt.solver_tolerance = keep_tol;
   free(buf);

@@ -1,0 +1,720 @@
+/* newton.c -- the Newton phase of the contact solve (solver.h).
+ *
+ * Gauss-Seidel converges slowly on a slipping wheel patch: the tangential
+ * impulses of its points settle by a factor of about 0.65 a sweep, so a
+ * tolerance of 1e-9 takes 20 to 30 sweeps.  Yet everything the contacts of
+ * one link do to the system passes through the link's spatial velocity V_b
+ * (6 numbers): the point velocities are v_i = X_i V_b, and the impulses act
+ * on the system only through their spatial sum F_b = sum X_i^T lambda_i.
+ * When every point of a patch slips, the law of DESIGN 3.1 written at the
+ * end-of-step velocity is an explicit, piecewise smooth function
+ * lambda_i(v_i):
+ *
+ *   delta = -(g0 + dt v_n),  lambda_n = A dt (min(K_e delta, k s^n) + D max(-v_n, 0))
+ *   lambda_t = -A dt tau_max(p_n, j + dt |v_t|) v_t / |v_t|
+ *
+ * so the whole step reduces to an equation in the contact links' spatial
+ * velocities and the joint rows' velocities y = (V_b ..., v_r ...):
+ *
+ *   Phi(y) = y - y_free - Lam F(y) = 0,    Lam = [J_b Y_c] (loop closures
+ *                                          eliminated), F = (F_b ..., lambda_r ...)
+ *
+ * of size 6 per link plus one per row (27 for the buggy), which Newton's
+ * method solves with the Jacobian I - Lam H, H = blockdiag(sum X_i^T K_i X_i),
+ * K_i = d lambda_i / d v_i -- the six-component reduction of the contact
+ * group.  A backtracking line search on |Phi|^2 (weighted by 1/Lam_kk)
+ * guards each step.
+ *
+ * The phase is an accelerator, not a second solver: it only moves the
+ * sweeps' starting point.  Gauss-Seidel sweeps follow it and decide
+ * convergence with the same test as always (solver.c), so the answer meets
+ * the same tolerance whatever happened here.  The phase declines (and
+ * leaves impulses and velocities as it found them) when a contact is not a
+ * soil point on an articulated link or a PD row, when a loaded point does
+ * not clearly slip (sticking: the velocity form is set-valued there; the
+ * sweeps handle it), or when Newton does not converge fast. */
+#include "solver.h"
+#include "articulated.h"
+#include "ss_math.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A loaded point whose slip stiffness T/|v_t| exceeds this many times its
+ * own tangential response 1/G_tt is sticking, or so nearly that the
+ * velocity form is too stiff for Newton: the phase declines. */
+#define STICK_RATIO 1e3
+#define MAX_ITER 8
+
+/* A soil point as the Newton phase sees it: its law's constants for this
+ * step, its place in its group's frame, and the last values of its two
+ * transcendental functions, from which the next evaluation moves by a
+ * short series (the iterates of one step stay close together). */
+typedef struct NPoint {
+  double r[3];        /* position from the group's origin o, group frame
+                         (rows n, t1, t2) */
+  double g0, sp, S;   /* start separation, rut depth, A dt */
+  double k, tf0;      /* k_c/b + k_phi; A dt c */
+  double x0, gtt;     /* j/K_j; largest diagonal entry of G_tt */
+  double ps, pv;      /* last s and s^(n-1) (ps = 0: none) */
+  double xa, ma, ea;  /* last x = x0 + sigma dt/K_j, 1 - exp(-x), exp(-x)
+                         (xa < 0: none) */
+} NPoint;
+
+/* A group: the soil points of one link on one bed, in that bed's frame */
+typedef struct NGroup {
+  int link;
+  const ssSoilMaterial *mat;
+  double R[9];        /* contact frame rows n, t1, t2 (world) */
+  double o[3];        /* origin of the points' r (world) */
+} NGroup;
+
+/* One evaluation's sums over a group's points, in its frame about o */
+typedef struct NSum {
+  double V[6];        /* the group's velocity (omega'; v_o') */
+  double F[6];        /* sum (r x lambda; lambda) */
+  double K[6];        /* sum of K's entries nn, 1n, 2n, 11, 12, 22 */
+  double vw[9], wv[9], ww[9]; /* sums of K (-[r]x), [r]x K, [r]x K (-[r]x) */
+} NSum;
+
+struct ssNewtonWork {
+  int cap_n, cap_c, cap_v, cap_g;
+  int *group_of;      /* (ncontact) group of each soil contact */
+  double *lam_save;   /* (ncontact x 3) impulses on entry */
+  double *u_save;     /* (nv) velocities on entry */
+  double *Lam;        /* (n x n) J Y over the groups' links and the rows */
+  double *A;          /* (n x n) Newton matrix I - Lam H, then its LU */
+  int *piv;           /* (n) */
+  double *y, *yfree, *phi, *dy, *F;           /* (n) */
+  double *ytry, *Ftry, *phitry;               /* (n) line-search trial */
+  double *H, *Htry;   /* (ngroup x 36 + nrow) d F / d y, block diagonal */
+  double *col;        /* (nv) one gathered response column */
+  NPoint *pt;         /* (ncontact) the soil points' constants and caches */
+  NGroup *grp;        /* (ngroup) */
+  NSum *sum;          /* (ngroup) one evaluation's sums */
+};
+
+void ss_newton_work_free(ssNewtonWork *w)
+{
+  if (!w) return;
+  free(w->group_of); free(w->lam_save); free(w->u_save);
+  free(w->Lam); free(w->A); free(w->piv); free(w->y); free(w->yfree);
+  free(w->phi); free(w->dy); free(w->F); free(w->ytry); free(w->Ftry);
+  free(w->phitry); free(w->H); free(w->Htry); free(w->col); free(w->pt);
+  free(w->grp); free(w->sum);
+  free(w);
+}
+
+static int grow(void *pp, size_t count, size_t size)
+{
+  void **p = pp, *q = realloc(*p, (count ? count : 1) * size);
+  if (!q) return 0;
+  *p = q;
+  return 1;
+}
+
+/* room for n unknowns, nc contacts, nv velocities and ng groups */
+static ssNewtonWork *work(ssData *d, int n, int nc, int nv, int ng)
+{
+  ssNewtonWork *w = d->newton;
+  if (!w && !(w = d->newton = calloc(1, sizeof *w))) return NULL;
+  if (nc > w->cap_c) {
+    if (!grow(&w->group_of, (size_t)nc, sizeof(int)) ||
+        !grow(&w->pt, (size_t)nc, sizeof(NPoint)) ||
+        !grow(&w->lam_save, 3 * (size_t)nc, sizeof(double)))
+      return NULL;
+    w->cap_c = nc;
+  }
+  if (nv > w->cap_v) {
+    if (!grow(&w->u_save, (size_t)nv, sizeof(double)) ||
+        !grow(&w->col, (size_t)nv, sizeof(double)))
+      return NULL;
+    w->cap_v = nv;
+  }
+  if (ng > w->cap_g) {
+    if (!grow(&w->grp, (size_t)ng, sizeof(NGroup)) ||
+        !grow(&w->sum, (size_t)ng, sizeof(NSum)))
+      return NULL;
+    w->cap_g = ng;
+  }
+  if (n > w->cap_n) {
+    double **vec[] = {&w->y, &w->yfree, &w->phi, &w->dy, &w->F,
+                      &w->ytry, &w->Ftry, &w->phitry};
+    for (size_t k = 0; k < sizeof vec / sizeof *vec; k++)
+      if (!grow(vec[k], (size_t)n, sizeof(double))) return NULL;
+    /* H needs at most 36 per group (6 unknowns): 6 n */
+    if (!grow(&w->H, 6 * (size_t)n, sizeof(double)) ||
+        !grow(&w->Htry, 6 * (size_t)n, sizeof(double)) ||
+        !grow(&w->Lam, (size_t)n * n, sizeof(double)) ||
+        !grow(&w->A, (size_t)n * n, sizeof(double)) ||
+        !grow(&w->piv, (size_t)n, sizeof(int)))
+      return NULL;
+    w->cap_n = n;
+  }
+  return w;
+}
+
+/* ---------------------------------------------------------------------- */
+/* the law in velocity form                                                */
+
+/* (1 + u)^a - 1 and expm1(-d) for |u| <= 1/256, |d| <= 1/1024: seven and
+ * six terms leave a remainder below 1e-17 of the leading 1 */
+#define POW_SERIES_MAX (1.0 / 256)
+#define EXP_SERIES_MAX (1.0 / 1024)
+
+static inline double binom_m1(double a, double u)
+{
+  double t = a * u, sum = t;
+  t *= (a - 1) * u * 0.5;         sum += t;
+  t *= (a - 2) * u * (1.0 / 3);   sum += t;
+  t *= (a - 3) * u * 0.25;        sum += t;
+  t *= (a - 4) * u * 0.2;         sum += t;
+  t *= (a - 5) * u * (1.0 / 6);   sum += t;
+  t *= (a - 6) * u * (1.0 / 7);   sum += t;
+  return sum;
+}
+
+static inline double expm1_neg(double d)
+{
+  /* expm1(-d) = -d (1 - d/2 (1 - d/3 (1 - d/4 (1 - d/5 (1 - d/6))))) */
+  return -d * (1 - d * 0.5 * (1 - d * (1.0 / 3) * (1 - d * 0.25 * (1 - d * 0.2 * (1 - d * (1.0 / 6))))));
+}
+
+/* s^(n-1) of point P, moved from its last value when near */
+static inline double pow_point(NPoint *P, double s, double m1)
+{
+  double u = P->ps > 0 ? (s - P->ps) / P->ps : INFINITY, v;
+  if (fabs(u) <= POW_SERIES_MAX && fabs(m1) <= 3) v = P->pv + P->pv * binom_m1(m1, u);
+  else v = pow(s, m1);
+  P->ps = s;
+  P->pv = v;
+  return v;
+}
+
+/* Janosi mobilisation 1 - exp(-x) of point P and exp(-x) in *e */
+static inline double mobil_point(NPoint *P, double x, double *e)
+{
+  double d = x - P->xa;
+  if (d != 0) {
+    if (P->xa >= 0 && fabs(d) <= EXP_SERIES_MAX) {
+      double em1 = expm1_neg(d);
+      P->ma -= P->ea * em1;
+      P->ea += P->ea * em1;
+    } else {
+      P->ma = -expm1(-x);
+      P->ea = exp(-x);
+    }
+    P->xa = x;
+  }
+  *e = P->ea;
+  return P->ma;
+}
+
+/* ---------------------------------------------------------------------- */
+/* Phi and its Jacobian                                                    */
+
+/* the unknowns: 6 per group (its link's spatial velocity), then one per
+ * joint row (its velocity); contacts [0, first_row) are the soil points,
+ * [first_row, ncontact) the rows */
+typedef struct Setup {
+  int ngroup, nrow, n, first_row;
+} Setup;
+
+/* y_b (omega; v_O, world, about the origin) in a group's frame about its
+ * origin: omega' = R omega, v' = R (v_O + omega x o) */
+static void to_group(const NGroup *G, const double V[6], double Vg[6])
+{
+  double vo[3];
+  ss_v3_cross(vo, V, G->o);
+  ss_v3_add(vo, vo, V + 3);
+  ss_m3_mulv(Vg, G->R, V);
+  ss_m3_mulv(Vg + 3, G->R, vo);
+}
+
+/* the group's impulse and its derivative back to world, about the origin:
+ * with y' = T y, T = [[R, 0], [-R [o]x, R]], F = T^T F' and H = T^T H' T */
+static void from_group(const NGroup *G, const double Fg[6], const double Hg[36],
+                       double F[6], double H[36])
+{
+  double T[36] = {0}, ox[9] = {0, -G->o[2], G->o[1], G->o[2], 0, -G->o[0],
+                               -G->o[1], G->o[0], 0}, Rox[9];
+  ss_m3_mul(Rox, G->R, ox);
+  for (int a = 0; a < 3; a++)
+    for (int b = 0; b < 3; b++) {
+      T[6 * a + b] = G->R[3 * a + b];
+      T[6 * (a + 3) + b + 3] = G->R[3 * a + b];
+      T[6 * (a + 3) + b] = -Rox[3 * a + b];
+    }
+  for (int a = 0; a < 6; a++) {
+    double t = 0;
+    for (int k = 0; k < 6; k++) t += T[6 * k + a] * Fg[k];
+    F[a] = t;
+  }
+  double HT[36];
+  for (int a = 0; a < 6; a++)
+    for (int b = 0; b < 6; b++) {
+      double t = 0;
+      for (int k = 0; k < 6; k++) t += Hg[6 * a + k] * T[6 * k + b];
+      HT[6 * a + b] = t;
+    }
+  for (int a = 0; a < 6; a++)
+    for (int b = 0; b < 6; b++) {
+      double t = 0;
+      for (int k = 0; k < 6; k++) t += T[6 * k + a] * HT[6 * k + b];
+      H[6 * a + b] = t;
+    }
+}
+
+/* F(y) and H(y) = dF/dy over all contacts, each contact's impulse written
+ * to it.  H: a 6 x 6 block per group, then one value per row.  Returns 1
+ * if a loaded point sticks (or so nearly that T / |v_t| exceeds
+ * STICK_RATIO times its own tangential response 1/G_tt): the velocity
+ * form is set-valued there. */
+static int evaluate(const ssModel *m, ssData *d, const Setup *s,
+                    const ssNewtonWork *w, const double *y, double *F, double *H)
+{
+  const double dt = m->opt.timestep;
+  memset(F, 0, (size_t)s->n * sizeof(double));
+  /* each group's velocity in its frame about o; its sums in the same
+   * frame: F' = (sum r x lambda; sum lambda), H' = sum J^T K J with the
+   * point's J = [-[r]x, I] */
+  for (int g = 0; g < s->ngroup; g++) {
+    NSum *A = w->sum + g;
+    memset(A, 0, sizeof *A);
+    to_group(w->grp + g, y + 6 * g, A->V);
+  }
+  int gprev = -1;
+  const ssSoilMaterial *mat = NULL;
+  double n = 1, m1 = 0, Ke = 0, D = 0, mu = 0, rj = 0;
+  int linear = 1;
+  for (int i = 0; i < s->first_row; i++) {
+    ssContact *c = d->contact + i;
+    NPoint *P = w->pt + i;
+    int g = w->group_of[i];
+    NSum *A = w->sum + g;
+    if (g != gprev) {
+      gprev = g;
+      mat = w->grp[g].mat;
+      n = mat->sinkage_exponent;
+      m1 = n - 1;
+      linear = n == 1.0;
+      Ke = mat->elastic_stiffness;
+      D = mat->damping;
+      mu = mat->friction_coefficient;
+      rj = mat->shear_displacement > 0 ? dt / mat->shear_displacement : 0;
+    }
+    const double *r = P->r, *V = A->V;
+    /* v = v_o + omega x r */
+    double vn = V[3] + V[1] * r[2] - V[2] * r[1];
+    double delta = -(P->g0 + dt * vn);
+    if (!(delta > 0)) {
+      c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
+      continue;
+    }
+    double v1 = V[4] + V[2] * r[0] - V[0] * r[2];
+    double v2 = V[5] + V[0] * r[1] - V[1] * r[0];
+    double sk = P->sp + delta, sn1 = linear ? 1.0 : pow_point(P, sk, m1);
+    double pe = Ke * delta, py = P->k * sk * sn1, p, slope;
+    if (pe <= py) {
+      p = pe;
+      slope = Ke;
+    } else {
+      p = py;
+      slope = P->k * n * sn1;
+    }
+    double dpdv = -dt * slope;
+    if (vn < 0) {
+      p -= D * vn;
+      dpdv -= D;
+    }
+    double ln = P->S * p, dln = P->S * dpdv;
+    /* shear: the bound T = tf m(sigma) opposes the slip */
+    double sigma = sqrt(v1 * v1 + v2 * v2), tf = P->tf0 + mu * ln, mob = 1, dmob = 0;
+    if (rj > 0) {
+      double e;
+      mob = mobil_point(P, P->x0 + rj * sigma, &e);
+      dmob = e * rj;
+    }
+    double T = tf * mob, l1 = 0, l2 = 0, k11 = 0, k12 = 0, k22 = 0, k1n = 0, k2n = 0;
+    if (T > 0) {
+      if (!(sigma > 0) || T * P->gtt > STICK_RATIO * sigma) return 1;
+      double t1 = v1 / sigma, t2 = v2 / sigma, a = T / sigma, b = tf * dmob;
+      l1 = -T * t1;
+      l2 = -T * t2;
+      /* d lambda_t / d v_t = -(T/sigma)(I - t t^T) - tf m' t t^T, and
+       * d lambda_t / d v_n through tf = A dt c + mu lambda_n */
+      k11 = -a * (1 - t1 * t1) - b * t1 * t1;
+      k12 = (a - b) * t1 * t2;
+      k22 = -a * (1 - t2 * t2) - b * t2 * t2;
+      double tn = mu * mob * dln;
+      k1n = -t1 * tn;
+      k2n = -t2 * tn;
+    }
+    c->lambda[0] = ln;
+    c->lambda[1] = l1;
+    c->lambda[2] = l2;
+    A->F[0] += r[1] * l2 - r[2] * l1;
+    A->F[1] += r[2] * ln - r[0] * l2;
+    A->F[2] += r[0] * l1 - r[1] * ln;
+    A->F[3] += ln;
+    A->F[4] += l1;
+    A->F[5] += l2;
+    /* K = [[dln, 0, 0], [k1n, k11, k12], [k2n, k12, k22]] and the blocks
+     * of J^T K J written out: K (-[r]x), [r]x K and [r]x K (-[r]x) */
+    const double r0 = r[0], r1 = r[1], r2 = r[2];
+    A->K[0] += dln;
+    A->K[1] += k1n;
+    A->K[2] += k2n;
+    A->K[3] += k11;
+    A->K[4] += k12;
+    A->K[5] += k22;
+    /* K (-[r]x), row by row */
+    double q01 = dln * r2, q02 = -dln * r1;
+    double q10 = k12 * r1 - k11 * r2, q11 = k1n * r2 - k12 * r0, q12 = k11 * r0 - k1n * r1;
+    double q20 = k22 * r1 - k12 * r2, q21 = k2n * r2 - k22 * r0, q22 = k12 * r0 - k2n * r1;
+    A->vw[1] += q01;
+    A->vw[2] += q02;
+    A->vw[3] += q10;
+    A->vw[4] += q11;
+    A->vw[5] += q12;
+    A->vw[6] += q20;
+    A->vw[7] += q21;
+    A->vw[8] += q22;
+    /* [r]x K */
+    A->wv[0] += r1 * k2n - r2 * k1n;
+    A->wv[1] += r1 * k12 - r2 * k11;
+    A->wv[2] += r1 * k22 - r2 * k12;
+    A->wv[3] += r2 * dln - r0 * k2n;
+    A->wv[4] -= r0 * k12;
+    A->wv[5] -= r0 * k22;
+    A->wv[6] += r0 * k1n - r1 * dln;
+    A->wv[7] += r0 * k11;
+    A->wv[8] += r0 * k12;
+    /* [r]x (K (-[r]x)): row a of [r]x times the columns of q */
+    A->ww[0] += r1 * q20 - r2 * q10;
+    A->ww[1] += r1 * q21 - r2 * q11;
+    A->ww[2] += r1 * q22 - r2 * q12;
+    A->ww[3] += -r0 * q20;
+    A->ww[4] += r2 * q01 - r0 * q21;
+    A->ww[5] += r2 * q02 - r0 * q22;
+    A->ww[6] += r0 * q10;
+    A->ww[7] += r0 * q11 - r1 * q01;
+    A->ww[8] += r0 * q12 - r1 * q02;
+  }
+  for (int g = 0; g < s->ngroup; g++) {
+    const NSum *A = w->sum + g;
+    double Hg[36];
+    double Kv[9] = {A->K[0], 0, 0, A->K[1], A->K[3], A->K[4], A->K[2], A->K[4], A->K[5]};
+    for (int a = 0; a < 3; a++)
+      for (int b = 0; b < 3; b++) {
+        Hg[6 * a + b] = A->ww[3 * a + b];
+        Hg[6 * a + 3 + b] = A->wv[3 * a + b];
+        Hg[6 * (a + 3) + b] = A->vw[3 * a + b];
+        Hg[6 * (a + 3) + 3 + b] = Kv[3 * a + b];
+      }
+    from_group(w->grp + g, A->F, Hg, F + 6 * g, H + 36 * g);
+  }
+  /* PD rows: lambda = clamp(a - b v, -bound, bound) */
+  for (int r = 0; r < s->nrow; r++) {
+    ssContact *c = d->contact + s->first_row + r;
+    int k = 6 * s->ngroup + r;
+    double l = c->row_a - c->row_b * y[k], h = -c->row_b;
+    if (l > c->row_bound) {
+      l = c->row_bound;
+      h = 0;
+    } else if (l < -c->row_bound) {
+      l = -c->row_bound;
+      h = 0;
+    }
+    c->lambda[0] = l;
+    F[k] = l;
+    H[36 * s->ngroup + r] = h;
+  }
+  return 0;
+}
+
+/* phi = y - yfree - Lam F.  Returns |phi|^2 and sets *size to |Lam F|^2,
+ * both weighted by 1/Lam_kk (an energy-like norm in which linear and
+ * angular velocities and the rows compare fairly). */
+static double residual(const Setup *s, const ssNewtonWork *w, const double *y,
+                       const double *F, double *phi, double *size)
+{
+  int n = s->n;
+  double sum = 0, big = 0;
+  for (int a = 0; a < n; a++) {
+    const double *L = w->Lam + (size_t)a * n;
+    double t = 0;
+    for (int b = 0; b < n; b++) t += L[b] * F[b];
+    phi[a] = y[a] - w->yfree[a] - t;
+    double inv = L[a] > 0 ? 1 / L[a] : 1;
+    sum += phi[a] * phi[a] * inv;
+    big += t * t * inv;
+  }
+  *size = big;
+  return sum;
+}
+
+/* A = I - Lam H */
+static void newton_matrix(const Setup *s, ssNewtonWork *w, const double *H)
+{
+  int n = s->n;
+  for (int a = 0; a < n; a++) {
+    const double *L = w->Lam + (size_t)a * n;
+    double *Ar = w->A + (size_t)a * n;
+    for (int g = 0; g < s->ngroup; g++) {
+      const double *Hg = H + 36 * g, *Lg = L + 6 * g;
+      for (int j = 0; j < 6; j++)
+        Ar[6 * g + j] = -(Lg[0] * Hg[j] + Lg[1] * Hg[6 + j] + Lg[2] * Hg[12 + j] +
+                          Lg[3] * Hg[18 + j] + Lg[4] * Hg[24 + j] + Lg[5] * Hg[30 + j]);
+    }
+    for (int r = 0; r < s->nrow; r++) {
+      int k = 6 * s->ngroup + r;
+      Ar[k] = -L[k] * H[36 * s->ngroup + r];
+    }
+    Ar[a] += 1;
+  }
+}
+
+/* LU with partial pivoting of the n x n matrix A, in place; 0 if singular */
+static int lu_factor(double *A, int *piv, int n)
+{
+  for (int k = 0; k < n; k++) {
+    int p = k;
+    double best = fabs(A[k * n + k]);
+    for (int i = k + 1; i < n; i++)
+      if (fabs(A[i * n + k]) > best) {
+        best = fabs(A[i * n + k]);
+        p = i;
+      }
+    if (!(best > 0)) return 0;
+    piv[k] = p;
+    if (p != k)
+      for (int j = 0; j < n; j++) {
+        double t = A[k * n + j];
+        A[k * n + j] = A[p * n + j];
+        A[p * n + j] = t;
+      }
+    double inv = 1 / A[k * n + k];
+    for (int i = k + 1; i < n; i++) {
+      double f = A[i * n + k] * inv;
+      A[i * n + k] = f;
+      if (f != 0)
+        for (int j = k + 1; j < n; j++) A[i * n + j] -= f * A[k * n + j];
+    }
+  }
+  return 1;
+}
+
+static void lu_solve(const double *A, const int *piv, int n, double *x)
+{
+  /* the factor's rows were swapped whole, multipliers included: all the
+   * swaps first, then the substitutions */
+  for (int k = 0; k < n; k++)
+    if (piv[k] != k) {
+      double t = x[k];
+      x[k] = x[piv[k]];
+      x[piv[k]] = t;
+    }
+  for (int k = 0; k < n; k++)
+    for (int i = k + 1; i < n; i++) x[i] -= A[i * n + k] * x[k];
+  for (int k = n - 1; k >= 0; k--) {
+    double t = x[k];
+    for (int j = k + 1; j < n; j++) t -= A[k * n + j] * x[j];
+    x[k] = t / A[k * n + k];
+  }
+}
+
+/* ---------------------------------------------------------------------- */
+/* set-up                                                                  */
+
+/* Lam = J Y over the unknowns: column block of each group (the six columns
+ * of its link's Y_b) and each row (its W column), read by every unknown of
+ * the same system through its J */
+static void lam_matrix(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork *w)
+{
+  int n = s->n;
+  memset(w->Lam, 0, (size_t)n * n * sizeof(double));
+  for (int gc = 0; gc < s->ngroup + s->nrow; gc++) {
+    const double *Y;
+    int sys, vadr, nv, ncol, col0, stride;
+    if (gc < s->ngroup) {
+      const double *Lb;
+      int link = w->grp[gc].link;
+      ss_art_link_block(m, d, link, &Y, &Lb);
+      sys = m->body_sys[link];
+      vadr = m->sys_vadr[sys];
+      nv = m->sys_nv[sys];
+      ncol = 6;
+      col0 = 6 * gc;
+      stride = 6;
+    } else {
+      const ssContact *c = d->contact + s->first_row + (gc - s->ngroup);
+      Y = d->jac + c->jadr + 3 * c->nv;
+      sys = c->sys;
+      vadr = c->vadr;
+      nv = c->nv;
+      ncol = 1;
+      col0 = 6 * s->ngroup + (gc - s->ngroup);
+      stride = 3;
+    }
+    for (int k = 0; k < ncol; k++) {
+      for (int i = 0; i < nv; i++) w->col[i] = Y[stride * i + k];
+      for (int gr = 0; gr < s->ngroup; gr++) {
+        int link = w->grp[gr].link;
+        if (m->body_sys[link] != sys) continue;
+        double V[6];
+        ss_art_link_motion(m, d, link, w->col, V);
+        for (int a = 0; a < 6; a++) w->Lam[(size_t)(6 * gr + a) * n + col0 + k] = V[a];
+      }
+      for (int r = 0; r < s->nrow; r++) {
+        const ssContact *c = d->contact + s->first_row + r;
+        if (c->sys != sys) continue;
+        int dof = c->dof - vadr;
+        w->Lam[(size_t)(6 * s->ngroup + r) * n + col0 + k] = d->jac[c->jadr + dof] * w->col[dof];
+      }
+    }
+  }
+}
+
+/* the unknowns' values for system velocities u (all of qvel's layout) */
+static void unknowns_of(const ssModel *m, const ssData *d, const Setup *s,
+                        const ssNewtonWork *w, const double *u, double *y)
+{
+  for (int g = 0; g < s->ngroup; g++) {
+    int link = w->grp[g].link, sys = m->body_sys[link];
+    ss_art_link_motion(m, d, link, u + m->sys_vadr[sys], y + 6 * g);
+  }
+  for (int r = 0; r < s->nrow; r++) {
+    const ssContact *c = d->contact + s->first_row + r;
+    y[6 * s->ngroup + r] = d->jac[c->jadr + (c->dof - c->vadr)] * u[c->dof];
+  }
+}
+
+int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations)
+{
+  *iterations = 0;
+  if (first_row == 0) return 0;
+  /* suited: soil points on articulated links, PD rows */
+  int ngroup = 0, nrow = d->ncontact - first_row;
+  for (int i = 0; i < d->ncontact; i++) {
+    const ssContact *c = d->contact + i;
+    if (i < first_row ? !(c->type == SS_CONTACT_SOIL && c->link >= 0 && c->nv > 0)
+                      : !(c->type == SS_CONTACT_PD && c->nv > 0))
+      return 0;
+    /* runs of one link on one bed: at least as many as the groups */
+    if (i < first_row && (i == 0 || c[-1].link != c->link || c[-1].hfield != c->hfield)) ngroup++;
+  }
+  int n = 6 * ngroup + nrow;
+  ssNewtonWork *w = work(d, n, d->ncontact, m->nv, ngroup);
+  if (!w) return 0;
+  /* groups: one per link and bed (a link's contacts may come in several
+   * runs); every point of a bed shares the bed's frame */
+  ngroup = 0;
+  for (int i = 0; i < first_row; i++) {
+    const ssContact *c = d->contact + i;
+    int g = 0;
+    while (g < ngroup && !(w->grp[g].link == c->link &&
+                           w->grp[g].mat == &m->hfield_soilmat[c->hfield]))
+      g++;
+    NGroup *G = w->grp + g;
+    if (g == ngroup) {
+      ngroup++;
+      G->link = c->link;
+      G->mat = &m->hfield_soilmat[c->hfield];
+      memcpy(G->R, c->frame, sizeof G->R);
+      memcpy(G->o, c->pos, sizeof G->o);
+    } else if (memcmp(G->R, c->frame, sizeof G->R)) {
+      return 0;
+    }
+    w->group_of[i] = g;
+    /* the point's constants, its caches empty */
+    NPoint *P = w->pt + i;
+    const ssSoilMaterial *mat = G->mat;
+    double rel[3];
+    ss_v3_sub(rel, c->pos, G->o);
+    ss_m3_mulv(P->r, G->R, rel);
+    P->g0 = c->g0;
+    P->sp = c->sp;
+    P->S = c->area * m->opt.timestep;
+    P->k = (c->width > 0 && mat->bekker_kc != 0 ? mat->bekker_kc / c->width : 0) + mat->bekker_kphi;
+    P->tf0 = P->S * mat->cohesion;
+    P->x0 = mat->shear_displacement > 0 ? c->j / mat->shear_displacement : 0;
+    P->gtt = fmax(c->G[4], c->G[8]);
+    P->ps = 0;
+    P->xa = -1;
+  }
+  n = 6 * ngroup + nrow;
+  Setup s = {ngroup, nrow, n, first_row};
+
+  lam_matrix(m, d, &s, w);
+  unknowns_of(m, d, &s, w, d->qvel_free, w->yfree);
+  unknowns_of(m, d, &s, w, d->qvel, w->y);
+  for (int i = 0; i < d->ncontact; i++)
+    memcpy(w->lam_save + 3 * i, d->contact[i].lambda, 3 * sizeof(double));
+  memcpy(w->u_save, d->qvel, (size_t)m->nv * sizeof(double));
+
+  /* Newton with backtracking on |phi|^2, until |phi| is the solver's
+   * tolerance of the contacts' effect |Lam F| (both weighted, see
+   * residual): the sweeps after it then have (nearly) nothing left to do */
+  const double tol2 = m->opt.solver_tolerance * m->opt.solver_tolerance;
+  int it = 0;
+  double size, size_try;
+  if (evaluate(m, d, &s, w, w->y, w->F, w->H)) goto decline;
+  double f = residual(&s, w, w->y, w->F, w->phi, &size);
+  while (f > tol2 * size) {
+    if (it == MAX_ITER) goto decline;
+    it++;
+    newton_matrix(&s, w, w->H);
+    if (!lu_factor(w->A, w->piv, n)) goto decline;
+    for (int a = 0; a < n; a++) w->dy[a] = -w->phi[a];
+    lu_solve(w->A, w->piv, n, w->dy);
+    double alpha = 1, ftry = f;
+    int ok = 0;
+    for (int ls = 0; ls < 8 && !ok; ls++, alpha *= 0.5) {
+      for (int a = 0; a < n; a++) w->ytry[a] = w->y[a] + alpha * w->dy[a];
+      if (evaluate(m, d, &s, w, w->ytry, w->Ftry, w->Htry)) goto decline;
+      ftry = residual(&s, w, w->ytry, w->Ftry, w->phitry, &size_try);
+      ok = ftry <= (1 - 1e-4 * alpha) * f;
+    }
+    /* no descent: a kink Newton cannot cross, or round-off */
+    if (!ok) goto decline;
+    double *t;
+    t = w->y; w->y = w->ytry; w->ytry = t;
+    t = w->F; w->F = w->Ftry; w->Ftry = t;
+    t = w->H; w->H = w->Htry; w->Htry = t;
+    t = w->phi; w->phi = w->phitry; w->phitry = t;
+    f = ftry;
+    size = size_try;
+  }
+  *iterations = it;
+
+  /* the contacts hold the impulses of the last evaluation, at y; the
+   * velocities they give: u = u_free + sum Y_b F_b + sum W_r lambda_r */
+  memcpy(d->qvel, d->qvel_free, (size_t)m->nv * sizeof(double));
+  for (int g = 0; g < ngroup; g++) {
+    const double *Y, *Lb, *Fg = w->F + 6 * g;
+    int link = w->grp[g].link, sys = m->body_sys[link];
+    ss_art_link_block(m, d, link, &Y, &Lb);
+    double *u = d->qvel + m->sys_vadr[sys];
+    for (int k = 0; k < m->sys_nv[sys]; k++) {
+      const double *yk = Y + 6 * k;
+      u[k] += yk[0] * Fg[0] + yk[1] * Fg[1] + yk[2] * Fg[2] + yk[3] * Fg[3] + yk[4] * Fg[4] +
+              yk[5] * Fg[5];
+    }
+  }
+  for (int r = 0; r < nrow; r++) {
+    const ssContact *c = d->contact + first_row + r;
+    const double *W = d->jac + c->jadr + 3 * c->nv;
+    double *u = d->qvel + c->vadr;
+    for (int k = 0; k < c->nv; k++) u[k] += W[3 * k] * c->lambda[0];
+  }
+  return 1;
+
+decline:
+  for (int i = 0; i < d->ncontact; i++)
+    memcpy(d->contact[i].lambda, w->lam_save + 3 * i, 3 * sizeof(double));
+  memcpy(d->qvel, w->u_save, (size_t)m->nv * sizeof(double));
+  *iterations = it;
+  return 0;
+}
