@@ -81,8 +81,8 @@ typedef struct NSum {
 struct ssNewtonWork {
   int cap_n, cap_c, cap_v, cap_g;
   int *group_of;      /* (ncontact) group of each soil contact */
-  double *lam_save;   /* (ncontact x 3) impulses on entry */
-  double *u_save;     /* (nv) velocities on entry */
+  double *lam, *lamtry; /* (ncontact x 3) the soil points' impulses at y,
+                         at the trial point */
   double *Lam;        /* (n x n) J Y over the groups' links and the rows */
   double *A;          /* (n x n) Newton matrix I - Lam H, then its LU */
   int *piv;           /* (n) */
@@ -98,7 +98,7 @@ struct ssNewtonWork {
 void ss_newton_work_free(ssNewtonWork *w)
 {
   if (!w) return;
-  free(w->group_of); free(w->lam_save); free(w->u_save);
+  free(w->group_of); free(w->lam); free(w->lamtry);
   free(w->Lam); free(w->A); free(w->piv); free(w->y); free(w->yfree);
   free(w->phi); free(w->dy); free(w->F); free(w->ytry); free(w->Ftry);
   free(w->phitry); free(w->H); free(w->Htry); free(w->col); free(w->pt);
@@ -122,14 +122,13 @@ static ssNewtonWork *work(ssData *d, int n, int nc, int nv, int ng)
   if (nc > w->cap_c) {
     if (!grow(&w->group_of, (size_t)nc, sizeof(int)) ||
         !grow(&w->pt, (size_t)nc, sizeof(NPoint)) ||
-        !grow(&w->lam_save, 3 * (size_t)nc, sizeof(double)))
+        !grow(&w->lam, 3 * (size_t)nc, sizeof(double)) ||
+        !grow(&w->lamtry, 3 * (size_t)nc, sizeof(double)))
       return NULL;
     w->cap_c = nc;
   }
   if (nv > w->cap_v) {
-    if (!grow(&w->u_save, (size_t)nv, sizeof(double)) ||
-        !grow(&w->col, (size_t)nv, sizeof(double)))
-      return NULL;
+    if (!grow(&w->col, (size_t)nv, sizeof(double))) return NULL;
     w->cap_v = nv;
   }
   if (ng > w->cap_g) {
@@ -266,13 +265,89 @@ static void from_group(const NGroup *G, const double Fg[6], const double Hg[36],
     }
 }
 
-/* F(y) and H(y) = dF/dy over all contacts, each contact's impulse written
- * to it.  H: a 6 x 6 block per group, then one value per row.  Returns 1
- * if a loaded point sticks (or so nearly that T / |v_t| exceeds
- * STICK_RATIO times its own tangential response 1/G_tt): the velocity
- * form is set-valued there. */
-static int evaluate(const ssModel *m, ssData *d, const Setup *s,
-                    const ssNewtonWork *w, const double *y, double *F, double *H)
+/* a bed material's constants as the law uses them */
+typedef struct Mat {
+  double dt, n, m1, Ke, D, mu, rj; /* rj = dt / K_j, 0 when K_j = 0 */
+  int linear;
+} Mat;
+
+static Mat mat_of(const ssSoilMaterial *mat, double dt)
+{
+  Mat M = {dt, mat->sinkage_exponent, mat->sinkage_exponent - 1,
+           mat->elastic_stiffness, mat->damping, mat->friction_coefficient,
+           mat->shear_displacement > 0 ? dt / mat->shear_displacement : 0,
+           mat->sinkage_exponent == 1.0};
+  return M;
+}
+
+enum { UNLOADED = 0, LOADED = 1, STICKS = 2 };
+
+/* The law of point P at its group's velocity V (frame about o): impulse
+ * lam, and with K non-NULL the entries of K = d lambda / d v, (nn, 1n, 2n,
+ * 11, 12, 22) (K_n1 = K_n2 = 0: the normal law does not see the slip).
+ * Returns UNLOADED (lam = 0), LOADED, or STICKS when the point sticks or so
+ * nearly that T / |v_t| exceeds STICK_RATIO times its own tangential
+ * response 1/G_tt: the velocity form is set-valued there. */
+static inline int point_law(const Mat *M, NPoint *P, const double V[6],
+                            double lam[3], double *K)
+{
+  const double *r = P->r;
+  /* v = v_o + omega x r */
+  double vn = V[3] + V[1] * r[2] - V[2] * r[1];
+  double delta = -(P->g0 + M->dt * vn);
+  if (!(delta > 0)) {
+    lam[0] = lam[1] = lam[2] = 0;
+    return UNLOADED;
+  }
+  double v1 = V[4] + V[2] * r[0] - V[0] * r[2];
+  double v2 = V[5] + V[0] * r[1] - V[1] * r[0];
+  double sk = P->sp + delta, sn1 = M->linear ? 1.0 : pow_point(P, sk, M->m1);
+  double pe = M->Ke * delta, py = P->k * sk * sn1, p, slope;
+  if (pe <= py) {
+    p = pe;
+    slope = M->Ke;
+  } else {
+    p = py;
+    slope = P->k * M->n * sn1;
+  }
+  double dpdv = -M->dt * slope;
+  if (vn < 0) {
+    p -= M->D * vn;
+    dpdv -= M->D;
+  }
+  double ln = P->S * p;
+  /* shear: the bound T = tf m(sigma) opposes the slip */
+  double sigma = sqrt(v1 * v1 + v2 * v2), tf = P->tf0 + M->mu * ln, mob = 1, e = 0;
+  if (M->rj > 0) mob = mobil_point(P, P->x0 + M->rj * sigma, &e);
+  double T = tf * mob;
+  lam[0] = ln;
+  lam[1] = lam[2] = 0;
+  if (K) K[1] = K[2] = K[3] = K[4] = K[5] = 0;
+  if (K) K[0] = P->S * dpdv;
+  if (!(T > 0)) return LOADED;
+  if (!(sigma > 0) || T * P->gtt > STICK_RATIO * sigma) return STICKS;
+  double t1 = v1 / sigma, t2 = v2 / sigma;
+  lam[1] = -T * t1;
+  lam[2] = -T * t2;
+  if (K) {
+    /* d lambda_t / d v_t = -(T/sigma)(I - t t^T) - tf m' t t^T, and
+     * d lambda_t / d v_n through tf = A dt c + mu lambda_n */
+    double a = T / sigma, b = tf * e * M->rj, tn = M->mu * mob * K[0];
+    K[1] = -t1 * tn;
+    K[2] = -t2 * tn;
+    K[3] = -a * (1 - t1 * t1) - b * t1 * t1;
+    K[4] = (a - b) * t1 * t2;
+    K[5] = -a * (1 - t2 * t2) - b * t2 * t2;
+  }
+  return LOADED;
+}
+
+/* F(y) and H(y) = dF/dy over all contacts, the soil points' impulses in
+ * lam (3 each; the rows' are their entries of F).  H: a 6 x 6 block per
+ * group, then one value per row.  Returns 1 if a loaded point sticks. */
+static int evaluate(const ssModel *m, const ssData *d, const Setup *s,
+                    const ssNewtonWork *w, const double *y, double *F, double *H,
+                    double *lam_out)
 {
   const double dt = m->opt.timestep;
   memset(F, 0, (size_t)s->n * sizeof(double));
@@ -285,92 +360,33 @@ static int evaluate(const ssModel *m, ssData *d, const Setup *s,
     to_group(w->grp + g, y + 6 * g, A->V);
   }
   int gprev = -1;
-  const ssSoilMaterial *mat = NULL;
-  double n = 1, m1 = 0, Ke = 0, D = 0, mu = 0, rj = 0;
-  int linear = 1;
+  Mat M = {0};
   for (int i = 0; i < s->first_row; i++) {
-    ssContact *c = d->contact + i;
     NPoint *P = w->pt + i;
     int g = w->group_of[i];
     NSum *A = w->sum + g;
     if (g != gprev) {
       gprev = g;
-      mat = w->grp[g].mat;
-      n = mat->sinkage_exponent;
-      m1 = n - 1;
-      linear = n == 1.0;
-      Ke = mat->elastic_stiffness;
-      D = mat->damping;
-      mu = mat->friction_coefficient;
-      rj = mat->shear_displacement > 0 ? dt / mat->shear_displacement : 0;
+      M = mat_of(w->grp[g].mat, dt);
     }
-    const double *r = P->r, *V = A->V;
-    /* v = v_o + omega x r */
-    double vn = V[3] + V[1] * r[2] - V[2] * r[1];
-    double delta = -(P->g0 + dt * vn);
-    if (!(delta > 0)) {
-      c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
-      continue;
-    }
-    double v1 = V[4] + V[2] * r[0] - V[0] * r[2];
-    double v2 = V[5] + V[0] * r[1] - V[1] * r[0];
-    double sk = P->sp + delta, sn1 = linear ? 1.0 : pow_point(P, sk, m1);
-    double pe = Ke * delta, py = P->k * sk * sn1, p, slope;
-    if (pe <= py) {
-      p = pe;
-      slope = Ke;
-    } else {
-      p = py;
-      slope = P->k * n * sn1;
-    }
-    double dpdv = -dt * slope;
-    if (vn < 0) {
-      p -= D * vn;
-      dpdv -= D;
-    }
-    double ln = P->S * p, dln = P->S * dpdv;
-    /* shear: the bound T = tf m(sigma) opposes the slip */
-    double sigma = sqrt(v1 * v1 + v2 * v2), tf = P->tf0 + mu * ln, mob = 1, dmob = 0;
-    if (rj > 0) {
-      double e;
-      mob = mobil_point(P, P->x0 + rj * sigma, &e);
-      dmob = e * rj;
-    }
-    double T = tf * mob, l1 = 0, l2 = 0, k11 = 0, k12 = 0, k22 = 0, k1n = 0, k2n = 0;
-    if (T > 0) {
-      if (!(sigma > 0) || T * P->gtt > STICK_RATIO * sigma) return 1;
-      double t1 = v1 / sigma, t2 = v2 / sigma, a = T / sigma, b = tf * dmob;
-      l1 = -T * t1;
-      l2 = -T * t2;
-      /* d lambda_t / d v_t = -(T/sigma)(I - t t^T) - tf m' t t^T, and
-       * d lambda_t / d v_n through tf = A dt c + mu lambda_n */
-      k11 = -a * (1 - t1 * t1) - b * t1 * t1;
-      k12 = (a - b) * t1 * t2;
-      k22 = -a * (1 - t2 * t2) - b * t2 * t2;
-      double tn = mu * mob * dln;
-      k1n = -t1 * tn;
-      k2n = -t2 * tn;
-    }
-    c->lambda[0] = ln;
-    c->lambda[1] = l1;
-    c->lambda[2] = l2;
-    A->F[0] += r[1] * l2 - r[2] * l1;
-    A->F[1] += r[2] * ln - r[0] * l2;
-    A->F[2] += r[0] * l1 - r[1] * ln;
+    double *lam = lam_out + 3 * i, K[6];
+    int st = point_law(&M, P, A->V, lam, K);
+    if (st == UNLOADED) continue;
+    if (st == STICKS) return 1;
+    const double r0 = P->r[0], r1 = P->r[1], r2 = P->r[2];
+    const double ln = lam[0], l1 = lam[1], l2 = lam[2];
+    A->F[0] += r1 * l2 - r2 * l1;
+    A->F[1] += r2 * ln - r0 * l2;
+    A->F[2] += r0 * l1 - r1 * ln;
     A->F[3] += ln;
     A->F[4] += l1;
     A->F[5] += l2;
-    /* K = [[dln, 0, 0], [k1n, k11, k12], [k2n, k12, k22]] and the blocks
-     * of J^T K J written out: K (-[r]x), [r]x K and [r]x K (-[r]x) */
-    const double r0 = r[0], r1 = r[1], r2 = r[2];
-    A->K[0] += dln;
-    A->K[1] += k1n;
-    A->K[2] += k2n;
-    A->K[3] += k11;
-    A->K[4] += k12;
-    A->K[5] += k22;
+    /* K = [[kn, 0, 0], [k1n, k11, k12], [k2n, k12, k22]] and the blocks of
+     * J^T K J written out: K (-[r]x), [r]x K and [r]x K (-[r]x) */
+    const double kn = K[0], k1n = K[1], k2n = K[2], k11 = K[3], k12 = K[4], k22 = K[5];
+    for (int k = 0; k < 6; k++) A->K[k] += K[k];
     /* K (-[r]x), row by row */
-    double q01 = dln * r2, q02 = -dln * r1;
+    double q01 = kn * r2, q02 = -kn * r1;
     double q10 = k12 * r1 - k11 * r2, q11 = k1n * r2 - k12 * r0, q12 = k11 * r0 - k1n * r1;
     double q20 = k22 * r1 - k12 * r2, q21 = k2n * r2 - k22 * r0, q22 = k12 * r0 - k2n * r1;
     A->vw[1] += q01;
@@ -385,17 +401,17 @@ static int evaluate(const ssModel *m, ssData *d, const Setup *s,
     A->wv[0] += r1 * k2n - r2 * k1n;
     A->wv[1] += r1 * k12 - r2 * k11;
     A->wv[2] += r1 * k22 - r2 * k12;
-    A->wv[3] += r2 * dln - r0 * k2n;
+    A->wv[3] += r2 * kn - r0 * k2n;
     A->wv[4] -= r0 * k12;
     A->wv[5] -= r0 * k22;
-    A->wv[6] += r0 * k1n - r1 * dln;
+    A->wv[6] += r0 * k1n - r1 * kn;
     A->wv[7] += r0 * k11;
     A->wv[8] += r0 * k12;
-    /* [r]x (K (-[r]x)): row a of [r]x times the columns of q */
+    /* [r]x (K (-[r]x)): the rows of [r]x times the columns of q */
     A->ww[0] += r1 * q20 - r2 * q10;
     A->ww[1] += r1 * q21 - r2 * q11;
     A->ww[2] += r1 * q22 - r2 * q12;
-    A->ww[3] += -r0 * q20;
+    A->ww[3] -= r0 * q20;
     A->ww[4] += r2 * q01 - r0 * q21;
     A->ww[5] += r2 * q02 - r0 * q22;
     A->ww[6] += r0 * q10;
@@ -417,7 +433,7 @@ static int evaluate(const ssModel *m, ssData *d, const Setup *s,
   }
   /* PD rows: lambda = clamp(a - b v, -bound, bound) */
   for (int r = 0; r < s->nrow; r++) {
-    ssContact *c = d->contact + s->first_row + r;
+    const ssContact *c = d->contact + s->first_row + r;
     int k = 6 * s->ngroup + r;
     double l = c->row_a - c->row_b * y[k], h = -c->row_b;
     if (l > c->row_bound) {
@@ -427,11 +443,52 @@ static int evaluate(const ssModel *m, ssData *d, const Setup *s,
       l = -c->row_bound;
       h = 0;
     }
-    c->lambda[0] = l;
     F[k] = l;
     H[36 * s->ngroup + r] = h;
   }
   return 0;
+}
+
+/* The check of a converged Newton solve, an exact residual: with the
+ * velocities u the contacts' impulses give, each contact's law at its
+ * velocity against the impulse it holds.  Returns max |law - lambda|_1
+ * over max |lambda|_1 (the sweeps' measure), or INFINITY if a loaded point
+ * sticks there. */
+static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonWork *w)
+{
+  const double dt = m->opt.timestep;
+  for (int g = 0; g < s->ngroup; g++) {
+    double V[6];
+    ss_art_link_velocity(m, d, w->grp[g].link, V);
+    to_group(w->grp + g, V, w->sum[g].V);
+  }
+  double dmax = 0, lmax = 0;
+  int gprev = -1;
+  Mat M = {0};
+  for (int i = 0; i < s->first_row; i++) {
+    const ssContact *c = d->contact + i;
+    int g = w->group_of[i];
+    if (g != gprev) {
+      gprev = g;
+      M = mat_of(w->grp[g].mat, dt);
+    }
+    double lam[3];
+    if (point_law(&M, w->pt + i, w->sum[g].V, lam, NULL) == STICKS) return INFINITY;
+    double dn = fabs(lam[0] - c->lambda[0]) + fabs(lam[1] - c->lambda[1]) + fabs(lam[2] - c->lambda[2]);
+    double ln = fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]);
+    dmax = fmax(dmax, dn);
+    lmax = fmax(lmax, ln);
+  }
+  for (int r = 0; r < s->nrow; r++) {
+    const ssContact *c = d->contact + s->first_row + r;
+    double v = d->jac[c->jadr + (c->dof - c->vadr)] * d->qvel[c->dof];
+    double l = c->row_a - c->row_b * v;
+    if (l > c->row_bound) l = c->row_bound;
+    if (l < -c->row_bound) l = -c->row_bound;
+    dmax = fmax(dmax, fabs(l - c->lambda[0]));
+    lmax = fmax(lmax, fabs(c->lambda[0]));
+  }
+  return lmax > 0 ? dmax / lmax : 0;
 }
 
 /* phi = y - yfree - Lam F.  Returns |phi|^2 and sets *size to |Lam F|^2,
@@ -591,9 +648,38 @@ static void unknowns_of(const ssModel *m, const ssData *d, const Setup *s,
   }
 }
 
-int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations)
+/* the impulses at y into the contacts, and the velocities they give:
+ * u = u_free + sum Y_b F_b + sum W_r lambda_r */
+static void apply(const ssModel *m, ssData *d, const Setup *s, const ssNewtonWork *w)
+{
+  for (int i = 0; i < s->first_row; i++)
+    memcpy(d->contact[i].lambda, w->lam + 3 * i, 3 * sizeof(double));
+  memcpy(d->qvel, d->qvel_free, (size_t)m->nv * sizeof(double));
+  for (int g = 0; g < s->ngroup; g++) {
+    const double *Y, *Lb, *Fg = w->F + 6 * g;
+    int link = w->grp[g].link, sys = m->body_sys[link];
+    ss_art_link_block(m, d, link, &Y, &Lb);
+    double *u = d->qvel + m->sys_vadr[sys];
+    for (int k = 0; k < m->sys_nv[sys]; k++) {
+      const double *yk = Y + 6 * k;
+      u[k] += yk[0] * Fg[0] + yk[1] * Fg[1] + yk[2] * Fg[2] + yk[3] * Fg[3] + yk[4] * Fg[4] +
+              yk[5] * Fg[5];
+    }
+  }
+  for (int r = 0; r < s->nrow; r++) {
+    ssContact *c = d->contact + s->first_row + r;
+    const double *W = d->jac + c->jadr + 3 * c->nv;
+    double *u = d->qvel + c->vadr, l = w->F[6 * s->ngroup + r];
+    c->lambda[0] = l;
+    for (int k = 0; k < c->nv; k++) u[k] += W[3 * k] * l;
+  }
+}
+
+int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
+                    double *residual_out)
 {
   *iterations = 0;
+  *residual_out = INFINITY;
   if (first_row == 0) return 0;
   /* suited: soil points on articulated links, PD rows */
   int ngroup = 0, nrow = d->ncontact - first_row;
@@ -650,71 +736,60 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations)
   lam_matrix(m, d, &s, w);
   unknowns_of(m, d, &s, w, d->qvel_free, w->yfree);
   unknowns_of(m, d, &s, w, d->qvel, w->y);
-  for (int i = 0; i < d->ncontact; i++)
-    memcpy(w->lam_save + 3 * i, d->contact[i].lambda, 3 * sizeof(double));
-  memcpy(w->u_save, d->qvel, (size_t)m->nv * sizeof(double));
-
   /* Newton with backtracking on |phi|^2, until |phi| is the solver's
    * tolerance of the contacts' effect |Lam F| (both weighted, see
-   * residual): the sweeps after it then have (nearly) nothing left to do */
-  const double tol2 = m->opt.solver_tolerance * m->opt.solver_tolerance;
-  int it = 0;
+   * residual); then the answer is applied and checked against every
+   * contact's law (check), and Newton goes on while the check fails.  The
+   * contacts and d->qvel are untouched until an answer is applied. */
+  const double tol = m->opt.solver_tolerance, tol2 = tol * tol;
   double size, size_try;
-  if (evaluate(m, d, &s, w, w->y, w->F, w->H)) goto decline;
+  if (evaluate(m, d, &s, w, w->y, w->F, w->H, w->lam)) return 0;
   double f = residual(&s, w, w->y, w->F, w->phi, &size);
-  while (f > tol2 * size) {
-    if (it == MAX_ITER) goto decline;
+  int it = 0, stalled = 0;
+  for (;;) {
+    if (f <= tol2 * size || stalled || it == MAX_ITER) {
+      /* stalled far from the answer (a patch near sticking, where the
+       * velocity form is nearly set-valued): the sweeps do better from the
+       * warm start */
+      if (f > tol2 * size && !(f <= tol * size)) break;
+      apply(m, d, &s, w);
+      *residual_out = check(m, d, &s, w);
+      if (*residual_out <= tol || stalled || it == MAX_ITER) {
+        *iterations = it;
+        return 1;
+      }
+    }
     it++;
     newton_matrix(&s, w, w->H);
-    if (!lu_factor(w->A, w->piv, n)) goto decline;
+    if (!lu_factor(w->A, w->piv, n)) {
+      stalled = 1;
+      continue;
+    }
     for (int a = 0; a < n; a++) w->dy[a] = -w->phi[a];
     lu_solve(w->A, w->piv, n, w->dy);
     double alpha = 1, ftry = f;
     int ok = 0;
     for (int ls = 0; ls < 8 && !ok; ls++, alpha *= 0.5) {
       for (int a = 0; a < n; a++) w->ytry[a] = w->y[a] + alpha * w->dy[a];
-      if (evaluate(m, d, &s, w, w->ytry, w->Ftry, w->Htry)) goto decline;
+      /* a trial that makes a point stick is no descent either */
+      if (evaluate(m, d, &s, w, w->ytry, w->Ftry, w->Htry, w->lamtry)) continue;
       ftry = residual(&s, w, w->ytry, w->Ftry, w->phitry, &size_try);
       ok = ftry <= (1 - 1e-4 * alpha) * f;
     }
     /* no descent: a kink Newton cannot cross, or round-off */
-    if (!ok) goto decline;
+    if (!ok) {
+      stalled = 1;
+      continue;
+    }
     double *t;
     t = w->y; w->y = w->ytry; w->ytry = t;
     t = w->F; w->F = w->Ftry; w->Ftry = t;
     t = w->H; w->H = w->Htry; w->Htry = t;
     t = w->phi; w->phi = w->phitry; w->phitry = t;
+    t = w->lam; w->lam = w->lamtry; w->lamtry = t;
     f = ftry;
     size = size_try;
   }
-  *iterations = it;
-
-  /* the contacts hold the impulses of the last evaluation, at y; the
-   * velocities they give: u = u_free + sum Y_b F_b + sum W_r lambda_r */
-  memcpy(d->qvel, d->qvel_free, (size_t)m->nv * sizeof(double));
-  for (int g = 0; g < ngroup; g++) {
-    const double *Y, *Lb, *Fg = w->F + 6 * g;
-    int link = w->grp[g].link, sys = m->body_sys[link];
-    ss_art_link_block(m, d, link, &Y, &Lb);
-    double *u = d->qvel + m->sys_vadr[sys];
-    for (int k = 0; k < m->sys_nv[sys]; k++) {
-      const double *yk = Y + 6 * k;
-      u[k] += yk[0] * Fg[0] + yk[1] * Fg[1] + yk[2] * Fg[2] + yk[3] * Fg[3] + yk[4] * Fg[4] +
-              yk[5] * Fg[5];
-    }
-  }
-  for (int r = 0; r < nrow; r++) {
-    const ssContact *c = d->contact + first_row + r;
-    const double *W = d->jac + c->jadr + 3 * c->nv;
-    double *u = d->qvel + c->vadr;
-    for (int k = 0; k < c->nv; k++) u[k] += W[3 * k] * c->lambda[0];
-  }
-  return 1;
-
-decline:
-  for (int i = 0; i < d->ncontact; i++)
-    memcpy(d->contact[i].lambda, w->lam_save + 3 * i, 3 * sizeof(double));
-  memcpy(d->qvel, w->u_save, (size_t)m->nv * sizeof(double));
   *iterations = it;
   return 0;
 }

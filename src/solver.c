@@ -482,14 +482,18 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   }
   int pack = !d->solver_full;
 
-  /* Newton on the contact links' velocities, where it applies, gives the
-   * sweeps a start that is (nearly) their answer */
+  /* Newton on the contact links' velocities, where it applies: its answer
+   * stands when its check meets the tolerance, else the sweeps go on from
+   * it */
+  int sweeps = d->ncontact ? m->opt.solver_max_sweeps : 0;
   if (!d->solver_gs_only) {
-    int its;
-    if (ss_newton_solve(m, d, first_row, &its)) st->newton = its;
+    double res;
+    if (ss_newton_solve(m, d, first_row, &st->newton, &res) && res <= tol) {
+      st->residual = res;
+      sweeps = 0;
+    }
   }
 
-  int sweeps = d->ncontact ? m->opt.solver_max_sweeps : 0;
   Group g = {NULL, NULL, NULL, {0}, {0}};
   for (int sweep = 0; sweep < sweeps; sweep++) {
     double dmax = 0, lmax = 0;

@@ -98,12 +98,14 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err);
  * velocities and the rows' velocities.  On entry d->qvel_free holds the
  * free velocity, the contacts their first impulses and d->qvel the matching
  * velocity; contacts [first_row, ncontact) are the joint rows.  Returns 1
- * when the contacts hold the converged impulses and d->qvel their
- * velocity, 0 when it declined (everything as on entry); *iterations: the
- * Newton iterations spent either way.  The sweeps that follow judge
- * convergence as always. */
+ * when Newton converged: the contacts hold its impulses, d->qvel their
+ * velocity, and *residual the check of that answer against every
+ * contact's law at that velocity (the sweeps' measure: max |change| /
+ * max |impulse|); 0 when it declined (everything as on entry).
+ * *iterations: the Newton iterations spent either way. */
 typedef struct ssNewtonWork ssNewtonWork;
-int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations);
+int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
+                    double *residual);
 void ss_newton_work_free(ssNewtonWork *w);
 
 /* The per-point soil solve (exposed for tests and benchmarks): given the
