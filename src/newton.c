@@ -62,9 +62,12 @@ typedef struct NPoint {
                          (xa < 0: none) */
 } NPoint;
 
-/* A group: the soil points of one link on one bed, in that bed's frame */
+/* A group: the soil points of one link (or free rigid body) on one bed,
+ * in that bed's frame */
 typedef struct NGroup {
-  int link;
+  int link;           /* articulated link, or -1: the free body `body` */
+  int body, sys;
+  double Yb[36];      /* free body: its response Y (see body_block) */
   const ssSoilMaterial *mat;
   double R[9];        /* contact frame rows n, t1, t2 (world) */
   double o[3];        /* origin of the points' r (world) */
@@ -265,6 +268,53 @@ static void from_group(const NGroup *G, const double Fg[6], const double Hg[36],
     }
 }
 
+/* A group's body velocity y_b = (omega; v_O) from its system's
+ * velocities u (qvel's block of the system): a link's J_b u, or for a
+ * free body (qvel = (v_c; omega) at its centre of mass c)
+ * (omega; v_c + c x omega). */
+static void group_motion(const ssModel *m, const ssData *d, const NGroup *G,
+                         const double *u, double V[6])
+{
+  if (G->link >= 0) {
+    ss_art_link_motion(m, d, G->link, u, V);
+    return;
+  }
+  double cw[3];
+  ss_v3_cross(cw, d->body_xipos + 3 * G->body, u + 3);
+  ss_v3_copy(V, u + 3);
+  ss_v3_add(V + 3, u, cw);
+}
+
+/* A free body's response Y (6 x 6, Y[6 i + k]: velocity i per unit of
+ * F_k) to a spatial impulse F = (torque about O; force): dv_c = f / m,
+ * domega = I^-1 (tau_O - c x f) */
+static void body_block(const ssModel *m, const ssData *d, int b, double Y[36])
+{
+  const double *c = d->body_xipos + 3 * b, *Ii = d->body_iinv + 9 * b;
+  double im = 1 / m->body_mass[b];
+  memset(Y, 0, 36 * sizeof(double));
+  for (int k = 0; k < 3; k++) {
+    double e[3] = {0, 0, 0}, ce[3], w[3];
+    e[k] = 1;
+    ss_v3_cross(ce, c, e);
+    ss_m3_mulv(w, Ii, ce);
+    Y[6 * k + 3 + k] = im;
+    for (int i = 0; i < 3; i++) {
+      Y[6 * (3 + i) + k] = Ii[3 * i + k];
+      Y[6 * (3 + i) + 3 + k] = -w[i];
+    }
+  }
+}
+
+/* the group's response Y (nv x 6, rows of its system's velocities) */
+static const double *group_block(const ssModel *m, ssData *d, const NGroup *G)
+{
+  if (G->link < 0) return G->Yb;
+  const double *Y, *Lb;
+  ss_art_link_block(m, d, G->link, &Y, &Lb);
+  return Y;
+}
+
 /* a bed material's constants as the law uses them */
 typedef struct Mat {
   double dt, n, m1, Ke, D, mu, rj; /* rj = dt / K_j, 0 when K_j = 0 */
@@ -458,9 +508,10 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
 {
   const double dt = m->opt.timestep;
   for (int g = 0; g < s->ngroup; g++) {
+    const NGroup *G = w->grp + g;
     double V[6];
-    ss_art_link_velocity(m, d, w->grp[g].link, V);
-    to_group(w->grp + g, V, w->sum[g].V);
+    group_motion(m, d, G, d->qvel + m->sys_vadr[G->sys], V);
+    to_group(G, V, w->sum[g].V);
   }
   double dmax = 0, lmax = 0;
   int gprev = -1;
@@ -596,10 +647,8 @@ static void lam_matrix(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork
     const double *Y;
     int sys, vadr, nv, ncol, col0, stride;
     if (gc < s->ngroup) {
-      const double *Lb;
-      int link = w->grp[gc].link;
-      ss_art_link_block(m, d, link, &Y, &Lb);
-      sys = m->body_sys[link];
+      Y = group_block(m, d, w->grp + gc);
+      sys = w->grp[gc].sys;
       vadr = m->sys_vadr[sys];
       nv = m->sys_nv[sys];
       ncol = 6;
@@ -618,10 +667,9 @@ static void lam_matrix(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork
     for (int k = 0; k < ncol; k++) {
       for (int i = 0; i < nv; i++) w->col[i] = Y[stride * i + k];
       for (int gr = 0; gr < s->ngroup; gr++) {
-        int link = w->grp[gr].link;
-        if (m->body_sys[link] != sys) continue;
+        if (w->grp[gr].sys != sys) continue;
         double V[6];
-        ss_art_link_motion(m, d, link, w->col, V);
+        group_motion(m, d, w->grp + gr, w->col, V);
         for (int a = 0; a < 6; a++) w->Lam[(size_t)(6 * gr + a) * n + col0 + k] = V[a];
       }
       for (int r = 0; r < s->nrow; r++) {
@@ -638,10 +686,8 @@ static void lam_matrix(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork
 static void unknowns_of(const ssModel *m, const ssData *d, const Setup *s,
                         const ssNewtonWork *w, const double *u, double *y)
 {
-  for (int g = 0; g < s->ngroup; g++) {
-    int link = w->grp[g].link, sys = m->body_sys[link];
-    ss_art_link_motion(m, d, link, u + m->sys_vadr[sys], y + 6 * g);
-  }
+  for (int g = 0; g < s->ngroup; g++)
+    group_motion(m, d, w->grp + g, u + m->sys_vadr[w->grp[g].sys], y + 6 * g);
   for (int r = 0; r < s->nrow; r++) {
     const ssContact *c = d->contact + s->first_row + r;
     y[6 * s->ngroup + r] = d->jac[c->jadr + (c->dof - c->vadr)] * u[c->dof];
@@ -656,9 +702,8 @@ static void apply(const ssModel *m, ssData *d, const Setup *s, const ssNewtonWor
     memcpy(d->contact[i].lambda, w->lam + 3 * i, 3 * sizeof(double));
   memcpy(d->qvel, d->qvel_free, (size_t)m->nv * sizeof(double));
   for (int g = 0; g < s->ngroup; g++) {
-    const double *Y, *Lb, *Fg = w->F + 6 * g;
-    int link = w->grp[g].link, sys = m->body_sys[link];
-    ss_art_link_block(m, d, link, &Y, &Lb);
+    const double *Y = group_block(m, d, w->grp + g), *Fg = w->F + 6 * g;
+    int sys = w->grp[g].sys;
     double *u = d->qvel + m->sys_vadr[sys];
     for (int k = 0; k < m->sys_nv[sys]; k++) {
       const double *yk = Y + 6 * k;
@@ -681,32 +726,38 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
   *iterations = 0;
   *residual_out = INFINITY;
   if (first_row == 0) return 0;
-  /* suited: soil points on articulated links, PD rows */
+  /* suited: soil points on articulated links or free bodies, PD rows */
   int ngroup = 0, nrow = d->ncontact - first_row;
   for (int i = 0; i < d->ncontact; i++) {
     const ssContact *c = d->contact + i;
-    if (i < first_row ? !(c->type == SS_CONTACT_SOIL && c->link >= 0 && c->nv > 0)
+    int owner = c->nv > 0 && (c->link >= 0 || (c->nv == 6 && m->sys_type[c->sys] == SS_SYS_FREE));
+    if (i < first_row ? !(c->type == SS_CONTACT_SOIL && owner)
                       : !(c->type == SS_CONTACT_PD && c->nv > 0))
       return 0;
-    /* runs of one link on one bed: at least as many as the groups */
-    if (i < first_row && (i == 0 || c[-1].link != c->link || c[-1].hfield != c->hfield)) ngroup++;
+    /* runs of one link or body on one bed: at least as many as the groups */
+    if (i < first_row && (i == 0 || c[-1].link != c->link || c[-1].sys != c->sys ||
+                          c[-1].hfield != c->hfield))
+      ngroup++;
   }
   int n = 6 * ngroup + nrow;
   ssNewtonWork *w = work(d, n, d->ncontact, m->nv, ngroup);
   if (!w) return 0;
-  /* groups: one per link and bed (a link's contacts may come in several
-   * runs); every point of a bed shares the bed's frame */
+  /* groups: one per link (or body) and bed (a link's contacts may come in
+   * several runs); every point of a bed shares the bed's frame */
   ngroup = 0;
   for (int i = 0; i < first_row; i++) {
     const ssContact *c = d->contact + i;
     int g = 0;
-    while (g < ngroup && !(w->grp[g].link == c->link &&
+    while (g < ngroup && !(w->grp[g].link == c->link && w->grp[g].sys == c->sys &&
                            w->grp[g].mat == &m->hfield_soilmat[c->hfield]))
       g++;
     NGroup *G = w->grp + g;
     if (g == ngroup) {
       ngroup++;
       G->link = c->link;
+      G->sys = c->sys;
+      G->body = c->link >= 0 ? c->link : m->geom_body[c->geom];
+      if (c->link < 0) body_block(m, d, G->body, G->Yb);
       G->mat = &m->hfield_soilmat[c->hfield];
       memcpy(G->R, c->frame, sizeof G->R);
       memcpy(G->o, c->pos, sizeof G->o);

@@ -187,6 +187,39 @@ static void test_packed_groups(void)
   ss_model_free(m);
 }
 
+/* The Newton phase against the sweeps alone on the driving buggy, ten
+ * steps each taken both ways from the same state (bound: test_plate.c,
+ * newton_case): the same impulses, and the sweeps that follow the phase a
+ * fraction of those the sweeps alone need. */
+static void test_newton(void)
+{
+  ssModel *m;
+  ssData *d;
+  if (!load("scenes/buggy.xml", &m, &d)) {
+    ok(0, "buggy.xml loads");
+    return;
+  }
+  run(m, d, 300, NULL);
+  const double tol = m->opt.solver_tolerance;
+  double worst = 0;
+  int good = 1, sweeps[2] = {0, 0}, newton = 0, nc = 0;
+  for (int k = 0; k < 10 && good; k++) {
+    PathCompare pc;
+    good = newton_paths(m, d, &pc) && pc.converged[0] && pc.converged[1];
+    worst = fmax(worst, pc.dlam);
+    sweeps[0] += pc.sweeps[0];
+    sweeps[1] += pc.sweeps[1];
+    newton += pc.newton[0];
+    nc = pc.ncontact;
+  }
+  ok(good && nc > 400 && worst <= 1e3 * tol && newton > 0 && 4 * sweeps[0] <= sweeps[1],
+     "buggy on soil (%d contacts), 10 steps: %d Newton iterations + %d sweeps against %d "
+     "sweeps alone; impulses %.2g apart relative (bound %.2g)", nc, newton, sweeps[0],
+     sweeps[1], worst, 1e3 * tol);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 static void test_drive(void)
 {
   ssModel *m;
@@ -338,6 +371,7 @@ int main(void)
   test_steering();
   test_determinism();
   test_packed_groups();
+  test_newton();
   test_drive();
   return done_testing();
 }

@@ -6,6 +6,7 @@
 #include "tap.h"
 #include "worlds.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -454,6 +455,9 @@ static void test_warm_trend(void)
   const double tol = w.m->opt.solver_tolerance, dt = w.m->opt.timestep;
   ssWarmEntry *old = malloc((size_t)w.m->nhfielddata * sizeof *old);
   int nold = 0, moving, conv[3], bad, bad2;
+  /* the sweeps' start is what the warm start serves: the Newton phase,
+   * which solves a free plate's step outright, stays out */
+  w.d->solver_gs_only = u.d->solver_gs_only = v.d->solver_gs_only = 1;
   if (!old || !run(&w, 12)) {
     ok(0, "warm trend: set-up");
     goto out;
@@ -517,6 +521,51 @@ out:
   free_world(&v);
 }
 
+/* The Newton phase (solver.h) against the sweeps alone, one step from the
+ * same state each.  Both stop at the solver tolerance tol in the sweeps'
+ * measure (largest impulse change over largest impulse); a contraction of
+ * rate rho leaves each within tol / (1 - rho) of the exact impulses, so
+ * 1e3 tol allows rho up to 0.998 on each side -- slower than any patch
+ * here -- while an error in the Newton phase's law or Jacobian shows as
+ * an O(1) difference or as sweeps after it. */
+static void newton_case(World *w, const char *what, int expect_newton)
+{
+  PathCompare pc;
+  const double tol = w->m->opt.solver_tolerance;
+  int good = newton_paths(w->m, w->d, &pc);
+  int path = expect_newton ? pc.sweeps[0] == 0 : pc.sweeps[0] > 0;
+  ok(good && pc.ncontact > 0 && pc.converged[0] && pc.converged[1] &&
+     pc.dlam <= 1e3 * tol && path,
+     "%s: the Newton phase %s (%d Newton iterations + %d sweeps, the sweeps alone %d); "
+     "impulses %.2g apart relative (bound %.2g)", what,
+     expect_newton ? "solves the step" : "declines, the sweeps solve it",
+     pc.newton[0], pc.sweeps[0], pc.sweeps[1], pc.dlam, 1e3 * tol);
+}
+
+static void test_newton(void)
+{
+  World w = make_world(plate_soil(), 1.2, 0.02, 0.4, 0.6, 20, 0, 0, 0.3, 0);
+  /* sinking from rest, settling, settled */
+  int steps[] = {3, 40, 400};
+  for (int k = 0, done = 0; k < 3; k++) {
+    run(&w, steps[k] - done);
+    done = steps[k] + 1;
+    char what[64];
+    snprintf(what, sizeof what, "plate (yaw 0.3) after %d steps", steps[k]);
+    newton_case(&w, what, 1);
+  }
+  /* sliding: pushed at 0.5 m/s along x and spun at 1 rad/s */
+  w.d->qvel[0] = 0.5;
+  w.d->qvel[5] = 1.0;
+  run(&w, 2);
+  newton_case(&w, "plate sliding and spinning", 1);
+  /* stopped after the slide: the shear built up (j > 0) holds the points
+   * at zero slip, where the velocity form is set-valued */
+  run(&w, 600);
+  newton_case(&w, "plate stopped after sliding (sticking)", 0);
+  free_world(&w);
+}
+
 int main(void)
 {
   test_analytic_plate();
@@ -526,5 +575,6 @@ int main(void)
   test_drag();
   test_rigid();
   test_warm_trend();
+  test_newton();
   return done_testing();
 }

@@ -2,8 +2,10 @@
  * program: a tiny in-memory URDF builder, the plate soil of DESIGN 2.7, and
  * the articulated benchmark bodies of DESIGN 8. */
 #include "worlds.h"
+#include "solver.h"
 #include "ss_math.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -232,4 +234,49 @@ out:
   free(buf);
   free(u);
   return worst;
+}
+
+/* ---------------------------------------------------------------------- */
+/* the Newton phase against the sweeps alone                               */
+
+int newton_paths(ssModel *m, ssData *d, PathCompare *out)
+{
+  ssError e;
+  unsigned char *buf = NULL;
+  size_t len = 0;
+  int gs = d->solver_gs_only, ok = 0, nc = 0;
+  double *lam = NULL;
+  memset(out, 0, sizeof *out);
+  out->dlam = -1;
+  if (ss_checkpoint_save_buffer(m, d, &buf, &len, &e) != SS_OK) goto done;
+  /* the sweeps alone first, their impulses kept */
+  d->solver_gs_only = 1;
+  if (ss_step(m, d, &e) != SS_OK) goto done;
+  nc = d->ncontact;
+  if (!(lam = malloc((size_t)(nc ? nc : 1) * 3 * sizeof(double)))) goto done;
+  for (int i = 0; i < nc; i++) memcpy(lam + 3 * i, d->contact[i].lambda, 3 * sizeof(double));
+  out->sweeps[1] = d->stats.sweeps;
+  out->newton[1] = d->stats.newton;
+  out->converged[1] = d->stats.converged;
+  /* then the same step with the Newton phase */
+  if (ss_checkpoint_load_buffer(m, d, buf, len, &e) != SS_OK) goto done;
+  d->solver_gs_only = 0;
+  if (ss_step(m, d, &e) != SS_OK || d->ncontact != nc) goto done;
+  out->sweeps[0] = d->stats.sweeps;
+  out->newton[0] = d->stats.newton;
+  out->converged[0] = d->stats.converged;
+  double dmax = 0, lmax = 0;
+  for (int i = 0; i < nc; i++) {
+    const double *a = d->contact[i].lambda, *b = lam + 3 * i;
+    dmax = fmax(dmax, fabs(a[0] - b[0]) + fabs(a[1] - b[1]) + fabs(a[2] - b[2]));
+    lmax = fmax(lmax, fabs(b[0]) + fabs(b[1]) + fabs(b[2]));
+  }
+  out->dlam = lmax > 0 ? dmax / lmax : dmax;
+  out->ncontact = nc;
+  ok = 1;
+done:
+  d->solver_gs_only = gs;
+  free(buf);
+  free(lam);
+  return ok;
 }

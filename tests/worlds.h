@@ -38,4 +38,15 @@ ssUrdf *fourpad64(void);
  * failure); d holds the full path's step.  *ncontact: its contacts. */
 double solver_paths_difference(ssModel *m, ssData *d, int sweeps, int *ncontact);
 
+/* One step of d taken twice from the same state: with the sweeps alone
+ * (d->solver_gs_only; index 1 of the arrays) and with the Newton phase
+ * before them (index 0).  dlam: the largest difference of the contacts'
+ * impulses (1-norms) relative to the largest impulse, the measure of the
+ * solver's tolerance.  d holds the Newton path's step.  0 on failure. */
+typedef struct PathCompare {
+  double dlam;
+  int ncontact, sweeps[2], newton[2], converged[2];
+} PathCompare;
+int newton_paths(ssModel *m, ssData *d, PathCompare *out);
+
 #endif
