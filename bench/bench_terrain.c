@@ -47,14 +47,14 @@ static double median(double *v, int n)
 }
 
 static void csv_row(const Opt *o, const char *kind, double ms, double ns_point,
-                    double sweeps, double err)
+                    double sweeps, double newton, double err)
 {
   if (!o->csv) return;
   FILE *f = fopen(o->csv, "a");
   if (!f) return;
-  fprintf(f, "%s,%s,%s,%s,%d,%d,%.6g,%.6g,%.6g,%.6g\n", kind, o->body,
+  fprintf(f, "%s,%s,%s,%s,%d,%d,%.6g,%.6g,%.6g,%.6g,%.6g\n", kind, o->body,
           o->warm ? "warm" : "cold", o->linear ? "linear" : "nonlinear", o->steps,
-          o->repeats, ms, ns_point, sweeps, err);
+          o->repeats, ms, ns_point, sweeps, err, newton);
   fclose(f);
 }
 
@@ -62,7 +62,7 @@ static void csv_row(const Opt *o, const char *kind, double ms, double ns_point,
 /* bodies on soil                                                          */
 
 typedef struct Run {
-  double seconds, sweeps, points, sinkage, soil_normal, dt;
+  double seconds, sweeps, newton, points, sinkage, soil_normal, dt;
   int ok;
 } Run;
 
@@ -136,7 +136,7 @@ __attribute__((noinline)) static ssStatus timed_step(const ssModel *m, ssData *d
 
 static Run run_body(const Opt *o)
 {
-  Run r = {0, 0, 0, 0, 0, 0, 0};
+  Run r = {0};
   ssModel *m;
   ssData *d;
   char why[1200];
@@ -155,7 +155,7 @@ static Run run_body(const Opt *o)
     }
   }
   double t0 = now();
-  long sweeps = 0, points = 0;
+  long sweeps = 0, newton = 0, points = 0;
   for (int k = 0; k < o->steps; k++) {
     if (timed_step(m, d, &e) != SS_OK) {
       fprintf(stderr, "benchmarks: step %d failed: %s\n", k + 1, e.message);
@@ -164,10 +164,12 @@ static Run run_body(const Opt *o)
       return r;
     }
     sweeps += d->stats.sweeps;
+    newton += d->stats.newton;
     points += d->stats.soil_loaded;
   }
   r.seconds = now() - t0;
   r.sweeps = (double)sweeps / o->steps;
+  r.newton = (double)newton / o->steps;
   r.points = (double)points / o->steps;
   r.soil_normal = d->stats.soil_normal_force;
   r.dt = m->opt.timestep;
@@ -188,7 +190,7 @@ static Run run_body(const Opt *o)
 static int bench_bodies(const Opt *o)
 {
   double *ms = calloc((size_t)o->repeats, sizeof(double));
-  Run last = {0, 0, 0, 0, 0, 0, 0};
+  Run last = {0};
   for (int k = 0; k < o->repeats; k++) {
     last = run_body(o);
     if (!last.ok) {
@@ -202,15 +204,15 @@ static int bench_bodies(const Opt *o)
   int buggy = !strcmp(o->body, "buggy");
   double s_ref = 8.175e-3, err = buggy ? 0 : (last.sinkage - s_ref) / s_ref;
   double ns_point = last.points > 0 ? 1e6 * med / last.points : 0;
-  printf("%-12s %-5s %6d steps x %d: %9.4f ms/step  %8.1f ns/point/step  %6.1f sweeps/step  "
-         "%7.1f loaded points",
+  printf("%-12s %-5s %6d steps x %d: %9.4f ms/step  %8.1f ns/point/step  %5.2f sweeps + "
+         "%4.2f Newton/step  %7.1f loaded points",
          o->body, o->warm ? "warm" : "cold", o->steps, o->repeats, med, ns_point,
-         last.sweeps, last.points);
+         last.sweeps, last.newton, last.points);
   if (buggy)
     printf("  real-time factor %.3f\n", last.dt / (1e-3 * med));
   else
     printf("  sinkage %.4f mm (analytic 8.175, error %+.3f %%)\n", last.sinkage * 1e3, 100 * err);
-  csv_row(o, "body", med, ns_point, last.sweeps, err);
+  csv_row(o, "body", med, ns_point, last.sweeps, last.newton, err);
   if (o->verify && !buggy) {
     /* warm and cold starts reach the same converged answer */
     Opt other = *o;
@@ -328,7 +330,7 @@ static int bench_contact_law(const Opt *o)
   printf("checks: normal pressure %s, shear within tau_max %s, shear opposes slip %s, "
          "never adds energy %s\n", bad_p ? "FAILED" : "ok", bad_bound ? "FAILED" : "ok",
          bad_align ? "FAILED" : "ok", bad_power ? "FAILED" : "ok");
-  csv_row(o, "contact_law", 0, med, 0, good ? 0 : 1);
+  csv_row(o, "contact_law", 0, med, 0, 0, good ? 0 : 1);
   return good ? 0 : 1;
 }
 
@@ -371,7 +373,7 @@ int bench_terrain(int argc, char **argv)
       f = fopen(o.csv, "w");
       if (f) {
         fprintf(f, "case,body,start,material,steps,repeats,ms_per_step,ns_per_point,"
-                   "sweeps_per_step,error\n");
+                   "sweeps_per_step,error,newton_per_step\n");
         fclose(f);
       }
     } else {
