@@ -184,7 +184,7 @@ static inline double expm1_neg(double d)
 }
 
 /* s^(n-1) of point P, moved from its last value when near */
-static inline double pow_point(NPoint *P, double s, double m1)
+static inline __attribute__((always_inline)) double pow_point(NPoint *P, double s, double m1)
 {
   double u = P->ps > 0 ? (s - P->ps) / P->ps : INFINITY, v;
   if (fabs(u) <= POW_SERIES_MAX && fabs(m1) <= 3) v = P->pv + P->pv * binom_m1(m1, u);
@@ -195,7 +195,7 @@ static inline double pow_point(NPoint *P, double s, double m1)
 }
 
 /* Janosi mobilisation 1 - exp(-x) of point P and exp(-x) in *e */
-static inline double mobil_point(NPoint *P, double x, double *e)
+static inline __attribute__((always_inline)) double mobil_point(NPoint *P, double x, double *e)
 {
   double d = x - P->xa;
   if (d != 0) {
@@ -338,7 +338,7 @@ enum { UNLOADED = 0, LOADED = 1, STICKS = 2 };
  * Returns UNLOADED (lam = 0), LOADED, or STICKS when the point sticks or so
  * nearly that T / |v_t| exceeds STICK_RATIO times its own tangential
  * response 1/G_tt: the velocity form is set-valued there. */
-static inline int point_law(const Mat *M, NPoint *P, const double V[6],
+static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint *P, const double V[6],
                             double lam[3], double *K)
 {
   const double *r = P->r;
