@@ -30,6 +30,7 @@ struct ssArtWork {
   double *phi;           /* (nrow) closure residual */
   double *MiKT;          /* (nv x nrow) M'^-1 K^T */
   double *A;             /* (nrow x nrow) Cholesky factor of K M'^-1 K^T */
+  double *Z;             /* (6 x nrow) scratch of body_response */
   unsigned char *row_on; /* (nrow) 0: row dropped as dependent */
   double *Y;             /* (nb x nv x 6) projected responses P M'^-1 J_b^T */
   double *Lam;           /* (nb x 36) J_b Y_b */
@@ -114,7 +115,7 @@ void ss_art_work_free(ssArtWork *w)
   free(w->eq); free(w->dof_body); free(w->dof_parent); free(w->S);
   free(w->vel); free(w->acc); free(w->frc); free(w->I6); free(w->Ic);
   free(w->M); free(w->L); free(w->rhs); free(w->x); free(w->y);
-  free(w->K); free(w->phi); free(w->MiKT); free(w->A); free(w->row_on);
+  free(w->K); free(w->phi); free(w->MiKT); free(w->A); free(w->Z); free(w->row_on);
   free(w->Y); free(w->Lam); free(w->Yok);
   free(w);
 }
@@ -148,13 +149,14 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
   w->phi = calloc(nr, sizeof(double));
   w->MiKT = calloc(nv * nr, sizeof(double));
   w->A = calloc(nr * nr, sizeof(double));
+  w->Z = calloc(6 * nr, sizeof(double));
   w->row_on = calloc(nr, 1);
   w->Y = calloc(nb * nv * 6, sizeof(double));
   w->Lam = calloc(nb * 36, sizeof(double));
   w->Yok = calloc(nb, 1);
   if (!w->eq || !w->dof_body || !w->dof_parent || !w->S || !w->vel || !w->acc ||
       !w->frc || !w->I6 || !w->Ic || !w->M || !w->L || !w->rhs || !w->x || !w->y ||
-      !w->K || !w->phi || !w->MiKT || !w->A || !w->row_on || !w->Y || !w->Lam ||
+      !w->K || !w->phi || !w->MiKT || !w->A || !w->Z || !w->row_on || !w->Y || !w->Lam ||
       !w->Yok) {
     ss_art_work_free(w);
     return NULL;
@@ -303,13 +305,18 @@ static int ltdl_factor(ssArtWork *w)
   return 0;
 }
 
-/* x <- M'^-1 x */
+/* x <- M'^-1 x.  The first pass moves each entry into its ancestors only:
+ * the zeros of a sparse x (a Jacobian's column, a closure row: a path or
+ * two in the tree) cost nothing there. */
 static void ltdl_solve(const ssArtWork *w, double *x)
 {
   int n = w->nv;
   const double *H = w->L;
-  for (int i = n - 1; i >= 0; i--)
-    for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) x[j] -= H[i * n + j] * x[i];
+  for (int i = n - 1; i >= 0; i--) {
+    double xi = x[i];
+    if (xi == 0) continue;
+    for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) x[j] -= H[i * n + j] * xi;
+  }
   for (int i = 0; i < n; i++) x[i] /= H[i * n + i];
   for (int i = 0; i < n; i++)
     for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) x[i] -= H[i * n + j] * x[j];
@@ -645,11 +652,14 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
   return SS_OK;
 }
 
-/* Y_b = P M'^-1 J_b^T (nv x 6) and Lam_b = J_b Y_b, once per step */
+/* Y_b = P M'^-1 J_b^T (nv x 6) and Lam_b = J_b Y_b, once per step.  The
+ * projection P = I - M'^-1 K^T A^-1 K (project) is applied to the six
+ * columns at once, and K M'^-1 J_b^T = (J_b MiKT)^T (M' is symmetric)
+ * reads only the rows of MiKT on b's path. */
 static void body_response(const ssModel *m, ssArtWork *w, int lb)
 {
   if (w->Yok[lb]) return;
-  int n = w->nv, b = w->b0 + lb;
+  int n = w->nv, nr = w->nrow, b = w->b0 + lb;
   double *Y = w->Y + (size_t)lb * n * 6, *col = w->x;
   for (int r = 0; r < 6; r++) {
     memset(col, 0, (size_t)n * sizeof(double));
@@ -660,8 +670,30 @@ static void body_response(const ssModel *m, ssArtWork *w, int lb)
       for (int k = k0; k < k0 + nd; k++) col[k] = w->S[6 * k + r];
     }
     ltdl_solve(w, col);
-    project(w, col);
     for (int k = 0; k < n; k++) Y[6 * k + r] = col[k];
+  }
+  if (nr) {
+    double *Z = w->Z;
+    memset(Z, 0, 6 * (size_t)nr * sizeof(double));
+    for (int a = b; a >= 0; a = m->body_parent[a]) {
+      int nd = m->body_ndof[a];
+      if (!nd) continue;
+      int k0 = m->body_dofadr[a] - w->v0;
+      for (int k = k0; k < k0 + nd; k++) {
+        const double *Sk = w->S + 6 * k, *Mk = w->MiKT + (size_t)k * nr;
+        for (int r = 0; r < 6; r++)
+          for (int i = 0; i < nr; i++) Z[r * nr + i] += Sk[r] * Mk[i];
+      }
+    }
+    for (int r = 0; r < 6; r++) closure_solve(w, Z + r * nr);
+    for (int k = 0; k < n; k++) {
+      const double *Mk = w->MiKT + (size_t)k * nr;
+      for (int r = 0; r < 6; r++) {
+        double t = 0;
+        for (int i = 0; i < nr; i++) t += Mk[i] * Z[r * nr + i];
+        Y[6 * k + r] -= t;
+      }
+    }
   }
   double *Lam = w->Lam + 36 * lb;
   memset(Lam, 0, 36 * sizeof(double));
