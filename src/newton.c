@@ -205,7 +205,7 @@ static inline __attribute__((always_inline)) double mobil_point(NPoint *P, doubl
       P->ea += P->ea * em1;
     } else {
       P->ma = -expm1(-x);
-      P->ea = exp(-x);
+      P->ea = 1 - P->ma; /* absolute accuracy is all e needs (T' and the series) */
     }
     P->xa = x;
   }
