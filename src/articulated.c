@@ -836,17 +836,24 @@ void ss_art_integrate(const ssModel *m, ssData *d, int s)
   ssArtWork *w = d->art[s];
   advance(m, d, w, d->qvel + w->v0, m->opt.timestep);
   if (!w->nrow) return;
-  /* remove closure drift: Newton steps du = -M'^-1 K^T A^-1 phi with K and
-   * A at the current configuration, M' of this step */
-  double err = 0, z[64], *zz = w->nrow <= 64 ? z : malloc((size_t)w->nrow * sizeof(double));
+  /* remove closure drift: steps du = -M'^-1 K^T A^-1 phi, M' of this step.
+   * K and A are first those of the step's start (ss_art_free_velocity
+   * factored them; the configuration has moved by one step since): a chord
+   * method, each step cutting phi by about the relative change of K over
+   * the step, at the cost of a forward pass instead of a factorisation.
+   * Where the last step did not cut phi at least fourfold, K and A are
+   * refactored at the current configuration (a Newton step). */
+  double err = 0, prev = INFINITY, z[64];
+  double *zz = w->nrow <= 64 ? z : malloc((size_t)w->nrow * sizeof(double));
   if (!zz) return;
-  for (int it = 0; it < 8; it++) {
+  for (int it = 0; it < 12; it++) {
     ss_art_forward(m, d, s);
     closures(m, d, w);
     err = 0;
     for (int r = 0; r < w->nrow; r++) err = fmax(err, fabs(w->phi[r]));
     if (err < 1e-13) break;
-    factor_closures(w);
+    if (!(err <= 0.25 * prev)) factor_closures(w);
+    prev = err;
     memcpy(zz, w->phi, (size_t)w->nrow * sizeof(double));
     closure_solve(w, zz);
     double *du = w->rhs;
