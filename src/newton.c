@@ -787,18 +787,20 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
   lam_matrix(m, d, &s, w);
   unknowns_of(m, d, &s, w, d->qvel_free, w->yfree);
   unknowns_of(m, d, &s, w, d->qvel, w->y);
-  /* Newton with backtracking on |phi|^2, until |phi| is the solver's
-   * tolerance of the contacts' effect |Lam F| (both weighted, see
-   * residual); then the answer is applied and checked against every
-   * contact's law (check), and Newton goes on while the check fails.  The
+  /* Newton with backtracking on |phi|^2, until |phi| is within ten times
+   * the solver's tolerance of the contacts' effect |Lam F| (both weighted,
+   * see residual); then the answer is applied and checked against every
+   * contact's law (check), which decides, and Newton goes on while the
+   * check fails.  (Trying the check at 10 tol saves the last iteration in
+   * about a sixth of the buggy's steps, for a failed check in 3 %.)  The
    * contacts and d->qvel are untouched until an answer is applied. */
-  const double tol = m->opt.solver_tolerance, tol2 = tol * tol;
+  const double tol = m->opt.solver_tolerance, tol2 = tol * tol, try2 = 100 * tol2;
   double size, size_try;
   if (evaluate(m, d, &s, w, w->y, w->F, w->H, w->lam)) return 0;
   double f = residual(&s, w, w->y, w->F, w->phi, &size);
   int it = 0, stalled = 0;
   for (;;) {
-    if (f <= tol2 * size || stalled || it == MAX_ITER) {
+    if (f <= try2 * size || stalled || it == MAX_ITER) {
       /* stalled far from the answer (a patch near sticking, where the
        * velocity form is nearly set-valued): the sweeps do better from the
        * warm start */
