@@ -459,10 +459,6 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   st->newton = 0;
   if (m->nv) memcpy(d->qvel_free, d->qvel, (size_t)m->nv * sizeof(double));
   warm_start(m, d, converged);
-  for (int i = 0; i < d->ncontact; i++) {
-    ssContact *c = d->contact + i;
-    if (c->type == SS_CONTACT_SOIL) ss_point_setup(&m->hfield_soilmat[c->hfield], dt, c);
-  }
 
   /* joint rows (PD, limits) are few, stiff and coupled to everything:
    * they are revisited after every piece of a link run (PIECE) and every
@@ -494,6 +490,11 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
     }
   }
 
+  /* the soil points' laws for the sweeps (the Newton phase has its own) */
+  for (int i = 0; i < d->ncontact && sweeps > 0; i++) {
+    ssContact *c = d->contact + i;
+    if (c->type == SS_CONTACT_SOIL) ss_point_setup(&m->hfield_soilmat[c->hfield], dt, c);
+  }
   Group g = {NULL, NULL, NULL, {0}, {0}};
   for (int sweep = 0; sweep < sweeps; sweep++) {
     double dmax = 0, lmax = 0;
