@@ -322,6 +322,32 @@ static void ltdl_solve(const ssArtWork *w, double *x)
     for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) x[i] -= H[i * n + j] * x[j];
 }
 
+/* ltdl_solve on six columns at once, X (n x 6, row k = dof k): the same
+ * operations per column in the same order (so the same bits), six wide */
+static void ltdl_solve6(const ssArtWork *w, double *X)
+{
+  int n = w->nv;
+  const double *H = w->L;
+  for (int i = n - 1; i >= 0; i--) {
+    const double *xi = X + 6 * i;
+    if (xi[0] == 0 && xi[1] == 0 && xi[2] == 0 && xi[3] == 0 && xi[4] == 0 && xi[5] == 0)
+      continue;
+    for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) {
+      double h = H[i * n + j], *xj = X + 6 * j;
+      for (int r = 0; r < 6; r++) xj[r] -= h * xi[r];
+    }
+  }
+  for (int i = 0; i < n; i++) {
+    double h = H[i * n + i];
+    for (int r = 0; r < 6; r++) X[6 * i + r] /= h;
+  }
+  for (int i = 0; i < n; i++)
+    for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) {
+      double h = H[i * n + j];
+      for (int r = 0; r < 6; r++) X[6 * i + r] -= h * X[6 * j + r];
+    }
+}
+
 /* ---------------------------------------------------------------------- */
 /* Jacobians                                                               */
 
@@ -452,6 +478,42 @@ static void closure_solve(const ssArtWork *w, double *z)
     double t = z[i];
     for (int k = i + 1; k < nr; k++) t -= A[k * nr + i] * z[k];
     z[i] = t / A[i * nr + i];
+  }
+}
+
+/* closure_solve on six columns at once, Z (nr x 6, row i = closure row
+ * i): the same operations per column in the same order */
+static void closure_solve6(const ssArtWork *w, double *Z)
+{
+  int nr = w->nrow;
+  const double *A = w->A;
+  for (int i = 0; i < nr; i++) {
+    double *zi = Z + 6 * i;
+    if (!w->row_on[i]) {
+      for (int r = 0; r < 6; r++) zi[r] = 0;
+      continue;
+    }
+    double t[6];
+    for (int r = 0; r < 6; r++) t[r] = zi[r];
+    for (int k = 0; k < i; k++) {
+      double a = A[i * nr + k];
+      for (int r = 0; r < 6; r++) t[r] -= a * Z[6 * k + r];
+    }
+    for (int r = 0; r < 6; r++) zi[r] = t[r] / A[i * nr + i];
+  }
+  for (int i = nr - 1; i >= 0; i--) {
+    double *zi = Z + 6 * i;
+    if (!w->row_on[i]) {
+      for (int r = 0; r < 6; r++) zi[r] = 0;
+      continue;
+    }
+    double t[6];
+    for (int r = 0; r < 6; r++) t[r] = zi[r];
+    for (int k = i + 1; k < nr; k++) {
+      double a = A[k * nr + i];
+      for (int r = 0; r < 6; r++) t[r] -= a * Z[6 * k + r];
+    }
+    for (int r = 0; r < 6; r++) zi[r] = t[r] / A[i * nr + i];
   }
 }
 
@@ -660,19 +722,18 @@ static void body_response(const ssModel *m, ssArtWork *w, int lb)
 {
   if (w->Yok[lb]) return;
   int n = w->nv, nr = w->nrow, b = w->b0 + lb;
-  double *Y = w->Y + (size_t)lb * n * 6, *col = w->x;
-  for (int r = 0; r < 6; r++) {
-    memset(col, 0, (size_t)n * sizeof(double));
-    for (int a = b; a >= 0; a = m->body_parent[a]) {
-      int nd = m->body_ndof[a];
-      if (!nd) continue;
-      int k0 = m->body_dofadr[a] - w->v0;
-      for (int k = k0; k < k0 + nd; k++) col[k] = w->S[6 * k + r];
-    }
-    ltdl_solve(w, col);
-    for (int k = 0; k < n; k++) Y[6 * k + r] = col[k];
+  double *Y = w->Y + (size_t)lb * n * 6;
+  /* J_b^T: the motion subspaces of b's path, the six columns solved at once */
+  memset(Y, 0, (size_t)n * 6 * sizeof(double));
+  for (int a = b; a >= 0; a = m->body_parent[a]) {
+    int nd = m->body_ndof[a];
+    if (!nd) continue;
+    int k0 = m->body_dofadr[a] - w->v0;
+    memcpy(Y + 6 * k0, w->S + 6 * k0, 6 * (size_t)nd * sizeof(double));
   }
+  ltdl_solve6(w, Y);
   if (nr) {
+    /* Z = (J_b MiKT)^T, row i = closure row i; then Y -= MiKT A^-1 Z */
     double *Z = w->Z;
     memset(Z, 0, 6 * (size_t)nr * sizeof(double));
     for (int a = b; a >= 0; a = m->body_parent[a]) {
@@ -681,18 +742,17 @@ static void body_response(const ssModel *m, ssArtWork *w, int lb)
       int k0 = m->body_dofadr[a] - w->v0;
       for (int k = k0; k < k0 + nd; k++) {
         const double *Sk = w->S + 6 * k, *Mk = w->MiKT + (size_t)k * nr;
-        for (int r = 0; r < 6; r++)
-          for (int i = 0; i < nr; i++) Z[r * nr + i] += Sk[r] * Mk[i];
+        for (int i = 0; i < nr; i++)
+          for (int r = 0; r < 6; r++) Z[6 * i + r] += Sk[r] * Mk[i];
       }
     }
-    for (int r = 0; r < 6; r++) closure_solve(w, Z + r * nr);
+    closure_solve6(w, Z);
     for (int k = 0; k < n; k++) {
       const double *Mk = w->MiKT + (size_t)k * nr;
-      for (int r = 0; r < 6; r++) {
-        double t = 0;
-        for (int i = 0; i < nr; i++) t += Mk[i] * Z[r * nr + i];
-        Y[6 * k + r] -= t;
-      }
+      double t[6] = {0, 0, 0, 0, 0, 0};
+      for (int i = 0; i < nr; i++)
+        for (int r = 0; r < 6; r++) t[r] += Mk[i] * Z[6 * i + r];
+      for (int r = 0; r < 6; r++) Y[6 * k + r] -= t[r];
     }
   }
   double *Lam = w->Lam + 36 * lb;
