@@ -503,7 +503,7 @@ static int evaluate(const ssModel *m, const ssData *d, const Setup *s,
  * velocities u the contacts' impulses give, each contact's law at its
  * velocity against the impulse it holds.  Returns max |law - lambda|_1
  * over max |lambda|_1 (the sweeps' measure), or INFINITY if a loaded point
- * sticks there. */
+ * sticks there or a difference is not finite. */
 static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonWork *w)
 {
   const double dt = m->opt.timestep;
@@ -514,6 +514,7 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
     to_group(G, V, w->sum[g].V);
   }
   double dmax = 0, lmax = 0;
+  int finite = 1;
   int gprev = -1;
   Mat M = {0};
   for (int i = 0; i < s->first_row; i++) {
@@ -527,8 +528,10 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
     if (point_law(&M, w->pt + i, w->sum[g].V, lam, NULL) == STICKS) return INFINITY;
     double dn = fabs(lam[0] - c->lambda[0]) + fabs(lam[1] - c->lambda[1]) + fabs(lam[2] - c->lambda[2]);
     double ln = fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]);
-    dmax = fmax(dmax, dn);
-    lmax = fmax(lmax, ln);
+    /* not fmax: a libm call here, and it would pass over a NaN */
+    finite &= isfinite(dn);
+    dmax = dn > dmax ? dn : dmax;
+    lmax = ln > lmax ? ln : lmax;
   }
   for (int r = 0; r < s->nrow; r++) {
     const ssContact *c = d->contact + s->first_row + r;
@@ -536,9 +539,12 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
     double l = c->row_a - c->row_b * v;
     if (l > c->row_bound) l = c->row_bound;
     if (l < -c->row_bound) l = -c->row_bound;
-    dmax = fmax(dmax, fabs(l - c->lambda[0]));
-    lmax = fmax(lmax, fabs(c->lambda[0]));
+    double dr = fabs(l - c->lambda[0]), lr = fabs(c->lambda[0]);
+    finite &= isfinite(dr);
+    dmax = dr > dmax ? dr : dmax;
+    lmax = lr > lmax ? lr : lmax;
   }
+  if (!finite) return INFINITY;
   return lmax > 0 ? dmax / lmax : 0;
 }
 
