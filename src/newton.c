@@ -160,34 +160,13 @@ static ssNewtonWork *work(ssData *d, int n, int nc, int nv, int ng)
 /* ---------------------------------------------------------------------- */
 /* the law in velocity form                                                */
 
-/* (1 + u)^a - 1 and expm1(-d) for |u| <= 1/256, |d| <= 1/1024: seven and
- * six terms leave a remainder below 1e-17 of the leading 1 */
-#define POW_SERIES_MAX (1.0 / 256)
-#define EXP_SERIES_MAX (1.0 / 1024)
-
-static inline double binom_m1(double a, double u)
-{
-  double t = a * u, sum = t;
-  t *= (a - 1) * u * 0.5;         sum += t;
-  t *= (a - 2) * u * (1.0 / 3);   sum += t;
-  t *= (a - 3) * u * 0.25;        sum += t;
-  t *= (a - 4) * u * 0.2;         sum += t;
-  t *= (a - 5) * u * (1.0 / 6);   sum += t;
-  t *= (a - 6) * u * (1.0 / 7);   sum += t;
-  return sum;
-}
-
-static inline double expm1_neg(double d)
-{
-  /* expm1(-d) = -d (1 - d/2 (1 - d/3 (1 - d/4 (1 - d/5 (1 - d/6))))) */
-  return -d * (1 - d * 0.5 * (1 - d * (1.0 / 3) * (1 - d * 0.25 * (1 - d * 0.2 * (1 - d * (1.0 / 6))))));
-}
+/* the series are ss_math.h's (shared with src/point.c) */
 
 /* s^(n-1) of point P, moved from its last value when near */
 static inline __attribute__((always_inline)) double pow_point(NPoint *P, double s, double m1)
 {
   double u = P->ps > 0 ? (s - P->ps) / P->ps : INFINITY, v;
-  if (fabs(u) <= POW_SERIES_MAX && fabs(m1) <= 3) v = P->pv + P->pv * binom_m1(m1, u);
+  if (fabs(u) <= SS_POW_SERIES_MAX && fabs(m1) <= 3) v = P->pv + P->pv * ss_pow1p_m1(m1, u);
   else v = pow(s, m1);
   P->ps = s;
   P->pv = v;
@@ -199,8 +178,8 @@ static inline __attribute__((always_inline)) double mobil_point(NPoint *P, doubl
 {
   double d = x - P->xa;
   if (d != 0) {
-    if (P->xa >= 0 && fabs(d) <= EXP_SERIES_MAX) {
-      double em1 = expm1_neg(d);
+    if (P->xa >= 0 && fabs(d) <= SS_EXP_SERIES_MAX) {
+      double em1 = ss_expm1_neg(d);
       P->ma -= P->ea * em1;
       P->ea += P->ea * em1;
     } else {

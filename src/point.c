@@ -1,6 +1,7 @@
 /* point.c -- the law of one contact inside the solver (point.h). */
 #include "point.h"
 #include "solver.h"
+#include "ss_math.h"
 
 #include <float.h>
 #include <math.h>
@@ -71,40 +72,21 @@
  * close together; the Janosi value at zero slip is formed only when a
  * stick test needs it. */
 
-static const double inv_k[] = {0, 1, 1.0 / 2, 1.0 / 3, 1.0 / 4, 1.0 / 5, 1.0 / 6,
-                               1.0 / 7, 1.0 / 8, 1.0 / 9, 1.0 / 10, 1.0 / 11,
-                               1.0 / 12, 1.0 / 13, 1.0 / 14, 1.0 / 15, 1.0 / 16,
-                               1.0 / 17, 1.0 / 18, 1.0 / 19, 1.0 / 20, 1.0 / 21};
-
-/* series terms are dropped once below this fraction of the leading 1 */
-#define SERIES_EPS 1e-18
-/* moves up to these are done by series, larger ones by libm (which costs
- * about as much as the longest series here) */
-#define SERIES_MAX (1.0 / 256)
-#define EXP_SERIES_MAX (1.0 / 1024)
+/* moves up to SS_POW_SERIES_MAX and SS_EXP_SERIES_MAX (ss_math.h) are done
+ * by series, larger ones by libm */
 
 /* the law of one point (ssLaw, solver.h): fixed during its solve, with the
  * cached power */
 typedef ssLaw Law;
 
-/* s^(n-1), from the last value by (1 + u)^(n-1) = sum C(n-1, k) u^k when
- * s = ps (1 + u) is near it: the binomial terms shrink by |u| each, so a few
- * suffice where pow would cost a log and an exp */
+/* s^(n-1), from the last value by (1 + u)^(n-1) when s = ps (1 + u) is near
+ * it: seven terms where pow would cost a log and an exp */
 static inline double pow_near(Law *L, double s)
 {
   double v;
   double u = L->ps > 0 ? (s - L->ps) / L->ps : INFINITY;
-  if (fabs(u) <= SERIES_MAX && fabs(L->m1) <= 3) {
-    double t = 1, sum = 0;
-    for (int k = 1; k <= 21; k++) {
-      t *= u * (L->m1 - (k - 1)) * inv_k[k];
-      sum += t;
-      if (fabs(t) <= SERIES_EPS) break;
-    }
-    v = L->pv + L->pv * sum;
-  } else {
-    v = pow(s, L->m1);
-  }
+  if (fabs(u) <= SS_POW_SERIES_MAX && fabs(L->m1) <= 3) v = L->pv + L->pv * ss_pow1p_m1(L->m1, u);
+  else v = pow(s, L->m1);
   L->ps = s;
   L->pv = v;
   return v;
@@ -339,13 +321,8 @@ static inline double mobil_at(Mobil *J, double sigma, double *e)
   }
   double x = J->x0 + J->r * sigma, d = x - J->xa;
   if (d != 0) {
-    if (J->xa >= 0 && fabs(d) <= EXP_SERIES_MAX) {
-      double t = 1, em1 = 0;
-      for (int k = 1; k <= 21; k++) {
-        t *= -d * inv_k[k];
-        em1 += t;
-        if (fabs(t) <= SERIES_EPS * fabs(em1)) break;
-      }
+    if (J->xa >= 0 && fabs(d) <= SS_EXP_SERIES_MAX) {
+      double em1 = ss_expm1_neg(d);
       J->ma -= J->ea * em1;
       J->ea += J->ea * em1;
     } else {

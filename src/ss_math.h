@@ -63,14 +63,17 @@ static inline void ss_m3_transpose(double R[9], const double A[9])
   double t[9] = {A[0], A[3], A[6], A[1], A[4], A[7], A[2], A[5], A[8]};
   memcpy(R, t, sizeof t);
 }
-/* Inverse of a general 3x3; returns the determinant (0: R untouched). */
+/* Inverse of a general 3x3; returns the determinant (0: singular, R = 0). */
 static inline double ss_m3_inv(double R[9], const double A[9])
 {
   double c0 = A[4] * A[8] - A[5] * A[7];
   double c1 = A[5] * A[6] - A[3] * A[8];
   double c2 = A[3] * A[7] - A[4] * A[6];
   double det = A[0] * c0 + A[1] * c1 + A[2] * c2;
-  if (det == 0) return 0;
+  if (det == 0) {
+    memset(R, 0, 9 * sizeof(double));
+    return 0;
+  }
   double id = 1.0 / det;
   double t[9] = {
     c0 * id, (A[2] * A[7] - A[1] * A[8]) * id, (A[1] * A[5] - A[2] * A[4]) * id,
@@ -119,6 +122,40 @@ static inline void ss_quat_from_axis_angle(double q[4], const double axis[3], do
 {
   double s = sin(0.5 * angle);
   q[0] = cos(0.5 * angle); q[1] = axis[0] * s; q[2] = axis[1] * s; q[3] = axis[2] * s;
+}
+
+/* Short series for functions moved a little from a known value (the soil
+ * law's s^(n-1) and Janosi exponential between the iterates of one point,
+ * src/point.c and src/newton.c): fixed length, no test per term. */
+
+/* (1 + u)^a - 1 for |u| <= SS_POW_SERIES_MAX, |a| <= 3: seven terms; the
+ * first one dropped, |C(a, 8)| u^8 <= 45 2^-64, is below 3e-18 of the
+ * leading 1, far under rounding.  The factors of the terms are independent,
+ * so only the running product is a chain. */
+#define SS_POW_SERIES_MAX (1.0 / 256)
+static inline double ss_pow1p_m1(double a, double u)
+{
+  double t = a * u, sum = t;
+  t *= (a - 1) * u * 0.5;         sum += t;
+  t *= (a - 2) * u * (1.0 / 3);   sum += t;
+  t *= (a - 3) * u * 0.25;        sum += t;
+  t *= (a - 4) * u * 0.2;         sum += t;
+  t *= (a - 5) * u * (1.0 / 6);   sum += t;
+  t *= (a - 6) * u * (1.0 / 7);   sum += t;
+  return sum;
+}
+
+/* expm1(-d) for |d| <= SS_EXP_SERIES_MAX: six terms (the first dropped,
+ * d^7/7!, is below 2e-22 of |d|), summed in pairs (Estrin) so that the
+ * chain of dependent operations is short */
+#define SS_EXP_SERIES_MAX (1.0 / 1024)
+static inline double ss_expm1_neg(double d)
+{
+  double d2 = d * d, d3 = d2 * d;
+  double p01 = d * (-1 + d * 0.5);
+  double p23 = -1.0 / 6 + d * (1.0 / 24);
+  double p45 = -1.0 / 120 + d * (1.0 / 720);
+  return p01 + d3 * (p23 + d2 * p45);
 }
 
 #endif /* SS_MATH_H */
