@@ -811,7 +811,10 @@ static void print_summary(const Options *o, const ssModel *m, const ssData *d,
   else
     printf("wall time   %.3f s\n", wall);
   if (steps > 0) {
-    printf("sweeps      %d (last step)", d->stats.sweeps);
+    printf("sweeps      %d", d->stats.sweeps);
+    if (d->stats.newton > 0)
+      printf(" after %d Newton iteration%s", d->stats.newton, d->stats.newton == 1 ? "" : "s");
+    printf(" (last step)");
     if (unconverged)
       printf("; %ld step%s stopped at the sweep cap", unconverged,
              unconverged == 1 ? "" : "s");

@@ -252,6 +252,12 @@ else
   skip "script(1) cannot make a terminal here"
 fi
 
+# The summary names the last step's sweeps and Newton iterations (the
+# settling plate: the Newton phase solves it and leaves no sweeps).
+run "$PLATE" --steps 50
+check "the summary reports the last step's sweeps and Newton iterations" \
+  'rc_is 0 && out_has "sweeps      0 after 1 Newton iteration (last step)"'
+
 # An existing output file is replaced whole.
 echo "old" >"$tmp/old.xml"
 run "$PLATE" --steps 10 --export "$tmp/old.xml" --quiet
