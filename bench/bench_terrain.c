@@ -26,6 +26,7 @@ typedef struct Opt {
   int bed_scale;        /* the bed's side times this (area x scale^2) */
   const char *csv, *scene;
   int verify;
+  int sweeps_only;      /* --solver=sweeps: the Gauss-Seidel sweeps alone */
 } Opt;
 
 static double now(void)
@@ -146,6 +147,7 @@ static Run run_body(const Opt *o)
     return r;
   }
   m->opt.terrain_warm_start = o->warm;
+  d->solver_gs_only = o->sweeps_only;
   ssError e;
   for (int k = 0; k < o->warmup; k++) {
     if (ss_step(m, d, &e) != SS_OK) {
@@ -205,15 +207,17 @@ static int bench_bodies(const Opt *o)
   int buggy = !strcmp(o->body, "buggy");
   double s_ref = 8.175e-3, err = buggy ? 0 : (last.sinkage - s_ref) / s_ref;
   double ns_point = last.points > 0 ? 1e6 * med / last.points : 0;
-  printf("%-12s %-5s %6d steps x %d: %9.4f ms/step  %8.1f ns/point/step  %5.2f sweeps + "
+  printf("%-12s %-5s%s %6d steps x %d: %9.4f ms/step  %8.1f ns/point/step  %5.2f sweeps + "
          "%4.2f Newton/step  %7.1f loaded points",
-         o->body, o->warm ? "warm" : "cold", o->steps, o->repeats, med, ns_point,
+         o->body, o->warm ? "warm" : "cold", o->sweeps_only ? " (sweeps only)" : "", o->steps,
+         o->repeats, med, ns_point,
          last.sweeps, last.newton, last.points);
   if (buggy)
     printf("  real-time factor %.3f\n", last.dt / (1e-3 * med));
   else
     printf("  sinkage %.4f mm (analytic 8.175, error %+.3f %%)\n", last.sinkage * 1e3, 100 * err);
-  csv_row(o, "body", med, ns_point, last.sweeps, last.newton, err);
+  csv_row(o, o->sweeps_only ? "body_sweeps_only" : "body", med, ns_point, last.sweeps,
+          last.newton, err);
   if (o->verify && !buggy) {
     /* warm and cold starts reach the same converged answer */
     Opt other = *o;
@@ -344,7 +348,7 @@ static int bench_contact_law(const Opt *o)
 
 int bench_terrain(int argc, char **argv)
 {
-  Opt o = {"rigid", 1, 0, 0, 0, 5, 0, 1, NULL, NULL, 0};
+  Opt o = {"rigid", 1, 0, 0, 0, 5, 0, 1, NULL, NULL, 0, 0};
   for (int i = 0; i < argc; i++) {
     const char *a = argv[i];
     if (!strcmp(a, "--")) continue;
@@ -361,12 +365,15 @@ int bench_terrain(int argc, char **argv)
     else if (!strncmp(a, "--csv=", 6)) o.csv = a + 6;
     else if (!strncmp(a, "--scene=", 8)) o.scene = a + 8;
     else if (!strcmp(a, "--verify")) o.verify = 1;
+    else if (!strcmp(a, "--solver=sweeps")) o.sweeps_only = 1;
+    else if (!strcmp(a, "--solver=newton")) o.sweeps_only = 0;
     else if (!strcmp(a, "--raisim") || !strcmp(a, "--soilsim")) continue;
     else {
       fprintf(stderr, "benchmarks: unknown option '%s'\n"
                       "options: --body=rigid|articulated|pinned|multilink|buggy "
                       "--start=warm|cold --contact-law --material=linear|nonlinear "
-                      "--steps=N --repeats=R --warmup=N --bed-scale=K --csv=FILE --scene=FILE --verify\n", a);
+                      "--steps=N --repeats=R --warmup=N --bed-scale=K --csv=FILE --scene=FILE --verify "
+                      "--solver=newton|sweeps\n", a);
       return 2;
     }
   }

@@ -22,6 +22,8 @@ check --contact-law --material=linear --steps=300 --repeats=1
 check --contact-law --material=nonlinear --steps=300 --repeats=1
 check --contact-law --material=nonlinear --start=cold --steps=300 --repeats=1
 check --body=rigid --steps=1500 --repeats=1 --verify
+# the sweeps alone (the solver where the Newton phase declines)
+check --body=rigid --solver=sweeps --steps=1500 --repeats=1 --verify
 check --body=articulated --steps=1500 --repeats=1 --verify
 check --body=multilink --steps=1500 --repeats=1 --verify
 # the same plate on a 100x larger bed (the step's cost must not notice it),
