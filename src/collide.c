@@ -251,6 +251,117 @@ void ss_shape_aabb(const ssShape *s, double lo[3], double hi[3])
   }
 }
 
+/* [lo, hi] widened to hold the product of scalar k and interval [a, b] */
+static void add_scaled(double k, double a, double b, double *lo, double *hi)
+{
+  double p = k * a, q = k * b;
+  *lo += fmin(p, q);
+  *hi += fmax(p, q);
+}
+
+int ss_shape_low_bounds(const ssShape *s, double zc, double lo[2], double hi[2])
+{
+  const double *R = s->R, *c = s->pos;
+  double e = fabs(s->size[0]) + fabs(s->size[1]) + fabs(s->size[2]);
+  /* slack far above round-off: widens zc, then the bounds */
+  zc += 1e-9 * (1 + fabs(zc) + fabs(c[2]) + e);
+  double pad = 1e-9 * (1 + fabs(c[0]) + fabs(c[1]) + e);
+
+  switch (s->type) {
+  case SS_GEOM_BOX: {
+    /* corners at or below zc and the points where edges cross it */
+    double p[8][3];
+    int any = 0;
+    lo[0] = lo[1] = INFINITY;
+    hi[0] = hi[1] = -INFINITY;
+    for (int i = 0; i < 8; i++) {
+      double l[3] = {(i & 1) ? 0.5 * s->size[0] : -0.5 * s->size[0],
+                     (i & 2) ? 0.5 * s->size[1] : -0.5 * s->size[1],
+                     (i & 4) ? 0.5 * s->size[2] : -0.5 * s->size[2]};
+      ss_m3_mulv(p[i], R, l);
+      ss_v3_add(p[i], p[i], c);
+    }
+    for (int i = 0; i < 8; i++) {
+      if (p[i][2] <= zc) {
+        any = 1;
+        for (int k = 0; k < 2; k++) {
+          lo[k] = fmin(lo[k], p[i][k]);
+          hi[k] = fmax(hi[k], p[i][k]);
+        }
+      }
+      for (int bit = 1; bit < 8; bit <<= 1) {
+        int j = i ^ bit;
+        if (j < i || (p[i][2] <= zc) == (p[j][2] <= zc)) continue;
+        double t = (zc - p[i][2]) / (p[j][2] - p[i][2]);
+        for (int k = 0; k < 2; k++) {
+          double x = p[i][k] + t * (p[j][k] - p[i][k]);
+          lo[k] = fmin(lo[k], x);
+          hi[k] = fmax(hi[k], x);
+        }
+      }
+    }
+    if (!any) return 0;
+    break;
+  }
+  case SS_GEOM_SPHERE:
+  case SS_GEOM_CAPSULE: {
+    /* centre segment c + t a (|t| <= hl) swept by a ball of radius r: only
+     * segment points within r above zc matter, and the ball's slice below
+     * zc is widest about the lowest of them */
+    double r = s->size[0], hl = s->type == SS_GEOM_CAPSULE ? 0.5 * s->size[1] : 0;
+    double a[3] = {R[2], R[5], R[8]}, t0 = -hl, t1 = hl;
+    double lim = zc + r - c[2];
+    if (a[2] > 0) t1 = fmin(t1, lim / a[2]);
+    else if (a[2] < 0) t0 = fmax(t0, lim / a[2]);
+    else if (lim < 0) return 0;
+    if (!(t0 <= t1)) return 0;
+    double h = c[2] + fmin(t0 * a[2], t1 * a[2]) - zc;
+    double rho = h <= 0 ? r : sqrt(fmax(0.0, r * r - h * h));
+    for (int k = 0; k < 2; k++) {
+      lo[k] = c[k] - rho;
+      hi[k] = c[k] + rho;
+      add_scaled(a[k], t0, t1, &lo[k], &hi[k]);
+    }
+    break;
+  }
+  case SS_GEOM_CYLINDER: {
+    /* points c + t a + al w + be b (|t| <= hl, al^2 + be^2 <= r^2) with w
+     * horizontal, so their height is c_z + t a_z + be b_z */
+    double r = s->size[0], hl = 0.5 * s->size[1];
+    double a[3] = {R[2], R[5], R[8]}, w[3], b[3];
+    axis_side(a, w);
+    ss_v3_cross(b, a, w);
+    if (b[2] < 0) ss_v3_scale(b, b, -1);
+    double t0 = -hl, t1 = hl, lim = zc + r * b[2] - c[2];
+    if (a[2] > 0) t1 = fmin(t1, lim / a[2]);
+    else if (a[2] < 0) t0 = fmax(t0, lim / a[2]);
+    else if (lim < 0) return 0;
+    if (!(t0 <= t1)) return 0;
+    /* be stays below bh; al within the disc's chord nearest the centre */
+    double bh = r, al = r;
+    if (b[2] > 0) {
+      bh = fmin(r, (zc - c[2] - fmin(t0 * a[2], t1 * a[2])) / b[2]);
+      if (bh < 0) al = sqrt(fmax(0.0, r * r - bh * bh));
+      bh = fmax(bh, -r);
+    }
+    for (int k = 0; k < 2; k++) {
+      lo[k] = c[k] - al * fabs(w[k]);
+      hi[k] = c[k] + al * fabs(w[k]);
+      add_scaled(a[k], t0, t1, &lo[k], &hi[k]);
+      add_scaled(b[k], -r, bh, &lo[k], &hi[k]);
+    }
+    break;
+  }
+  default:
+    return 0;
+  }
+  for (int k = 0; k < 2; k++) {
+    lo[k] -= pad;
+    hi[k] += pad;
+  }
+  return 1;
+}
+
 /* ---------------------------------------------------------------------- */
 /* polygons                                                                */
 

@@ -37,6 +37,11 @@ typedef struct ssPoly2 {
 void ss_shape_footprint(const ssShape *s, ssPoly2 *out);
 /* Axis-aligned bounds of the shape in the frame. */
 void ss_shape_aabb(const ssShape *s, double lo[3], double hi[3]);
+/* Bounds in x and y of the part of the shape at or below height zc: no
+ * point of the shape outside [lo, hi] lies at or below zc.  Conservative
+ * (may be wider, and zc is widened by a relative 1e-9 for round-off).
+ * Returns 0 when no part of the shape lies at or below zc. */
+int ss_shape_low_bounds(const ssShape *s, double zc, double lo[2], double hi[2]);
 /* Signed area of a polygon (positive when counter-clockwise). */
 double ss_poly_area(const ssPoly2 *p);
 /* Area of (convex polygon) ∩ [x0,x1]×[y0,y1], exact (clipping).  When the

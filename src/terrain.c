@@ -149,7 +149,18 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
   double lo[3], hi[3];
   ss_shape_aabb(&s, lo, hi);
   double margin = geom_margin(m, d, g, sys);
-  if (lo[2] > m->hfield_zrange[2 * h + 1] + margin) return SS_OK;
+  double ztop = m->hfield_zrange[2 * h + 1];
+  if (lo[2] > ztop + margin) return SS_OK;
+  /* no bed vertex lies above the bed's top (plastic sinkage only lowers
+   * it), so a cell can give a point only where the collider reaches below
+   * the top plus the margin: a wheel's contact patch, not its whole
+   * footprint (the cells beyond would be visited only to be dropped) */
+  double blo[2], bhi[2];
+  if (!ss_shape_low_bounds(&s, ztop + margin, blo, bhi)) return SS_OK;
+  for (int k = 0; k < 2; k++) {
+    lo[k] = fmax(lo[k], blo[k]);
+    hi[k] = fmin(hi[k], bhi[k]);
+  }
 
   int nx = m->hfield_nx[h], ny = m->hfield_ny[h], adr = m->hfield_adr[h];
   double xs = m->hfield_size[2 * h], ys = m->hfield_size[2 * h + 1];
