@@ -721,6 +721,42 @@ static void test_aabb(void)
   }
 }
 
+/* the bounds of a shape's part below a height hold every vertical line
+ * through the shape that reaches that low, and are tight for a wheel */
+static void test_low_bounds(void)
+{
+  double R[9], lo[2], hi[2];
+  for (int type = SS_GEOM_BOX; type <= SS_GEOM_CAPSULE; type++) {
+    int outside = 0, empty_wrong = 0;
+    for (int t = 0; t < 40; t++) {
+      rot_random(R);
+      if (t < 10) rot_wheel(R, urand(0, PI), urand(0, PI));
+      ssShape s = make_shape(type, 0.3, 0.5, 0.2, 1, 2, 3, R);
+      double alo[3], ahi[3];
+      ss_shape_aabb(&s, alo, ahi);
+      double zc = urand(alo[2] - 0.05, ahi[2]);
+      int any = ss_shape_low_bounds(&s, zc, lo, hi);
+      for (int i = 0; i < 4000; i++) {
+        double x = urand(alo[0], ahi[0]), y = urand(alo[1], ahi[1]), z;
+        if (!ss_shape_lowest_z(&s, x, y, &z) || z > zc) continue;
+        if (!any) empty_wrong++;
+        else if (x < lo[0] || x > hi[0] || y < lo[1] || y > hi[1]) outside++;
+      }
+    }
+    ok(outside == 0 && empty_wrong == 0, "type %d: points at or below zc lie in "
+       "the low bounds (%d outside, %d missed)", type, outside, empty_wrong);
+  }
+  /* a wheel of radius 0.3 rolling along x, 1 cm below zc: chord 2 sqrt(0.3^2 - 0.29^2) */
+  rot_wheel(R, 0, 0.7);
+  ssShape w = make_shape(SS_GEOM_CYLINDER, 0.3, 0.2, 0, 0, 0, 0.3, R);
+  int any = ss_shape_low_bounds(&w, 0.01, lo, hi);
+  double half = sqrt(0.3 * 0.3 - 0.29 * 0.29), l0 = fmin(hi[0] - lo[0], hi[1] - lo[1]);
+  double l1 = fmax(hi[0] - lo[0], hi[1] - lo[1]);
+  ok(any && fabs(l0 - 2 * half) < 1e-6 && fabs(l1 - 0.2) < 1e-6,
+     "wheel's low bounds: its contact chord by its tread (%.6g x %.6g)", l0, l1);
+  ok(!ss_shape_low_bounds(&w, -0.01, lo, hi), "wheel above zc: no low bounds");
+}
+
 int main(void)
 {
   test_plate_quadrature();
@@ -731,5 +767,6 @@ int main(void)
   test_candidates();
   test_width();
   test_aabb();
+  test_low_bounds();
   return done_testing();
 }
