@@ -386,56 +386,138 @@ static inline int put_cut(double *oc, double *oo, int m, double b, double pc,
 
 /* Sutherland-Hodgman against the slab lo <= c <= hi in one pass (c is x or
  * y, o the other coordinate): each edge P -> Q contributes its part inside
- * the slab.  Input is shifted by (-offc, -offo) as it is read. */
-static int clip_slab(const double *ic, const double *io, int n, double offc,
-                     double offo, double *oc, double *oo, double lo, double hi)
+ * the slab.  Input is shifted by (-offc, -offo) as it is read.  Only the
+ * edges j (ending at vertex j) in the ascending ranges [rg[2r], rg[2r+1])
+ * are visited: the others must contribute nothing, so that the output is
+ * that of visiting all n. */
+static int clip_slab(const double *ic, const double *io, int n, const int *rg,
+                     int nr, double offc, double offo, double *oc, double *oo,
+                     double lo, double hi)
 {
   int m = 0;
   if (n <= 0) return 0;
-  double pc = ic[n - 1] - offc, po = io[n - 1] - offo;
-  for (int j = 0; j < n && m <= CLIP_MAX - 2; j++) {
-    double qc = ic[j] - offc, qo = io[j] - offo;
-    if (qc >= lo && qc <= hi) {
-      /* entering (unless Q itself is the entry), then Q */
-      if (pc < lo && qc > lo) m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
-      else if (pc > hi && qc < hi) m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
-      oc[m] = qc;
-      oo[m] = qo;
-      m++;
-    } else if (qc < lo) {
-      /* leaving below (unless P itself was the exit), maybe crossing all */
-      if (pc > hi) {
-        m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
-        m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
-      } else if (pc > lo) {
-        m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
+  for (int r = 0; r < nr; r++) {
+    int j = rg[2 * r], pj = j > 0 ? j - 1 : n - 1;
+    double pc = ic[pj] - offc, po = io[pj] - offo;
+    for (; j < rg[2 * r + 1] && m <= CLIP_MAX - 2; j++) {
+      double qc = ic[j] - offc, qo = io[j] - offo;
+      if (qc >= lo && qc <= hi) {
+        /* entering (unless Q itself is the entry), then Q */
+        if (pc < lo && qc > lo) m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
+        else if (pc > hi && qc < hi) m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
+        oc[m] = qc;
+        oo[m] = qo;
+        m++;
+      } else if (qc < lo) {
+        /* leaving below (unless P itself was the exit), maybe crossing all */
+        if (pc > hi) {
+          m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
+          m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
+        } else if (pc > lo) {
+          m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
+        }
+      } else {
+        /* leaving above, likewise */
+        if (pc < lo) {
+          m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
+          m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
+        } else if (pc < hi) {
+          m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
+        }
       }
-    } else {
-      /* leaving above, likewise */
-      if (pc < lo) {
-        m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
-        m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
-      } else if (pc < hi) {
-        m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
-      }
+      pc = qc;
+      po = qo;
     }
-    pc = qc;
-    po = qo;
   }
   return m;
 }
 
-double ss_poly_rect_area(const ssPoly2 *p, double x0, double x1, double y0,
-                         double y1, double *cx, double *cy)
+int ss_poly_xchains(const ssPoly2 *p, int ends[2])
+{
+  int n = p->n, l = 0, r = 0;
+  if (n < 3) return 0;
+  for (int i = 1; i < n; i++) {
+    if (p->x[i] < p->x[l]) l = i;
+    if (p->x[i] > p->x[r]) r = i;
+  }
+  if (l == r) return 0;
+  /* x must not fall from l to r, nor rise from r back to l */
+  for (int i = l; i != r;) {
+    int k = i + 1 < n ? i + 1 : 0;
+    if (p->x[k] < p->x[i]) return 0;
+    i = k;
+  }
+  for (int i = r; i != l;) {
+    int k = i + 1 < n ? i + 1 : 0;
+    if (p->x[k] > p->x[i]) return 0;
+    i = k;
+  }
+  ends[0] = l;
+  ends[1] = r;
+  return 1;
+}
+
+/* first k in [0, cnt) where sgn (x[start + k] - v) >= 0 (> 0 when
+ * strict), indices modulo n; cnt when none.  sgn x is non-decreasing
+ * along the chain. */
+static int chain_search(const double *x, int n, int start, int cnt, double v,
+                        double sgn, int strict)
+{
+  int a = 0, b = cnt;
+  while (a < b) {
+    int mid = (a + b) / 2, i = start + mid;
+    if (i >= n) i -= n;
+    double dv = sgn * (x[i] - v);
+    if (strict ? dv > 0 : dv >= 0) b = mid;
+    else a = mid + 1;
+  }
+  return a;
+}
+
+/* the edges (index of their end vertex) of chain start -> start + cnt whose
+ * x range meets [x0, x1], as up to two ascending index ranges */
+static int chain_edges(const ssPoly2 *p, int start, int cnt, double sgn,
+                       double x0, double x1, int *rg)
+{
+  int n = p->n, s1 = start + 1 < n ? start + 1 : 0;
+  /* sgn = 1: x rises along the chain; edge k runs from vertex k to k + 1 */
+  double enter = sgn > 0 ? x0 : x1, leave = sgn > 0 ? x1 : x0;
+  int k0 = chain_search(p->x, n, s1, cnt, enter, sgn, 0);
+  int k1 = chain_search(p->x, n, start, cnt, leave, sgn, 1);
+  if (k1 <= k0) return 0;
+  int a = s1 + k0;
+  if (a >= n) a -= n;
+  int b = a + (k1 - k0);
+  if (b <= n) {
+    rg[0] = a;
+    rg[1] = b;
+    return 1;
+  }
+  rg[0] = a;
+  rg[1] = n;
+  rg[2] = 0;
+  rg[3] = b - n;
+  return 2;
+}
+
+/* area and centroid of p clipped to the rectangle: x first, visiting the
+ * edge ranges rg (or all edges when nr < 0), then y */
+static double rect_area(const ssPoly2 *p, const int *rg, int nr, double x0,
+                        double x1, double y0, double y1, double *cx, double *cy)
 {
   double ax[CLIP_MAX], ay[CLIP_MAX], bx[CLIP_MAX], by[CLIP_MAX];
-  if (p->n < 3 || !(x1 > x0) || !(y1 > y0)) return 0;
+  int all[2] = {0, p->n};
+  if (nr < 0) {
+    rg = all;
+    nr = 1;
+  }
 
   /* work about the rectangle's centre: small numbers, exact corners */
   double mx = 0.5 * (x0 + x1), my = 0.5 * (y0 + y1);
-  int n = clip_slab(p->x, p->y, p->n, mx, my, ax, ay, x0 - mx, x1 - mx);
+  int n = clip_slab(p->x, p->y, p->n, rg, nr, mx, my, ax, ay, x0 - mx, x1 - mx);
   if (n < 3) return 0;
-  n = clip_slab(ay, ax, n, 0, 0, by, bx, y0 - my, y1 - my);
+  all[1] = n;
+  n = clip_slab(ay, ax, n, all, 1, 0, 0, by, bx, y0 - my, y1 - my);
   if (n < 3) return 0;
 
   /* shoelace area and centroid */
@@ -452,6 +534,39 @@ double ss_poly_rect_area(const ssPoly2 *p, double x0, double x1, double y0,
     *cy = my + sy / (3 * a2);
   }
   return fabs(0.5 * a2);
+}
+
+double ss_poly_rect_area(const ssPoly2 *p, double x0, double x1, double y0,
+                         double y1, double *cx, double *cy)
+{
+  if (p->n < 3 || !(x1 > x0) || !(y1 > y0)) return 0;
+  return rect_area(p, NULL, -1, x0, x1, y0, y1, cx, cy);
+}
+
+double ss_poly_rect_area_x(const ssPoly2 *p, const int ends[2], double x0,
+                           double x1, double y0, double y1, double *cx,
+                           double *cy)
+{
+  if (p->n < 3 || !(x1 > x0) || !(y1 > y0)) return 0;
+  /* the edges whose x range meets the slab widened far beyond round-off:
+   * every edge the clip would take something from (it compares x - mx
+   * with x0 - mx) */
+  int n = p->n, l = ends[0], r = ends[1], rg[8], nr = 0;
+  double tol = 1e-9 * (fabs(x0) + fabs(x1));
+  double lo = x0 - tol, hi = x1 + tol;
+  nr += chain_edges(p, l, (r - l + n) % n, 1, lo, hi, rg);
+  nr += chain_edges(p, r, (l - r + n) % n, -1, lo, hi, rg + 2 * nr);
+  if (nr == 0) return 0;
+  /* ascending, as the clip visits them */
+  for (int i = 1; i < nr; i++)
+    for (int k = i; k > 0 && rg[2 * k - 2] > rg[2 * k]; k--) {
+      int a = rg[2 * k - 2], b = rg[2 * k - 1];
+      rg[2 * k - 2] = rg[2 * k];
+      rg[2 * k - 1] = rg[2 * k + 1];
+      rg[2 * k] = a;
+      rg[2 * k + 1] = b;
+    }
+  return rect_area(p, rg, nr, x0, x1, y0, y1, cx, cy);
 }
 
 int ss_poly_chord(const ssPoly2 *p, double y, double *x0, double *x1)
