@@ -251,6 +251,117 @@ void ss_shape_aabb(const ssShape *s, double lo[3], double hi[3])
   }
 }
 
+/* [lo, hi] widened to hold the product of scalar k and interval [a, b] */
+static void add_scaled(double k, double a, double b, double *lo, double *hi)
+{
+  double p = k * a, q = k * b;
+  *lo += fmin(p, q);
+  *hi += fmax(p, q);
+}
+
+int ss_shape_low_bounds(const ssShape *s, double zc, double lo[2], double hi[2])
+{
+  const double *R = s->R, *c = s->pos;
+  double e = fabs(s->size[0]) + fabs(s->size[1]) + fabs(s->size[2]);
+  /* slack far above round-off: widens zc, then the bounds */
+  zc += 1e-9 * (1 + fabs(zc) + fabs(c[2]) + e);
+  double pad = 1e-9 * (1 + fabs(c[0]) + fabs(c[1]) + e);
+
+  switch (s->type) {
+  case SS_GEOM_BOX: {
+    /* corners at or below zc and the points where edges cross it */
+    double p[8][3];
+    int any = 0;
+    lo[0] = lo[1] = INFINITY;
+    hi[0] = hi[1] = -INFINITY;
+    for (int i = 0; i < 8; i++) {
+      double l[3] = {(i & 1) ? 0.5 * s->size[0] : -0.5 * s->size[0],
+                     (i & 2) ? 0.5 * s->size[1] : -0.5 * s->size[1],
+                     (i & 4) ? 0.5 * s->size[2] : -0.5 * s->size[2]};
+      ss_m3_mulv(p[i], R, l);
+      ss_v3_add(p[i], p[i], c);
+    }
+    for (int i = 0; i < 8; i++) {
+      if (p[i][2] <= zc) {
+        any = 1;
+        for (int k = 0; k < 2; k++) {
+          lo[k] = fmin(lo[k], p[i][k]);
+          hi[k] = fmax(hi[k], p[i][k]);
+        }
+      }
+      for (int bit = 1; bit < 8; bit <<= 1) {
+        int j = i ^ bit;
+        if (j < i || (p[i][2] <= zc) == (p[j][2] <= zc)) continue;
+        double t = (zc - p[i][2]) / (p[j][2] - p[i][2]);
+        for (int k = 0; k < 2; k++) {
+          double x = p[i][k] + t * (p[j][k] - p[i][k]);
+          lo[k] = fmin(lo[k], x);
+          hi[k] = fmax(hi[k], x);
+        }
+      }
+    }
+    if (!any) return 0;
+    break;
+  }
+  case SS_GEOM_SPHERE:
+  case SS_GEOM_CAPSULE: {
+    /* centre segment c + t a (|t| <= hl) swept by a ball of radius r: only
+     * segment points within r above zc matter, and the ball's slice below
+     * zc is widest about the lowest of them */
+    double r = s->size[0], hl = s->type == SS_GEOM_CAPSULE ? 0.5 * s->size[1] : 0;
+    double a[3] = {R[2], R[5], R[8]}, t0 = -hl, t1 = hl;
+    double lim = zc + r - c[2];
+    if (a[2] > 0) t1 = fmin(t1, lim / a[2]);
+    else if (a[2] < 0) t0 = fmax(t0, lim / a[2]);
+    else if (lim < 0) return 0;
+    if (!(t0 <= t1)) return 0;
+    double h = c[2] + fmin(t0 * a[2], t1 * a[2]) - zc;
+    double rho = h <= 0 ? r : sqrt(fmax(0.0, r * r - h * h));
+    for (int k = 0; k < 2; k++) {
+      lo[k] = c[k] - rho;
+      hi[k] = c[k] + rho;
+      add_scaled(a[k], t0, t1, &lo[k], &hi[k]);
+    }
+    break;
+  }
+  case SS_GEOM_CYLINDER: {
+    /* points c + t a + al w + be b (|t| <= hl, al^2 + be^2 <= r^2) with w
+     * horizontal, so their height is c_z + t a_z + be b_z */
+    double r = s->size[0], hl = 0.5 * s->size[1];
+    double a[3] = {R[2], R[5], R[8]}, w[3], b[3];
+    axis_side(a, w);
+    ss_v3_cross(b, a, w);
+    if (b[2] < 0) ss_v3_scale(b, b, -1);
+    double t0 = -hl, t1 = hl, lim = zc + r * b[2] - c[2];
+    if (a[2] > 0) t1 = fmin(t1, lim / a[2]);
+    else if (a[2] < 0) t0 = fmax(t0, lim / a[2]);
+    else if (lim < 0) return 0;
+    if (!(t0 <= t1)) return 0;
+    /* be stays below bh; al within the disc's chord nearest the centre */
+    double bh = r, al = r;
+    if (b[2] > 0) {
+      bh = fmin(r, (zc - c[2] - fmin(t0 * a[2], t1 * a[2])) / b[2]);
+      if (bh < 0) al = sqrt(fmax(0.0, r * r - bh * bh));
+      bh = fmax(bh, -r);
+    }
+    for (int k = 0; k < 2; k++) {
+      lo[k] = c[k] - al * fabs(w[k]);
+      hi[k] = c[k] + al * fabs(w[k]);
+      add_scaled(a[k], t0, t1, &lo[k], &hi[k]);
+      add_scaled(b[k], -r, bh, &lo[k], &hi[k]);
+    }
+    break;
+  }
+  default:
+    return 0;
+  }
+  for (int k = 0; k < 2; k++) {
+    lo[k] -= pad;
+    hi[k] += pad;
+  }
+  return 1;
+}
+
 /* ---------------------------------------------------------------------- */
 /* polygons                                                                */
 
@@ -275,56 +386,138 @@ static inline int put_cut(double *oc, double *oo, int m, double b, double pc,
 
 /* Sutherland-Hodgman against the slab lo <= c <= hi in one pass (c is x or
  * y, o the other coordinate): each edge P -> Q contributes its part inside
- * the slab.  Input is shifted by (-offc, -offo) as it is read. */
-static int clip_slab(const double *ic, const double *io, int n, double offc,
-                     double offo, double *oc, double *oo, double lo, double hi)
+ * the slab.  Input is shifted by (-offc, -offo) as it is read.  Only the
+ * edges j (ending at vertex j) in the ascending ranges [rg[2r], rg[2r+1])
+ * are visited: the others must contribute nothing, so that the output is
+ * that of visiting all n. */
+static int clip_slab(const double *ic, const double *io, int n, const int *rg,
+                     int nr, double offc, double offo, double *oc, double *oo,
+                     double lo, double hi)
 {
   int m = 0;
   if (n <= 0) return 0;
-  double pc = ic[n - 1] - offc, po = io[n - 1] - offo;
-  for (int j = 0; j < n && m <= CLIP_MAX - 2; j++) {
-    double qc = ic[j] - offc, qo = io[j] - offo;
-    if (qc >= lo && qc <= hi) {
-      /* entering (unless Q itself is the entry), then Q */
-      if (pc < lo && qc > lo) m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
-      else if (pc > hi && qc < hi) m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
-      oc[m] = qc;
-      oo[m] = qo;
-      m++;
-    } else if (qc < lo) {
-      /* leaving below (unless P itself was the exit), maybe crossing all */
-      if (pc > hi) {
-        m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
-        m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
-      } else if (pc > lo) {
-        m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
+  for (int r = 0; r < nr; r++) {
+    int j = rg[2 * r], pj = j > 0 ? j - 1 : n - 1;
+    double pc = ic[pj] - offc, po = io[pj] - offo;
+    for (; j < rg[2 * r + 1] && m <= CLIP_MAX - 2; j++) {
+      double qc = ic[j] - offc, qo = io[j] - offo;
+      if (qc >= lo && qc <= hi) {
+        /* entering (unless Q itself is the entry), then Q */
+        if (pc < lo && qc > lo) m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
+        else if (pc > hi && qc < hi) m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
+        oc[m] = qc;
+        oo[m] = qo;
+        m++;
+      } else if (qc < lo) {
+        /* leaving below (unless P itself was the exit), maybe crossing all */
+        if (pc > hi) {
+          m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
+          m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
+        } else if (pc > lo) {
+          m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
+        }
+      } else {
+        /* leaving above, likewise */
+        if (pc < lo) {
+          m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
+          m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
+        } else if (pc < hi) {
+          m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
+        }
       }
-    } else {
-      /* leaving above, likewise */
-      if (pc < lo) {
-        m = put_cut(oc, oo, m, lo, pc, po, qc, qo);
-        m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
-      } else if (pc < hi) {
-        m = put_cut(oc, oo, m, hi, pc, po, qc, qo);
-      }
+      pc = qc;
+      po = qo;
     }
-    pc = qc;
-    po = qo;
   }
   return m;
 }
 
-double ss_poly_rect_area(const ssPoly2 *p, double x0, double x1, double y0,
-                         double y1, double *cx, double *cy)
+int ss_poly_xchains(const ssPoly2 *p, int ends[2])
+{
+  int n = p->n, l = 0, r = 0;
+  if (n < 3) return 0;
+  for (int i = 1; i < n; i++) {
+    if (p->x[i] < p->x[l]) l = i;
+    if (p->x[i] > p->x[r]) r = i;
+  }
+  if (l == r) return 0;
+  /* x must not fall from l to r, nor rise from r back to l */
+  for (int i = l; i != r;) {
+    int k = i + 1 < n ? i + 1 : 0;
+    if (p->x[k] < p->x[i]) return 0;
+    i = k;
+  }
+  for (int i = r; i != l;) {
+    int k = i + 1 < n ? i + 1 : 0;
+    if (p->x[k] > p->x[i]) return 0;
+    i = k;
+  }
+  ends[0] = l;
+  ends[1] = r;
+  return 1;
+}
+
+/* first k in [0, cnt) where sgn (x[start + k] - v) >= 0 (> 0 when
+ * strict), indices modulo n; cnt when none.  sgn x is non-decreasing
+ * along the chain. */
+static int chain_search(const double *x, int n, int start, int cnt, double v,
+                        double sgn, int strict)
+{
+  int a = 0, b = cnt;
+  while (a < b) {
+    int mid = (a + b) / 2, i = start + mid;
+    if (i >= n) i -= n;
+    double dv = sgn * (x[i] - v);
+    if (strict ? dv > 0 : dv >= 0) b = mid;
+    else a = mid + 1;
+  }
+  return a;
+}
+
+/* the edges (index of their end vertex) of chain start -> start + cnt whose
+ * x range meets [x0, x1], as up to two ascending index ranges */
+static int chain_edges(const ssPoly2 *p, int start, int cnt, double sgn,
+                       double x0, double x1, int *rg)
+{
+  int n = p->n, s1 = start + 1 < n ? start + 1 : 0;
+  /* sgn = 1: x rises along the chain; edge k runs from vertex k to k + 1 */
+  double enter = sgn > 0 ? x0 : x1, leave = sgn > 0 ? x1 : x0;
+  int k0 = chain_search(p->x, n, s1, cnt, enter, sgn, 0);
+  int k1 = chain_search(p->x, n, start, cnt, leave, sgn, 1);
+  if (k1 <= k0) return 0;
+  int a = s1 + k0;
+  if (a >= n) a -= n;
+  int b = a + (k1 - k0);
+  if (b <= n) {
+    rg[0] = a;
+    rg[1] = b;
+    return 1;
+  }
+  rg[0] = a;
+  rg[1] = n;
+  rg[2] = 0;
+  rg[3] = b - n;
+  return 2;
+}
+
+/* area and centroid of p clipped to the rectangle: x first, visiting the
+ * edge ranges rg (or all edges when nr < 0), then y */
+static double rect_area(const ssPoly2 *p, const int *rg, int nr, double x0,
+                        double x1, double y0, double y1, double *cx, double *cy)
 {
   double ax[CLIP_MAX], ay[CLIP_MAX], bx[CLIP_MAX], by[CLIP_MAX];
-  if (p->n < 3 || !(x1 > x0) || !(y1 > y0)) return 0;
+  int all[2] = {0, p->n};
+  if (nr < 0) {
+    rg = all;
+    nr = 1;
+  }
 
   /* work about the rectangle's centre: small numbers, exact corners */
   double mx = 0.5 * (x0 + x1), my = 0.5 * (y0 + y1);
-  int n = clip_slab(p->x, p->y, p->n, mx, my, ax, ay, x0 - mx, x1 - mx);
+  int n = clip_slab(p->x, p->y, p->n, rg, nr, mx, my, ax, ay, x0 - mx, x1 - mx);
   if (n < 3) return 0;
-  n = clip_slab(ay, ax, n, 0, 0, by, bx, y0 - my, y1 - my);
+  all[1] = n;
+  n = clip_slab(ay, ax, n, all, 1, 0, 0, by, bx, y0 - my, y1 - my);
   if (n < 3) return 0;
 
   /* shoelace area and centroid */
@@ -341,6 +534,39 @@ double ss_poly_rect_area(const ssPoly2 *p, double x0, double x1, double y0,
     *cy = my + sy / (3 * a2);
   }
   return fabs(0.5 * a2);
+}
+
+double ss_poly_rect_area(const ssPoly2 *p, double x0, double x1, double y0,
+                         double y1, double *cx, double *cy)
+{
+  if (p->n < 3 || !(x1 > x0) || !(y1 > y0)) return 0;
+  return rect_area(p, NULL, -1, x0, x1, y0, y1, cx, cy);
+}
+
+double ss_poly_rect_area_x(const ssPoly2 *p, const int ends[2], double x0,
+                           double x1, double y0, double y1, double *cx,
+                           double *cy)
+{
+  if (p->n < 3 || !(x1 > x0) || !(y1 > y0)) return 0;
+  /* the edges whose x range meets the slab widened far beyond round-off:
+   * every edge the clip would take something from (it compares x - mx
+   * with x0 - mx) */
+  int n = p->n, l = ends[0], r = ends[1], rg[8], nr = 0;
+  double tol = 1e-9 * (fabs(x0) + fabs(x1));
+  double lo = x0 - tol, hi = x1 + tol;
+  nr += chain_edges(p, l, (r - l + n) % n, 1, lo, hi, rg);
+  nr += chain_edges(p, r, (l - r + n) % n, -1, lo, hi, rg + 2 * nr);
+  if (nr == 0) return 0;
+  /* ascending, as the clip visits them */
+  for (int i = 1; i < nr; i++)
+    for (int k = i; k > 0 && rg[2 * k - 2] > rg[2 * k]; k--) {
+      int a = rg[2 * k - 2], b = rg[2 * k - 1];
+      rg[2 * k - 2] = rg[2 * k];
+      rg[2 * k - 1] = rg[2 * k + 1];
+      rg[2 * k] = a;
+      rg[2 * k + 1] = b;
+    }
+  return rect_area(p, rg, nr, x0, x1, y0, y1, cx, cy);
 }
 
 int ss_poly_chord(const ssPoly2 *p, double y, double *x0, double *x1)

@@ -37,12 +37,28 @@ typedef struct ssPoly2 {
 void ss_shape_footprint(const ssShape *s, ssPoly2 *out);
 /* Axis-aligned bounds of the shape in the frame. */
 void ss_shape_aabb(const ssShape *s, double lo[3], double hi[3]);
+/* Bounds in x and y of the part of the shape at or below height zc: no
+ * point of the shape outside [lo, hi] lies at or below zc.  Conservative
+ * (may be wider, and zc is widened by a relative 1e-9 for round-off).
+ * Returns 0 when no part of the shape lies at or below zc. */
+int ss_shape_low_bounds(const ssShape *s, double zc, double lo[2], double hi[2]);
 /* Signed area of a polygon (positive when counter-clockwise). */
 double ss_poly_area(const ssPoly2 *p);
 /* Area of (convex polygon) ∩ [x0,x1]×[y0,y1], exact (clipping).  When the
  * area is > 0 and cx, cy are not NULL they receive its centroid. */
 double ss_poly_rect_area(const ssPoly2 *p, double x0, double x1, double y0,
                          double y1, double *cx, double *cy);
+/* A vertex of least x (ends[0]) and one of greatest x (ends[1]) of a
+ * polygon along which it splits into two chains monotone in x; 0 (ends
+ * untouched) when it has none (fewer than 3 vertices, zero width, not
+ * convex). */
+int ss_poly_xchains(const ssPoly2 *p, int ends[2]);
+/* ss_poly_rect_area, bit for bit, given ss_poly_xchains' ends: visits only
+ * the edges near [x0, x1] (found by bisection on the chains), so its cost
+ * hardly grows with the polygon's vertex count. */
+double ss_poly_rect_area_x(const ssPoly2 *p, const int ends[2], double x0,
+                           double x1, double y0, double y1, double *cx,
+                           double *cy);
 /* The chord [*x0, *x1] of a convex polygon on the line at height y;
  * 0 when the line misses it. */
 int ss_poly_chord(const ssPoly2 *p, double y, double *x0, double *x1);

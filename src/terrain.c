@@ -149,7 +149,18 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
   double lo[3], hi[3];
   ss_shape_aabb(&s, lo, hi);
   double margin = geom_margin(m, d, g, sys);
-  if (lo[2] > m->hfield_zrange[2 * h + 1] + margin) return SS_OK;
+  double ztop = m->hfield_zrange[2 * h + 1];
+  if (lo[2] > ztop + margin) return SS_OK;
+  /* no bed vertex lies above the bed's top (plastic sinkage only lowers
+   * it), so a cell can give a point only where the collider reaches below
+   * the top plus the margin: a wheel's contact patch, not its whole
+   * footprint (the cells beyond would be visited only to be dropped) */
+  double blo[2], bhi[2];
+  if (!ss_shape_low_bounds(&s, ztop + margin, blo, bhi)) return SS_OK;
+  for (int k = 0; k < 2; k++) {
+    lo[k] = fmax(lo[k], blo[k]);
+    hi[k] = fmin(hi[k], bhi[k]);
+  }
 
   int nx = m->hfield_nx[h], ny = m->hfield_ny[h], adr = m->hfield_adr[h];
   double xs = m->hfield_size[2 * h], ys = m->hfield_size[2 * h + 1];
@@ -166,6 +177,7 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
 
   ssPoly2 fp;
   ss_shape_footprint(&s, &fp);
+  int ends[2], mono = ss_poly_xchains(&fp, ends);
   double up[3] = {0, 0, 1};
   double width = ss_shape_width(&s, up);
   double frame[9];
@@ -191,7 +203,8 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       double cx0 = i == 0 ? x : x - 0.5 * dx, cx1 = i == nx - 1 ? x : x + 0.5 * dx;
       double qx = x, qy = y, full = (cx1 - cx0) * (cy1 - cy0), area = full;
       if (!(cx0 > in0 && cx1 < in1)) {
-        area = ss_poly_rect_area(&fp, cx0, cx1, cy0, cy1, &qx, &qy);
+        area = mono ? ss_poly_rect_area_x(&fp, ends, cx0, cx1, cy0, cy1, &qx, &qy)
+                    : ss_poly_rect_area(&fp, cx0, cx1, cy0, cy1, &qx, &qy);
         if (!(area > tiny)) continue;
         /* the point represents the covered part of the cell: the vertex
          * when the cell is fully covered, else the covered part's centroid

@@ -356,6 +356,48 @@ static void test_poly_clip(void)
 }
 
 /* vertical ray casts against closed forms */
+/* the clip that visits only the edges near the cell gives the full
+ * clip's area and centroid bit for bit, on footprints of every shape and
+ * on cells straddling, touching and missing them */
+static void test_poly_clip_chains(void)
+{
+  double R[9];
+  int differ = 0, cells = 0, hits = 0, mono = 0;
+  for (int t = 0; t < 60; t++) {
+    int type = t % 4;
+    rot_random(R);
+    if (t % 3 == 0) rot_wheel(R, urand(0, PI), urand(0, PI));
+    ssShape s = make_shape(type, 0.3, 0.5, 0.2, urand(-1, 1), urand(-1, 1), 0.2, R);
+    ssPoly2 p;
+    int ends[2];
+    ss_shape_footprint(&s, &p);
+    if (!ss_poly_xchains(&p, ends)) continue;
+    mono++;
+    double lo[3], hi[3], dx = urand(0.005, 0.05), dy = urand(0.005, 0.05);
+    ss_shape_aabb(&s, lo, hi);
+    for (double y = lo[1] - dy; y < hi[1] + dy; y += dy)
+      for (double x = lo[0] - dx; x < hi[0] + dx; x += dx) {
+        double ax = 7, ay = 7, bx = 7, by = 7;
+        double a = ss_poly_rect_area(&p, x, x + dx, y, y + dy, &ax, &ay);
+        double b = ss_poly_rect_area_x(&p, ends, x, x + dx, y, y + dy, &bx, &by);
+        cells++;
+        hits += a > 0;
+        if (memcmp(&a, &b, sizeof a) || memcmp(&ax, &bx, sizeof ax) ||
+            memcmp(&ay, &by, sizeof ay))
+          differ++;
+      }
+  }
+  ok(mono == 60 && differ == 0 && hits > 1000, "edges near the cell only: the "
+     "full clip bit for bit (%d of %d cells differ, %d covered; %d of 60 "
+     "footprints split)", differ, cells, hits, mono);
+  ssPoly2 sq = {4, {0, 1, 1, 0}, {0, 0, 1, 1}}, cw = {4, {0, 0, 1, 1}, {0, 1, 1, 0}};
+  ssPoly2 bow = {4, {0, 1, 0, 1}, {0, 0, 1, 1}};
+  int e[2] = {-1, -1};
+  ok(ss_poly_xchains(&sq, e) && e[0] == 0 && e[1] == 1 && ss_poly_xchains(&cw, e) &&
+     !ss_poly_xchains(&bow, e), "x chains of a square either way round, none "
+     "for a bow tie");
+}
+
 static void test_lowest_z(void)
 {
   double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, R[9], z = 0, worst;
@@ -721,15 +763,53 @@ static void test_aabb(void)
   }
 }
 
+/* the bounds of a shape's part below a height hold every vertical line
+ * through the shape that reaches that low, and are tight for a wheel */
+static void test_low_bounds(void)
+{
+  double R[9], lo[2], hi[2];
+  for (int type = SS_GEOM_BOX; type <= SS_GEOM_CAPSULE; type++) {
+    int outside = 0, empty_wrong = 0;
+    for (int t = 0; t < 40; t++) {
+      rot_random(R);
+      if (t < 10) rot_wheel(R, urand(0, PI), urand(0, PI));
+      ssShape s = make_shape(type, 0.3, 0.5, 0.2, 1, 2, 3, R);
+      double alo[3], ahi[3];
+      ss_shape_aabb(&s, alo, ahi);
+      double zc = urand(alo[2] - 0.05, ahi[2]);
+      int any = ss_shape_low_bounds(&s, zc, lo, hi);
+      for (int i = 0; i < 4000; i++) {
+        double x = urand(alo[0], ahi[0]), y = urand(alo[1], ahi[1]), z;
+        if (!ss_shape_lowest_z(&s, x, y, &z) || z > zc) continue;
+        if (!any) empty_wrong++;
+        else if (x < lo[0] || x > hi[0] || y < lo[1] || y > hi[1]) outside++;
+      }
+    }
+    ok(outside == 0 && empty_wrong == 0, "type %d: points at or below zc lie in "
+       "the low bounds (%d outside, %d missed)", type, outside, empty_wrong);
+  }
+  /* a wheel of radius 0.3 rolling along x, 1 cm below zc: chord 2 sqrt(0.3^2 - 0.29^2) */
+  rot_wheel(R, 0, 0.7);
+  ssShape w = make_shape(SS_GEOM_CYLINDER, 0.3, 0.2, 0, 0, 0, 0.3, R);
+  int any = ss_shape_low_bounds(&w, 0.01, lo, hi);
+  double half = sqrt(0.3 * 0.3 - 0.29 * 0.29), l0 = fmin(hi[0] - lo[0], hi[1] - lo[1]);
+  double l1 = fmax(hi[0] - lo[0], hi[1] - lo[1]);
+  ok(any && fabs(l0 - 2 * half) < 1e-6 && fabs(l1 - 0.2) < 1e-6,
+     "wheel's low bounds: its contact chord by its tread (%.6g x %.6g)", l0, l1);
+  ok(!ss_shape_low_bounds(&w, -0.01, lo, hi), "wheel above zc: no low bounds");
+}
+
 int main(void)
 {
   test_plate_quadrature();
   test_box_footprint();
   test_round_footprints();
   test_poly_clip();
+  test_poly_clip_chains();
   test_lowest_z();
   test_candidates();
   test_width();
   test_aabb();
+  test_low_bounds();
   return done_testing();
 }
