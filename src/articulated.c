@@ -322,31 +322,37 @@ static void ltdl_solve(const ssArtWork *w, double *x)
     for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) x[i] -= H[i * n + j] * x[j];
 }
 
-/* ltdl_solve on six columns at once, X (n x 6, row k = dof k): the same
- * operations per column in the same order (so the same bits), six wide */
-static void ltdl_solve6(const ssArtWork *w, double *X)
+/* ltdl_solve on m columns at once, X (n x m, row k = dof k): the same
+ * operations per column in the same order (so the same bits), m wide */
+static inline void ltdl_solve_cols(const ssArtWork *w, double *X, int m)
 {
   int n = w->nv;
   const double *H = w->L;
   for (int i = n - 1; i >= 0; i--) {
-    const double *xi = X + 6 * i;
-    if (xi[0] == 0 && xi[1] == 0 && xi[2] == 0 && xi[3] == 0 && xi[4] == 0 && xi[5] == 0)
-      continue;
+    const double *xi = X + (size_t)m * i;
+    int r = 0;
+    while (r < m && xi[r] == 0) r++;
+    if (r == m) continue;
     for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) {
-      double h = H[i * n + j], *xj = X + 6 * j;
-      for (int r = 0; r < 6; r++) xj[r] -= h * xi[r];
+      double h = H[i * n + j], *xj = X + (size_t)m * j;
+      for (r = 0; r < m; r++) xj[r] -= h * xi[r];
     }
   }
   for (int i = 0; i < n; i++) {
-    double h = H[i * n + i];
-    for (int r = 0; r < 6; r++) X[6 * i + r] /= h;
+    double h = H[i * n + i], *xi = X + (size_t)m * i;
+    for (int r = 0; r < m; r++) xi[r] /= h;
   }
-  for (int i = 0; i < n; i++)
+  for (int i = 0; i < n; i++) {
+    double *xi = X + (size_t)m * i;
     for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) {
       double h = H[i * n + j];
-      for (int r = 0; r < 6; r++) X[6 * i + r] -= h * X[6 * j + r];
+      const double *xj = X + (size_t)m * j;
+      for (int r = 0; r < m; r++) xi[r] -= h * xj[r];
     }
+  }
 }
+
+static void ltdl_solve6(const ssArtWork *w, double *X) { ltdl_solve_cols(w, X, 6); }
 
 /* ---------------------------------------------------------------------- */
 /* Jacobians                                                               */
@@ -428,20 +434,26 @@ static void factor_closures(ssArtWork *w)
 {
   int n = w->nv, nr = w->nrow;
   w->rank_deficient = 0;
-  for (int r = 0; r < nr; r++) {
-    double *col = w->y;
-    memcpy(col, w->K + (size_t)r * n, (size_t)n * sizeof(double));
-    ltdl_solve(w, col);
-    for (int i = 0; i < n; i++) w->MiKT[(size_t)i * nr + r] = col[i];
-  }
+  /* MiKT = M'^-1 K^T, its nr columns solved together */
+  for (int i = 0; i < n; i++)
+    for (int r = 0; r < nr; r++) w->MiKT[(size_t)i * nr + r] = w->K[(size_t)r * n + i];
+  ltdl_solve_cols(w, w->MiKT, nr);
+  /* A = K MiKT (lower triangle, row by row over K's nonzeros; each entry
+   * summed over k in order), mirrored */
   double *A = w->A, amax = 0;
-  for (int i = 0; i < nr; i++)
-    for (int j = 0; j <= i; j++) {
-      double s = 0;
-      for (int k = 0; k < n; k++) s += w->K[(size_t)i * n + k] * w->MiKT[(size_t)k * nr + j];
-      A[i * nr + j] = A[j * nr + i] = s;
-      if (i == j) amax = fmax(amax, s);
+  for (int i = 0; i < nr; i++) {
+    double *Ai = A + (size_t)i * nr;
+    const double *Ki = w->K + (size_t)i * n;
+    for (int j = 0; j <= i; j++) Ai[j] = 0;
+    for (int k = 0; k < n; k++) {
+      double kik = Ki[k];
+      if (kik == 0) continue;
+      const double *Mk = w->MiKT + (size_t)k * nr;
+      for (int j = 0; j <= i; j++) Ai[j] += kik * Mk[j];
     }
+    for (int j = 0; j < i; j++) A[(size_t)j * nr + i] = Ai[j];
+    amax = fmax(amax, Ai[i]);
+  }
   for (int j = 0; j < nr; j++) {
     double s = A[j * nr + j];
     for (int k = 0; k < j; k++) s -= A[j * nr + k] * A[j * nr + k];
