@@ -360,10 +360,33 @@ ssStatus ss_terrain_contacts(const ssModel *m, ssData *d, ssError *err)
   return SS_OK;
 }
 
-static int cmp_int(const void *a, const void *b)
+/* end of the non-decreasing run of v that starts at i (< n) */
+static int run_end(const int *v, int i, int n)
 {
-  int x = *(const int *)a, y = *(const int *)b;
-  return (x > y) - (x < y);
+  while (++i < n && v[i - 1] <= v[i]) continue;
+  return i;
+}
+
+/* Sorts v (n values) by merging its non-decreasing runs through the
+ * scratch t (n values): linear for the few runs the colliders give, one
+ * per collider.  Returns the array that holds the result (v or t). */
+static int *merge_sort_runs(int *v, int *t, int n)
+{
+  for (;;) {
+    int runs = 0;
+    for (int i = 0; i < n; runs++) {
+      int e1 = run_end(v, i, n), e2 = e1 < n ? run_end(v, e1, n) : n;
+      int a = i, b = e1, o = i;
+      while (a < e1 && b < e2) t[o++] = v[b] < v[a] ? v[b++] : v[a++];
+      while (a < e1) t[o++] = v[a++];
+      while (b < e2) t[o++] = v[b++];
+      i = e2;
+    }
+    int *w = v;
+    v = t;
+    t = w;
+    if (runs <= 1) return v;
+  }
 }
 
 void ss_terrain_update(const ssModel *m, ssData *d)
@@ -404,15 +427,16 @@ void ss_terrain_update(const ssModel *m, ssData *d)
     st->soil_normal_force += c->lambda[0] / dt;
     nload++;
   }
-  /* the new list of loaded vertices (unique) */
-  if (nload > d->cap_soil_loaded) {
-    int *p = realloc(d->soil_loaded, (size_t)nload * sizeof(int));
+  /* the new list of loaded vertices (unique), and room for the scratch of
+   * its sort after it */
+  if (2 * nload > d->cap_soil_loaded) {
+    int *p = realloc(d->soil_loaded, (size_t)nload * 2 * sizeof(int));
     if (!p) {
       /* keep the old list: worst case some vertices recover a step late */
       return;
     }
     d->soil_loaded = p;
-    d->cap_soil_loaded = nload;
+    d->cap_soil_loaded = 2 * nload;
   }
   int n = 0;
   for (int i = 0; i < d->ncontact; i++) {
@@ -422,10 +446,10 @@ void ss_terrain_update(const ssModel *m, ssData *d)
   /* one collider's vertices come in order already */
   int sorted = 1;
   for (int i = 1; i < n && sorted; i++) sorted = d->soil_loaded[i - 1] < d->soil_loaded[i];
-  if (!sorted) qsort(d->soil_loaded, (size_t)n, sizeof(int), cmp_int);
+  const int *v = d->soil_loaded;
+  if (!sorted) v = merge_sort_runs(d->soil_loaded, d->soil_loaded + n, n);
   int u = 0;
   for (int i = 0; i < n; i++)
-    if (u == 0 || d->soil_loaded[u - 1] != d->soil_loaded[i])
-      d->soil_loaded[u++] = d->soil_loaded[i];
+    if (u == 0 || d->soil_loaded[u - 1] != v[i]) d->soil_loaded[u++] = v[i];
   d->nsoil_loaded = u;
 }
