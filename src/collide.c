@@ -34,30 +34,48 @@ static int pt_less(const pt2 *a, const pt2 *b)
   return a->x < b->x || (a->x == b->x && a->y < b->y);
 }
 
-static void sift_down(pt2 *p, int root, int n)
+/* end of the run of p that starts at i (< n): non-decreasing, or strictly
+ * decreasing and then reversed in place */
+static int point_run(pt2 *p, int i, int n)
 {
-  for (;;) {
-    int child = 2 * root + 1;
-    if (child >= n) return;
-    if (child + 1 < n && pt_less(&p[child], &p[child + 1])) child++;
-    if (!pt_less(&p[root], &p[child])) return;
-    pt2 t = p[root];
-    p[root] = p[child];
-    p[child] = t;
-    root = child;
+  int j = i + 1;
+  if (j < n && pt_less(&p[j], &p[i])) {
+    while (j + 1 < n && pt_less(&p[j + 1], &p[j])) j++;
+    for (int a = i, b = j; a < b; a++, b--) {
+      pt2 t = p[a];
+      p[a] = p[b];
+      p[b] = t;
+    }
+    j++;
   }
+  while (j < n && !pt_less(&p[j], &p[j - 1])) j++;
+  return j;
 }
 
-/* heapsort: qsort may allocate for inputs of this size */
+/* Natural merge sort (qsort may allocate for inputs of this size): the
+ * points of a circle's polygon come as a few monotone runs in x, so this
+ * is nearly linear.  Points equal under pt_less are equal.  n <= HULL_IN_MAX,
+ * the size of the one caller's array (convex_hull's input). */
 static void sort_points(pt2 *p, int n)
 {
-  for (int i = n / 2 - 1; i >= 0; i--) sift_down(p, i, n);
-  for (int end = n - 1; end > 0; end--) {
-    pt2 t = p[0];
-    p[0] = p[end];
-    p[end] = t;
-    sift_down(p, 0, end);
+  pt2 buf[HULL_IN_MAX], *v = p, *t = buf;
+  for (;;) {
+    int runs = 0;
+    for (int i = 0; i < n; runs++) {
+      int e1 = point_run(v, i, n), e2 = e1 < n ? point_run(v, e1, n) : n;
+      int a = i, b = e1, o = i;
+      while (a < e1 && b < e2) t[o++] = pt_less(&v[b], &v[a]) ? v[b++] : v[a++];
+      while (a < e1) t[o++] = v[a++];
+      while (b < e2) t[o++] = v[b++];
+      i = e2;
+    }
+    pt2 *w = v;
+    v = t;
+    t = w;
+    if (runs <= 1) break;
   }
+  if (v != p)
+    for (int i = 0; i < n; i++) p[i] = v[i];
 }
 
 static double cross3(const pt2 *o, const pt2 *a, const pt2 *b)
