@@ -305,26 +305,12 @@ static int ltdl_factor(ssArtWork *w)
   return 0;
 }
 
-/* x <- M'^-1 x.  The first pass moves each entry into its ancestors only:
- * the zeros of a sparse x (a Jacobian's column, a closure row: a path or
- * two in the tree) cost nothing there. */
-static void ltdl_solve(const ssArtWork *w, double *x)
-{
-  int n = w->nv;
-  const double *H = w->L;
-  for (int i = n - 1; i >= 0; i--) {
-    double xi = x[i];
-    if (xi == 0) continue;
-    for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) x[j] -= H[i * n + j] * xi;
-  }
-  for (int i = 0; i < n; i++) x[i] /= H[i * n + i];
-  for (int i = 0; i < n; i++)
-    for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) x[i] -= H[i * n + j] * x[j];
-}
-
-/* ltdl_solve on m columns at once, X (n x m, row k = dof k): the same
- * operations per column in the same order (so the same bits), m wide */
-static inline void ltdl_solve_cols(const ssArtWork *w, double *X, int m)
+/* X <- M'^-1 X for m columns at once, X (n x m, row k = dof k).  The first
+ * pass moves each row into its ancestors only: the zero rows of a sparse X
+ * (Jacobian columns, closure rows: a path or two in the tree) cost nothing
+ * there.  Each column sees the same operations in the same order whatever
+ * m (so the same bits). */
+static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
 {
   int n = w->nv;
   const double *H = w->L;
@@ -351,8 +337,6 @@ static inline void ltdl_solve_cols(const ssArtWork *w, double *X, int m)
     }
   }
 }
-
-static void ltdl_solve6(const ssArtWork *w, double *X) { ltdl_solve_cols(w, X, 6); }
 
 /* ---------------------------------------------------------------------- */
 /* Jacobians                                                               */
@@ -437,7 +421,7 @@ static void factor_closures(ssArtWork *w)
   /* MiKT = M'^-1 K^T, its nr columns solved together */
   for (int i = 0; i < n; i++)
     for (int r = 0; r < nr; r++) w->MiKT[(size_t)i * nr + r] = w->K[(size_t)r * n + i];
-  ltdl_solve_cols(w, w->MiKT, nr);
+  ltdl_solve(w, w->MiKT, nr);
   /* A = K MiKT (lower triangle, row by row over K's nonzeros; each entry
    * summed over k in order), mirrored */
   double *A = w->A, amax = 0;
@@ -474,58 +458,36 @@ static void factor_closures(ssArtWork *w)
   }
 }
 
-/* z <- A^-1 z over the active rows (dropped rows give 0) */
-static void closure_solve(const ssArtWork *w, double *z)
+/* Z <- A^-1 Z over the active rows (dropped rows give 0), for m columns
+ * at once, Z (nr x m, row i = closure row i); each column sees the same
+ * operations in the same order whatever m */
+static inline void closure_solve(const ssArtWork *w, double *Z, int m)
 {
   int nr = w->nrow;
   const double *A = w->A;
   for (int i = 0; i < nr; i++) {
-    if (!w->row_on[i]) { z[i] = 0; continue; }
-    double t = z[i];
-    for (int k = 0; k < i; k++) t -= A[i * nr + k] * z[k];
-    z[i] = t / A[i * nr + i];
-  }
-  for (int i = nr - 1; i >= 0; i--) {
-    if (!w->row_on[i]) { z[i] = 0; continue; }
-    double t = z[i];
-    for (int k = i + 1; k < nr; k++) t -= A[k * nr + i] * z[k];
-    z[i] = t / A[i * nr + i];
-  }
-}
-
-/* closure_solve on six columns at once, Z (nr x 6, row i = closure row
- * i): the same operations per column in the same order */
-static void closure_solve6(const ssArtWork *w, double *Z)
-{
-  int nr = w->nrow;
-  const double *A = w->A;
-  for (int i = 0; i < nr; i++) {
-    double *zi = Z + 6 * i;
+    double *zi = Z + (size_t)m * i;
     if (!w->row_on[i]) {
-      for (int r = 0; r < 6; r++) zi[r] = 0;
+      for (int r = 0; r < m; r++) zi[r] = 0;
       continue;
     }
-    double t[6];
-    for (int r = 0; r < 6; r++) t[r] = zi[r];
     for (int k = 0; k < i; k++) {
       double a = A[i * nr + k];
-      for (int r = 0; r < 6; r++) t[r] -= a * Z[6 * k + r];
+      for (int r = 0; r < m; r++) zi[r] -= a * Z[(size_t)m * k + r];
     }
-    for (int r = 0; r < 6; r++) zi[r] = t[r] / A[i * nr + i];
+    for (int r = 0; r < m; r++) zi[r] /= A[i * nr + i];
   }
   for (int i = nr - 1; i >= 0; i--) {
-    double *zi = Z + 6 * i;
+    double *zi = Z + (size_t)m * i;
     if (!w->row_on[i]) {
-      for (int r = 0; r < 6; r++) zi[r] = 0;
+      for (int r = 0; r < m; r++) zi[r] = 0;
       continue;
     }
-    double t[6];
-    for (int r = 0; r < 6; r++) t[r] = zi[r];
     for (int k = i + 1; k < nr; k++) {
       double a = A[k * nr + i];
-      for (int r = 0; r < 6; r++) t[r] -= a * Z[6 * k + r];
+      for (int r = 0; r < m; r++) zi[r] -= a * Z[(size_t)m * k + r];
     }
-    for (int r = 0; r < 6; r++) zi[r] = t[r] / A[i * nr + i];
+    for (int r = 0; r < m; r++) zi[r] /= A[i * nr + i];
   }
 }
 
@@ -541,7 +503,7 @@ static void project(const ssArtWork *w, double *x)
     for (int k = 0; k < n; k++) s += w->K[(size_t)r * n + k] * x[k];
     zz[r] = s;
   }
-  closure_solve(w, zz);
+  closure_solve(w, zz, 1);
   for (int k = 0; k < n; k++) {
     double s = 0;
     for (int r = 0; r < nr; r++) s += w->MiKT[(size_t)k * nr + r] * zz[r];
@@ -716,7 +678,7 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
                         m->sys_name[s], m->body_name[b0 + w->dof_body[k]]);
   }
   memcpy(u, w->rhs, (size_t)n * sizeof(double));
-  ltdl_solve(w, u);
+  ltdl_solve(w, u, 1);
   if (w->nrow) {
     closures(m, d, w);
     factor_closures(w);
@@ -743,7 +705,7 @@ static void body_response(const ssModel *m, ssArtWork *w, int lb)
     int k0 = m->body_dofadr[a] - w->v0;
     memcpy(Y + 6 * k0, w->S + 6 * k0, 6 * (size_t)nd * sizeof(double));
   }
-  ltdl_solve6(w, Y);
+  ltdl_solve(w, Y, 6);
   if (nr) {
     /* Z = (J_b MiKT)^T, row i = closure row i; then Y -= MiKT A^-1 Z */
     double *Z = w->Z;
@@ -758,7 +720,7 @@ static void body_response(const ssModel *m, ssArtWork *w, int lb)
           for (int r = 0; r < 6; r++) Z[6 * i + r] += Sk[r] * Mk[i];
       }
     }
-    closure_solve6(w, Z);
+    closure_solve(w, Z, 6);
     for (int k = 0; k < n; k++) {
       const double *Mk = w->MiKT + (size_t)k * nr;
       double t[6] = {0, 0, 0, 0, 0, 0};
@@ -817,7 +779,7 @@ void ss_art_dof_jacobian(const ssModel *m, ssData *d, int s, int dof,
   double *col = w->x;
   memset(col, 0, (size_t)n * sizeof(double));
   col[k] = 1;
-  ltdl_solve(w, col);
+  ltdl_solve(w, col, 1);
   project(w, col);
   memset(W, 0, 3 * (size_t)n * sizeof(double));
   for (int i = 0; i < n; i++) W[3 * i] = col[i];
@@ -927,7 +889,7 @@ void ss_art_integrate(const ssModel *m, ssData *d, int s)
     if (!(err <= 0.25 * prev)) factor_closures(w);
     prev = err;
     memcpy(zz, w->phi, (size_t)w->nrow * sizeof(double));
-    closure_solve(w, zz);
+    closure_solve(w, zz, 1);
     double *du = w->rhs;
     for (int k = 0; k < w->nv; k++) {
       double t = 0;

@@ -5,6 +5,7 @@
 
 #include <math.h>
 
+#include "sort_runs.h"
 #include "ss_math.h"
 
 #define SS_PI 3.14159265358979323846
@@ -34,48 +35,18 @@ static int pt_less(const pt2 *a, const pt2 *b)
   return a->x < b->x || (a->x == b->x && a->y < b->y);
 }
 
-/* end of the run of p that starts at i (< n): non-decreasing, or strictly
- * decreasing and then reversed in place */
-static int point_run(pt2 *p, int i, int n)
-{
-  int j = i + 1;
-  if (j < n && pt_less(&p[j], &p[i])) {
-    while (j + 1 < n && pt_less(&p[j + 1], &p[j])) j++;
-    for (int a = i, b = j; a < b; a++, b--) {
-      pt2 t = p[a];
-      p[a] = p[b];
-      p[b] = t;
-    }
-    j++;
-  }
-  while (j < n && !pt_less(&p[j], &p[j - 1])) j++;
-  return j;
-}
+/* footprint points by x, then y: they come as a few monotone runs in x
+ * (a circle's polygon), so the run-merging sort is nearly linear.  Points
+ * equal under pt_less are equal. */
+SS_SORT_RUNS(sort_point_runs, pt2, pt_less)
 
-/* Natural merge sort (qsort may allocate for inputs of this size): the
- * points of a circle's polygon come as a few monotone runs in x, so this
- * is nearly linear.  Points equal under pt_less are equal.  n <= HULL_IN_MAX,
- * the size of the one caller's array (convex_hull's input). */
+/* n <= HULL_IN_MAX, the size of the one caller's array (convex_hull's
+ * input); qsort may allocate for inputs of this size */
 static void sort_points(pt2 *p, int n)
 {
-  pt2 buf[HULL_IN_MAX], *v = p, *t = buf;
-  for (;;) {
-    int runs = 0;
-    for (int i = 0; i < n; runs++) {
-      int e1 = point_run(v, i, n), e2 = e1 < n ? point_run(v, e1, n) : n;
-      int a = i, b = e1, o = i;
-      while (a < e1 && b < e2) t[o++] = pt_less(&v[b], &v[a]) ? v[b++] : v[a++];
-      while (a < e1) t[o++] = v[a++];
-      while (b < e2) t[o++] = v[b++];
-      i = e2;
-    }
-    pt2 *w = v;
-    v = t;
-    t = w;
-    if (runs <= 1) break;
-  }
-  if (v != p)
-    for (int i = 0; i < n; i++) p[i] = v[i];
+  pt2 buf[HULL_IN_MAX];
+  const pt2 *v = sort_point_runs(p, buf, n);
+  if (v != p) memcpy(p, v, (size_t)n * sizeof *p);
 }
 
 static double cross3(const pt2 *o, const pt2 *a, const pt2 *b)

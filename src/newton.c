@@ -58,8 +58,8 @@ typedef struct NPoint {
   double k, tf0;      /* k_c/b + k_phi; A dt c */
   double x0, gtt;     /* j/K_j; largest diagonal entry of G_tt */
   double ps, pv;      /* last s and s^(n-1) (ps = 0: none) */
-  double xa, ma, ea;  /* last x = x0 + sigma dt/K_j, 1 - exp(-x), exp(-x)
-                         (xa < 0: none) */
+  ssExpMemo mob;      /* last x = x0 + sigma dt/K_j, 1 - exp(-x), exp(-x)
+                         (mob.x < 0: none) */
 } NPoint;
 
 /* A group: the soil points of one link (or free rigid body) on one bed,
@@ -165,31 +165,15 @@ static ssNewtonWork *work(ssData *d, int n, int nc, int nv, int ng)
 /* s^(n-1) of point P, moved from its last value when near */
 static inline __attribute__((always_inline)) double pow_point(NPoint *P, double s, double m1)
 {
-  double u = P->ps > 0 ? (s - P->ps) / P->ps : INFINITY, v;
-  if (fabs(u) <= SS_POW_SERIES_MAX && fabs(m1) <= 3) v = P->pv + P->pv * ss_pow1p_m1(m1, u);
-  else v = pow(s, m1);
-  P->ps = s;
-  P->pv = v;
-  return v;
+  return ss_pow_moved(&P->ps, &P->pv, s, m1);
 }
 
 /* Janosi mobilisation 1 - exp(-x) of point P and exp(-x) in *e */
 static inline __attribute__((always_inline)) double mobil_point(NPoint *P, double x, double *e)
 {
-  double d = x - P->xa;
-  if (d != 0) {
-    if (P->xa >= 0 && fabs(d) <= SS_EXP_SERIES_MAX) {
-      double em1 = ss_expm1_neg(d);
-      P->ma -= P->ea * em1;
-      P->ea += P->ea * em1;
-    } else {
-      P->ma = -expm1(-x);
-      P->ea = 1 - P->ma; /* absolute accuracy is all e needs (T' and the series) */
-    }
-    P->xa = x;
-  }
-  *e = P->ea;
-  return P->ma;
+  P->mob = ss_exp_memo_move(P->mob, x);
+  *e = P->mob.e;
+  return P->mob.m;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -764,7 +748,7 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
     P->x0 = mat->shear_displacement > 0 ? c->j / mat->shear_displacement : 0;
     P->gtt = fmax(c->G[4], c->G[8]);
     P->ps = 0;
-    P->xa = -1;
+    P->mob.x = -1;
   }
   n = 6 * ngroup + nrow;
   Setup s = {ngroup, nrow, n, first_row};

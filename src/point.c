@@ -83,13 +83,7 @@ typedef ssLaw Law;
  * it: seven terms where pow would cost a log and an exp */
 static inline double pow_near(Law *L, double s)
 {
-  double v;
-  double u = L->ps > 0 ? (s - L->ps) / L->ps : INFINITY;
-  if (fabs(u) <= SS_POW_SERIES_MAX && fabs(L->m1) <= 3) v = L->pv + L->pv * ss_pow1p_m1(L->m1, u);
-  else v = pow(s, L->m1);
-  L->ps = s;
-  L->pv = v;
-  return v;
+  return ss_pow_moved(&L->ps, &L->pv, s, L->m1);
 }
 
 /* Normal pressure at end-of-step normal velocity vn (DESIGN 3.1) and its
@@ -301,9 +295,9 @@ static void mobil_init(Mobil *J, double j, double K, double dt)
   J->x0 = (j > 0 ? j : 0) * iK;
   J->m0 = J->r > 0 ? (J->x0 > 0 ? -1 : 0) : 1;
   /* at x = 0 the point is free: m = 0, e = 1 */
-  J->xa = J->x0 > 0 ? -1 : 0;
-  J->ma = 0;
-  J->ea = 1;
+  J->last.x = J->x0 > 0 ? -1 : 0;
+  J->last.m = 0;
+  J->last.e = 1;
 }
 
 /* m at zero slip, for the stick test (m(sigma) >= m0 bounds it for free) */
@@ -319,20 +313,9 @@ static inline double mobil_at(Mobil *J, double sigma, double *e)
     *e = 0;
     return 1;
   }
-  double x = J->x0 + J->r * sigma, d = x - J->xa;
-  if (d != 0) {
-    if (J->xa >= 0 && fabs(d) <= SS_EXP_SERIES_MAX) {
-      double em1 = ss_expm1_neg(d);
-      J->ma -= J->ea * em1;
-      J->ea += J->ea * em1;
-    } else {
-      J->ma = -expm1(-x);
-      J->ea = 1 - J->ma; /* absolute accuracy is all e needs: T' and the series */
-    }
-    J->xa = x;
-  }
-  *e = J->ea;
-  return J->ma;
+  J->last = ss_exp_memo_move(J->last, J->x0 + J->r * sigma);
+  *e = J->last.e;
+  return J->last.m;
 }
 
 /* One evaluation of the slip equation at speed sigma: w = M^-1 c_t,

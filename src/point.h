@@ -8,6 +8,7 @@
 #define SS_POINT_H
 
 #include "soilsim.h"
+#include "ss_math.h"
 
 /* A soil point's law (DESIGN 3.1) as its solve uses it (solver.c): set up
  * once per step from the contact and its material, plus the values the
@@ -28,7 +29,7 @@ typedef struct ssLaw {
 typedef struct ssMobil {
   double r;          /* dt/K, 0 when constant */
   double x0, m0;     /* j/K and m there (zero slip; m0 < 0 not yet known) */
-  double xa, ea, ma; /* the last point (xa < 0: none) */
+  ssExpMemo last;    /* the last point (last.x < 0: none) */
 } ssMobil;
 
 /* The tangential block of one contact, fixed for its whole solve. */

@@ -9,6 +9,7 @@
  * contact by W (lambda_new - lambda_old). */
 #include "solver.h"
 #include "articulated.h"
+#include "sort_runs.h"
 #include "ss_math.h"
 
 #include <math.h>
@@ -307,38 +308,13 @@ static int cached(const ssContact *c)
          (c->type == SS_CONTACT_SOIL && c->lambda[0] > 0);
 }
 
-/* the end of the ascending run of cache entries that starts at k */
-static int run_end(const ssWarmEntry *e, int k, int n)
-{
-  k++;
-  while (k < n && cmp_warm(e + k - 1, e + k) < 0) k++;
-  return k;
-}
-
 /* Sort the n cache entries of a by key (cmp_warm), b being as large;
  * returns whichever of a and b ends holding them.  The contacts come in a
  * few ascending runs (one per collider and bed, then the joint rows), so
  * neighbouring runs are merged pairwise until one is left: a few passes,
  * no general sort. */
-static ssWarmEntry *sort_runs(ssWarmEntry *a, ssWarmEntry *b, int n)
-{
-  if (run_end(a, 0, n) >= n) return a;
-  for (;;) {
-    int runs = 0;
-    for (int k = 0; k < n; runs++) {
-      int mid = run_end(a, k, n), end = mid < n ? run_end(a, mid, n) : n;
-      int i = k, j = mid, o = k;
-      while (i < mid && j < end) b[o++] = cmp_warm(a + i, a + j) <= 0 ? a[i++] : a[j++];
-      while (i < mid) b[o++] = a[i++];
-      while (j < end) b[o++] = a[j++];
-      k = end;
-    }
-    ssWarmEntry *t = a;
-    a = b;
-    b = t;
-    if (runs <= 1) return a;
-  }
-}
+static int warm_less(const ssWarmEntry *a, const ssWarmEntry *b) { return cmp_warm(a, b) < 0; }
+SS_SORT_RUNS(sort_runs, ssWarmEntry, warm_less)
 
 /* keep this step's converged tractions (soil) and impulse rates (joint
  * rows) for the next one */

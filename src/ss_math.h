@@ -158,4 +158,44 @@ static inline double ss_expm1_neg(double d)
   return p01 + d3 * (p23 + d2 * p45);
 }
 
+/* s^a, moved by the series from the last pair (*ps, *pv = ps^a; *ps = 0:
+ * none) when s is within SS_POW_SERIES_MAX of ps, else from libm; the pair
+ * becomes (s, s^a) */
+static inline double ss_pow_moved(double *ps, double *pv, double s, double a)
+{
+  double u = *ps > 0 ? (s - *ps) / *ps : INFINITY, v;
+  if (fabs(u) <= SS_POW_SERIES_MAX && fabs(a) <= 3) v = *pv + *pv * ss_pow1p_m1(a, u);
+  else v = pow(s, a);
+  *ps = s;
+  *pv = v;
+  return v;
+}
+
+/* m = 1 - exp(-x) and e = exp(-x) at the last x (x < 0: none), kept to
+ * be moved to a nearby x.  m is carried directly (no 1 - exp cancellation
+ * at small x); e only to absolute accuracy, all its uses (a slope, the
+ * series' factor) need. */
+typedef struct ssExpMemo {
+  double x, m, e;
+} ssExpMemo;
+
+/* c moved to x: by the series when x is within SS_EXP_SERIES_MAX of c.x,
+ * else from libm */
+static inline ssExpMemo ss_exp_memo_move(ssExpMemo c, double x)
+{
+  double d = x - c.x;
+  if (d != 0) {
+    if (c.x >= 0 && fabs(d) <= SS_EXP_SERIES_MAX) {
+      double em1 = ss_expm1_neg(d);
+      c.m -= c.e * em1;
+      c.e += c.e * em1;
+    } else {
+      c.m = -expm1(-x);
+      c.e = 1 - c.m;
+    }
+    c.x = x;
+  }
+  return c;
+}
+
 #endif /* SS_MATH_H */

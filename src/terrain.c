@@ -19,6 +19,7 @@
 #include "dynamics.h"
 #include "mesh.h"
 #include "solver.h"
+#include "sort_runs.h"
 #include "ss_math.h"
 
 #include <stdlib.h>
@@ -360,34 +361,9 @@ ssStatus ss_terrain_contacts(const ssModel *m, ssData *d, ssError *err)
   return SS_OK;
 }
 
-/* end of the non-decreasing run of v that starts at i (< n) */
-static int run_end(const int *v, int i, int n)
-{
-  while (++i < n && v[i - 1] <= v[i]) continue;
-  return i;
-}
-
-/* Sorts v (n values) by merging its non-decreasing runs through the
- * scratch t (n values): linear for the few runs the colliders give, one
- * per collider.  Returns the array that holds the result (v or t). */
-static int *merge_sort_runs(int *v, int *t, int n)
-{
-  for (;;) {
-    int runs = 0;
-    for (int i = 0; i < n; runs++) {
-      int e1 = run_end(v, i, n), e2 = e1 < n ? run_end(v, e1, n) : n;
-      int a = i, b = e1, o = i;
-      while (a < e1 && b < e2) t[o++] = v[b] < v[a] ? v[b++] : v[a++];
-      while (a < e1) t[o++] = v[a++];
-      while (b < e2) t[o++] = v[b++];
-      i = e2;
-    }
-    int *w = v;
-    v = t;
-    t = w;
-    if (runs <= 1) return v;
-  }
-}
+/* vertex indices, merged from their runs (one per collider) */
+static int int_less(const int *a, const int *b) { return *a < *b; }
+SS_SORT_RUNS(merge_sort_runs, int, int_less)
 
 void ss_terrain_update(const ssModel *m, ssData *d)
 {
@@ -443,11 +419,9 @@ void ss_terrain_update(const ssModel *m, ssData *d)
     const ssContact *c = d->contact + i;
     if (c->type == SS_CONTACT_SOIL && c->loaded) d->soil_loaded[n++] = c->vertex;
   }
-  /* one collider's vertices come in order already */
-  int sorted = 1;
-  for (int i = 1; i < n && sorted; i++) sorted = d->soil_loaded[i - 1] < d->soil_loaded[i];
-  const int *v = d->soil_loaded;
-  if (!sorted) v = merge_sort_runs(d->soil_loaded, d->soil_loaded + n, n);
+  /* one collider's vertices come in order already (then the sort only
+   * checks them); several colliders' are merged */
+  const int *v = merge_sort_runs(d->soil_loaded, d->soil_loaded + n, n);
   int u = 0;
   for (int i = 0; i < n; i++)
     if (u == 0 || d->soil_loaded[u - 1] != v[i]) d->soil_loaded[u++] = v[i];

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "collide.h"
+#include "sort_runs.h"
 #include "ss_math.h"
 #include "tap.h"
 
@@ -799,6 +800,57 @@ static void test_low_bounds(void)
   ok(!ss_shape_low_bounds(&w, -0.01, lo, hi), "wheel above zc: no low bounds");
 }
 
+/* SS_SORT_RUNS on inputs made of runs (ascending, descending, with ties,
+ * as the colliders' contacts come) and on random ones: the result must be
+ * the stable order, the one a stable insertion sort gives, element for
+ * element (key and original position), and an already sorted input must
+ * come back in place. */
+typedef struct {
+  int key, pos;
+} SortItem;
+static int item_less(const SortItem *a, const SortItem *b) { return a->key < b->key; }
+SS_SORT_RUNS(sort_items, SortItem, item_less)
+
+static void test_sort_runs(void)
+{
+  enum { N = 97 };
+  SortItem v[N], t[N], want[N];
+  uint32_t seed = 12345;
+  int bad = 0, cases = 0;
+  for (int c = 0; c < 400; c++) {
+    int n = c % N + 1;
+    int mode = c % 4, key = 0, dir = 1;
+    for (int i = 0; i < n; i++) {
+      seed = seed * 1664525u + 1013904223u;
+      int r = (int)(seed >> 24);
+      if (mode == 0) key = r % 7; /* random with many ties */
+      else {
+        if (r % 11 == 0) dir = mode == 1 ? 1 : -dir; /* a new run */
+        if (r % 11 == 0) key = r % 20;
+        key += dir * (mode == 3 ? (r & 1) : 1); /* mode 3: ties in runs */
+      }
+      v[i] = (SortItem){key, i};
+    }
+    memcpy(want, v, sizeof(SortItem) * (size_t)n);
+    for (int i = 1; i < n; i++)
+      for (int j = i; j > 0 && want[j].key < want[j - 1].key; j--) {
+        SortItem s = want[j];
+        want[j] = want[j - 1];
+        want[j - 1] = s;
+      }
+    int was_sorted = 1;
+    for (int i = 1; i < n; i++) was_sorted &= v[i - 1].key <= v[i].key;
+    SortItem *r = sort_items(v, t, n);
+    int same = 1;
+    for (int i = 0; i < n; i++) same &= r[i].key == want[i].key && r[i].pos == want[i].pos;
+    if (!same || (was_sorted && r != v)) bad++;
+    cases++;
+  }
+  ok(bad == 0, "SS_SORT_RUNS: %d of %d inputs (runs up and down, ties) in the stable order", cases - bad, cases);
+  SortItem one[1] = {{3, 0}}, scratch[1];
+  ok(sort_items(one, scratch, 1) == one && sort_items(one, scratch, 0) == one, "SS_SORT_RUNS: 0 and 1 elements stay in place");
+}
+
 int main(void)
 {
   test_plate_quadrature();
@@ -811,5 +863,6 @@ int main(void)
   test_width();
   test_aabb();
   test_low_bounds();
+  test_sort_runs();
   return done_testing();
 }
