@@ -752,21 +752,36 @@ void ss_art_link_block(const ssModel *m, ssData *d, int b, const double **Y,
   *Lam = w->Lam + 36 * lb;
 }
 
-void ss_art_contact_rows(const ssModel *m, ssData *d, int b,
-                         const double p[3], const double frame[9],
-                         double X[18], double LX[18], double G[9])
+void ss_art_contact_rows(const double p[3], const double frame[9], double X[18])
 {
-  const double *Y, *Lam;
-  ss_art_link_block(m, d, b, &Y, &Lam);
   /* contact-frame velocity of the point from a spatial velocity */
   for (int i = 0; i < 3; i++) {
     const double *f = frame + 3 * i;
     ss_v3_cross(X + 6 * i, p, f);
     memcpy(X + 6 * i + 3, f, 3 * sizeof(double));
   }
+}
+
+void ss_art_contact_response(const ssModel *m, ssData *d, int b,
+                             const double X[18], double LX[18], double G[9])
+{
+  const double *Y, *Lam;
+  ss_art_link_block(m, d, b, &Y, &Lam);
   for (int i = 0; i < 3; i++) m6v(LX + 6 * i, Lam, X + 6 * i);
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++) G[3 * i + j] = dot6(X + 6 * i, LX + 6 * j);
+}
+
+double ss_art_contact_slip_response(const ssModel *m, ssData *d, int b,
+                                    const double X[18])
+{
+  const double *Y, *Lam;
+  ss_art_link_block(m, d, b, &Y, &Lam);
+  double l1[6], l2[6];
+  m6v(l1, Lam, X + 6);
+  m6v(l2, Lam, X + 12);
+  double g11 = dot6(X + 6, l1), g22 = dot6(X + 12, l2);
+  return g11 > g22 ? g11 : g22;
 }
 
 void ss_art_dof_jacobian(const ssModel *m, ssData *d, int s, int dof,

@@ -83,14 +83,21 @@ void ss_art_link_velocity(const ssModel *m, const ssData *d, int b,
  * spatial motion J_b u. */
 void ss_art_link_motion(const ssModel *m, const ssData *d, int b,
                         const double *u, double V[6]);
-/* Contact rows of a world point on link b: X (3 x 6) maps the link's
- * spatial velocity to the contact-frame velocity of the point (the
- * contact's Jacobian is X J_b, its response Y X^T), LX (3 x 6, row i =
+/* Contact rows of a world point p with contact frame `frame` (rows n, t1,
+ * t2) on a link: X (3 x 6) maps the link's spatial velocity to the
+ * contact-frame velocity of the point.  The contact's Jacobian is X J_b,
+ * its response Y X^T. */
+void ss_art_contact_rows(const double p[3], const double frame[9], double X[18]);
+/* The contact's response on link b, from its rows X: LX (3 x 6, row i =
  * Lam X_i^T) the link's velocity change per unit impulse along each
- * contact direction, and G = X Lam X^T. */
-void ss_art_contact_rows(const ssModel *m, ssData *d, int b,
-                         const double p[3], const double frame[9],
-                         double X[18], double LX[18], double G[9]);
+ * contact direction, and G = X Lam X^T.  Only the Gauss-Seidel sweeps need
+ * them: the solver forms them when sweeps follow the Newton phase. */
+void ss_art_contact_response(const ssModel *m, ssData *d, int b,
+                             const double X[18], double LX[18], double G[9]);
+/* max(G_11, G_22) of that G, the same bits, without the rest: the Newton
+ * phase's stick test. */
+double ss_art_contact_slip_response(const ssModel *m, ssData *d, int b,
+                                    const double X[18]);
 /* Row of one degree of freedom (PD, limits): J = e_k, W = P M'^-1 e_k. */
 void ss_art_dof_jacobian(const ssModel *m, ssData *d, int sys, int dof,
                          double *J, double *W, double G[9]);

@@ -10,7 +10,7 @@
 ssStatus ss_dyn_free_velocity(const ssModel *m, ssData *d, ssError *err);
 /* Contact Jacobian rows (frame rows n, t1, t2) of a point on single rigid
  * body b: J (3 x 6) and W = M^-1 J^T (6 x 3), and G = J W (3 x 3).
- * Articulated links use ss_art_contact_rows. */
+ * Articulated links use ss_art_contact_rows and ss_art_contact_response. */
 void ss_dyn_contact_jacobian(const ssModel *m, ssData *d, int body,
                              const double point[3], const double frame[9],
                              double *J, double *W, double G[9]);

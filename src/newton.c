@@ -746,7 +746,8 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
     P->k = (c->width > 0 && mat->bekker_kc != 0 ? mat->bekker_kc / c->width : 0) + mat->bekker_kphi;
     P->tf0 = P->S * mat->cohesion;
     P->x0 = mat->shear_displacement > 0 ? c->j / mat->shear_displacement : 0;
-    P->gtt = fmax(c->G[4], c->G[8]);
+    P->gtt = c->link >= 0 ? ss_art_contact_slip_response(m, d, c->link, d->jac + c->jadr)
+                          : fmax(c->G[4], c->G[8]);
     P->ps = 0;
     P->mob.x = -1;
   }

@@ -466,9 +466,14 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
     }
   }
 
-  /* the soil points' laws for the sweeps (the Newton phase has its own) */
+  /* what only the sweeps use: the link contacts' responses LX and G, and
+   * the soil points' laws (the Newton phase has its own) */
   for (int i = 0; i < d->ncontact && sweeps > 0; i++) {
     ssContact *c = d->contact + i;
+    if (c->link >= 0) {
+      double *X = d->jac + c->jadr;
+      ss_art_contact_response(m, d, c->link, X, X + 18, c->G);
+    }
     if (c->type == SS_CONTACT_SOIL) ss_point_setup(&m->hfield_soilmat[c->hfield], dt, c);
   }
   Group g = {NULL, NULL, NULL, {0}, {0}};

@@ -38,7 +38,8 @@ static long contact_jlen(const ssModel *m, int sys)
   return m->sys_type[sys] == SS_SYS_ARTICULATED ? 36 : 6L * m->sys_nv[sys];
 }
 
-/* fill the system-dependent part of a contact: Jacobian, response, G */
+/* fill the system-dependent part of a contact: Jacobian, response, G (a
+ * link contact: its rows X only) */
 static void attach(const ssModel *m, ssData *d, ssContact *c, int sys)
 {
   if (sys >= 0 && m->sys_nv[sys] > 0) {
@@ -49,7 +50,9 @@ static void attach(const ssModel *m, ssData *d, ssContact *c, int sys)
     double *J = d->jac + c->jadr;
     if (m->sys_type[sys] == SS_SYS_ARTICULATED) {
       c->link = b;
-      ss_art_contact_rows(m, d, b, c->pos, c->frame, J, J + 18, c->G);
+      /* X now; LX (J + 18) and G when sweeps need them
+       * (ss_art_contact_response) */
+      ss_art_contact_rows(c->pos, c->frame, J);
     } else {
       ss_dyn_contact_jacobian(m, d, b, c->pos, c->frame, J, J + 3 * c->nv, c->G);
     }
