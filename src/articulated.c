@@ -772,18 +772,6 @@ void ss_art_contact_response(const ssModel *m, ssData *d, int b,
     for (int j = 0; j < 3; j++) G[3 * i + j] = dot6(X + 6 * i, LX + 6 * j);
 }
 
-double ss_art_contact_slip_response(const ssModel *m, ssData *d, int b,
-                                    const double X[18])
-{
-  const double *Y, *Lam;
-  ss_art_link_block(m, d, b, &Y, &Lam);
-  double l1[6], l2[6];
-  m6v(l1, Lam, X + 6);
-  m6v(l2, Lam, X + 12);
-  double g11 = dot6(X + 6, l1), g22 = dot6(X + 12, l2);
-  return g11 > g22 ? g11 : g22;
-}
-
 void ss_art_dof_jacobian(const ssModel *m, ssData *d, int s, int dof,
                          double *J, double *W, double G[9])
 {

@@ -94,10 +94,6 @@ void ss_art_contact_rows(const double p[3], const double frame[9], double X[18])
  * them: the solver forms them when sweeps follow the Newton phase. */
 void ss_art_contact_response(const ssModel *m, ssData *d, int b,
                              const double X[18], double LX[18], double G[9]);
-/* max(G_11, G_22) of that G, the same bits, without the rest: the Newton
- * phase's stick test. */
-double ss_art_contact_slip_response(const ssModel *m, ssData *d, int b,
-                                    const double X[18]);
 /* Row of one degree of freedom (PD, limits): J = e_k, W = P M'^-1 e_k. */
 void ss_art_dof_jacobian(const ssModel *m, ssData *d, int sys, int dof,
                          double *J, double *W, double G[9]);

@@ -68,6 +68,7 @@ typedef struct NGroup {
   int link;           /* articulated link, or -1: the free body `body` */
   int body, sys;
   double Yb[36];      /* free body: its response Y (see body_block) */
+  double Lg[36];      /* link: its Lam in the group's frame (group_lam) */
   const ssSoilMaterial *mat;
   double R[9];        /* contact frame rows n, t1, t2 (world) */
   double o[3];        /* origin of the points' r (world) */
@@ -197,20 +198,27 @@ static void to_group(const NGroup *G, const double V[6], double Vg[6])
   ss_m3_mulv(Vg + 3, G->R, vo);
 }
 
-/* the group's impulse and its derivative back to world, about the origin:
- * with y' = T y, T = [[R, 0], [-R [o]x, R]], F = T^T F' and H = T^T H' T */
-static void from_group(const NGroup *G, const double Fg[6], const double Hg[36],
-                       double F[6], double H[36])
+/* The group's impulse and its derivative back to world, about the origin:
+ * with y' = T y, T = [[R, 0], [-R [o]x, R]], F = T^T F' and H = T^T H' T.
+ * group_T forms T. */
+static void group_T(const NGroup *G, double T[36])
 {
-  double T[36] = {0}, ox[9] = {0, -G->o[2], G->o[1], G->o[2], 0, -G->o[0],
-                               -G->o[1], G->o[0], 0}, Rox[9];
+  double ox[9] = {0, -G->o[2], G->o[1], G->o[2], 0, -G->o[0], -G->o[1], G->o[0], 0}, Rox[9];
   ss_m3_mul(Rox, G->R, ox);
+  memset(T, 0, 36 * sizeof(double));
   for (int a = 0; a < 3; a++)
     for (int b = 0; b < 3; b++) {
       T[6 * a + b] = G->R[3 * a + b];
       T[6 * (a + 3) + b + 3] = G->R[3 * a + b];
       T[6 * (a + 3) + b] = -Rox[3 * a + b];
     }
+}
+
+static void from_group(const NGroup *G, const double Fg[6], const double Hg[36],
+                       double F[6], double H[36])
+{
+  double T[36];
+  group_T(G, T);
   for (int a = 0; a < 6; a++) {
     double t = 0;
     for (int k = 0; k < 6; k++) t += T[6 * k + a] * Fg[k];
@@ -276,6 +284,43 @@ static const double *group_block(const ssModel *m, ssData *d, const NGroup *G)
   const double *Y, *Lb;
   ss_art_link_block(m, d, G->link, &Y, &Lb);
   return Y;
+}
+
+/* A link's response to the group's points in the group's frame,
+ * Lam' = T Lam T^T (y' = T y, F = T^T F'), for the stick test: a point at
+ * r has tangential rows x_1 = (r x e_1; e_1), x_2 = (r x e_2; e_2) there,
+ * and its G_kk = x_k^T Lam' x_k is a quadratic in r */
+static void group_lam(const NGroup *G, const double Lam[36], double Lg[36])
+{
+  double T[36], LT[36];
+  group_T(G, T);
+  for (int a = 0; a < 6; a++)
+    for (int b = 0; b < 6; b++) {
+      double t = 0;
+      for (int k = 0; k < 6; k++) t += Lam[6 * a + k] * T[6 * b + k];
+      LT[6 * a + b] = t;
+    }
+  for (int a = 0; a < 6; a++)
+    for (int b = 0; b < 6; b++) {
+      double t = 0;
+      for (int k = 0; k < 6; k++) t += T[6 * a + k] * LT[6 * k + b];
+      Lg[6 * a + b] = t;
+    }
+}
+
+/* max(G_11, G_22) of a point at r (group frame) from Lam' (group_lam):
+ * x_1 has -r_2, r_0, 1 at 0, 2, 4; x_2 has r_1, -r_0, 1 at 0, 1, 5 */
+static double slip_response(const double Lg[36], const double r[3])
+{
+  const int i1[3] = {0, 2, 4}, i2[3] = {0, 1, 5};
+  const double x1[3] = {-r[2], r[0], 1}, x2[3] = {r[1], -r[0], 1};
+  double g1 = 0, g2 = 0;
+  for (int a = 0; a < 3; a++)
+    for (int b = 0; b < 3; b++) {
+      g1 += x1[a] * Lg[6 * i1[a] + i1[b]] * x1[b];
+      g2 += x2[a] * Lg[6 * i2[a] + i2[b]] * x2[b];
+    }
+  return g1 > g2 ? g1 : g2;
 }
 
 /* a bed material's constants as the law uses them */
@@ -726,10 +771,16 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
       G->link = c->link;
       G->sys = c->sys;
       G->body = c->link >= 0 ? c->link : m->geom_body[c->geom];
-      if (c->link < 0) body_block(m, d, G->body, G->Yb);
       G->mat = &m->hfield_soilmat[c->hfield];
       memcpy(G->R, c->frame, sizeof G->R);
       memcpy(G->o, c->pos, sizeof G->o);
+      if (c->link < 0) {
+        body_block(m, d, G->body, G->Yb);
+      } else {
+        const double *Y, *Lam;
+        ss_art_link_block(m, d, c->link, &Y, &Lam);
+        group_lam(G, Lam, G->Lg);
+      }
     } else if (memcmp(G->R, c->frame, sizeof G->R)) {
       return 0;
     }
@@ -746,8 +797,7 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
     P->k = (c->width > 0 && mat->bekker_kc != 0 ? mat->bekker_kc / c->width : 0) + mat->bekker_kphi;
     P->tf0 = P->S * mat->cohesion;
     P->x0 = mat->shear_displacement > 0 ? c->j / mat->shear_displacement : 0;
-    P->gtt = c->link >= 0 ? ss_art_contact_slip_response(m, d, c->link, d->jac + c->jadr)
-                          : fmax(c->G[4], c->G[8]);
+    P->gtt = c->link >= 0 ? slip_response(G->Lg, P->r) : fmax(c->G[4], c->G[8]);
     P->ps = 0;
     P->mob.x = -1;
   }
