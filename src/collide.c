@@ -626,8 +626,8 @@ static int cylinder_interval(const double o[3], const double d[3], double r,
       lin = lout = 0;
     } else {
       double r1 = q / a, r2 = c / q;
-      lin = fmin(r1, r2);
-      lout = fmax(r1, r2);
+      lin = ss_min(r1, r2);
+      lout = ss_max(r1, r2);
     }
   }
 
@@ -636,11 +636,11 @@ static int cylinder_interval(const double o[3], const double d[3], double r,
     if (fabs(o[2]) > hl) return 0;
   } else {
     double s1 = (-hl - o[2]) / d[2], s2 = (hl - o[2]) / d[2];
-    sin_ = fmin(s1, s2);
-    sout = fmax(s1, s2);
+    sin_ = ss_min(s1, s2);
+    sout = ss_max(s1, s2);
   }
 
-  double tin = fmax(lin, sin_), tout = fmin(lout, sout);
+  double tin = ss_max(lin, sin_), tout = ss_min(lout, sout);
   if (!(tin <= tout)) return 0;
   *t0 = tin;
   *t1 = tout;
@@ -682,8 +682,8 @@ int ss_shape_lowest_z(const ssShape *s, double x, double y, double *z)
         continue;
       }
       double t1 = (-h - o[k]) / d[k], t2 = (h - o[k]) / d[k];
-      tin = fmax(tin, fmin(t1, t2));
-      tout = fmin(tout, fmax(t1, t2));
+      tin = ss_max(tin, ss_min(t1, t2));
+      tout = ss_min(tout, ss_max(t1, t2));
     }
     if (!(tin <= tout)) return 0;
     *z = s->pos[2] + tin;

@@ -69,7 +69,7 @@ ssStatus ss_dyn_free_velocity(const ssModel *m, ssData *d, ssError *err)
 
 void ss_dyn_contact_jacobian(const ssModel *m, ssData *d, int b,
                              const double p[3], const double frame[9],
-                             double *J, double *W, double G[9])
+                             double *J, double *W)
 {
   double r[3], inv_m = 1.0 / m->body_mass[b];
   const double *Iinv = d->body_iinv + 9 * b;
@@ -89,12 +89,20 @@ void ss_dyn_contact_jacobian(const ssModel *m, ssData *d, int b,
       W[3 * (3 + i) + k] = wang[k][i];
     }
   }
-#pragma GCC unroll 3
-  for (int a = 0; a < 3; a++)
-#pragma GCC unroll 3
-    for (int c = 0; c < 3; c++)
-      G[3 * a + c] = ss_v3_dot(frame + 3 * a, frame + 3 * c) * inv_m +
-                     ss_v3_dot(ang[a], wang[c]);
+}
+
+void ss_dyn_contact_response(const ssModel *m, int b, const double *J,
+                             const double *W, double G[9])
+{
+  double inv_m = 1.0 / m->body_mass[b];
+  for (int a = 0; a < 3; a++) {
+    const double *f = J + 6 * a, *ang = J + 6 * a + 3;
+    for (int c = 0; c < 3; c++) {
+      const double *fc = J + 6 * c;
+      double wang[3] = {W[9 + c], W[12 + c], W[15 + c]};
+      G[3 * a + c] = ss_v3_dot(f, fc) * inv_m + ss_v3_dot(ang, wang);
+    }
+  }
 }
 
 void ss_dyn_point_velocity(const ssModel *m, const ssData *d, int b,

@@ -68,7 +68,7 @@ typedef struct NGroup {
   int link;           /* articulated link, or -1: the free body `body` */
   int body, sys;
   double Yb[36];      /* free body: its response Y (see body_block) */
-  double Lg[36];      /* link: its Lam in the group's frame (group_lam) */
+  double Lg[36];      /* its Lam in the group's frame (group_lam) */
   const ssSoilMaterial *mat;
   double R[9];        /* contact frame rows n, t1, t2 (world) */
   double o[3];        /* origin of the points' r (world) */
@@ -286,7 +286,7 @@ static const double *group_block(const ssModel *m, ssData *d, const NGroup *G)
   return Y;
 }
 
-/* A link's response to the group's points in the group's frame,
+/* A link's or body's response to the group's points in the group's frame,
  * Lam' = T Lam T^T (y' = T y, F = T^T F'), for the stick test: a point at
  * r has tangential rows x_1 = (r x e_1; e_1), x_2 = (r x e_2; e_2) there,
  * and its G_kk = x_k^T Lam' x_k is a quadratic in r */
@@ -774,13 +774,23 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
       G->mat = &m->hfield_soilmat[c->hfield];
       memcpy(G->R, c->frame, sizeof G->R);
       memcpy(G->o, c->pos, sizeof G->o);
+      const double *Lam;
+      double Lb[36];
       if (c->link < 0) {
+        /* the body's Lam = J_b Y, a column per unit spatial impulse */
         body_block(m, d, G->body, G->Yb);
+        for (int k = 0; k < 6; k++) {
+          double u[6], V[6];
+          for (int r = 0; r < 6; r++) u[r] = G->Yb[6 * r + k];
+          group_motion(m, d, G, u, V);
+          for (int a = 0; a < 6; a++) Lb[6 * a + k] = V[a];
+        }
+        Lam = Lb;
       } else {
-        const double *Y, *Lam;
+        const double *Y;
         ss_art_link_block(m, d, c->link, &Y, &Lam);
-        group_lam(G, Lam, G->Lg);
       }
+      group_lam(G, Lam, G->Lg);
     } else if (memcmp(G->R, c->frame, sizeof G->R)) {
       return 0;
     }
@@ -797,7 +807,7 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
     P->k = (c->width > 0 && mat->bekker_kc != 0 ? mat->bekker_kc / c->width : 0) + mat->bekker_kphi;
     P->tf0 = P->S * mat->cohesion;
     P->x0 = mat->shear_displacement > 0 ? c->j / mat->shear_displacement : 0;
-    P->gtt = c->link >= 0 ? slip_response(G->Lg, P->r) : fmax(c->G[4], c->G[8]);
+    P->gtt = slip_response(G->Lg, P->r);
     P->ps = 0;
     P->mob.x = -1;
   }

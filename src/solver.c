@@ -9,6 +9,7 @@
  * contact by W (lambda_new - lambda_old). */
 #include "solver.h"
 #include "articulated.h"
+#include "dynamics.h"
 #include "sort_runs.h"
 #include "ss_math.h"
 
@@ -466,14 +467,16 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
     }
   }
 
-  /* what only the sweeps use: the link contacts' responses LX and G, and
-   * the soil points' laws (the Newton phase has its own) */
+  /* what only the sweeps use: the body contacts' responses G (and a link
+   * contact's LX), and the soil points' laws (the Newton phase has its
+   * own) */
   for (int i = 0; i < d->ncontact && sweeps > 0; i++) {
     ssContact *c = d->contact + i;
-    if (c->link >= 0) {
-      double *X = d->jac + c->jadr;
-      ss_art_contact_response(m, d, c->link, X, X + 18, c->G);
-    }
+    double *J = d->jac + c->jadr;
+    if (c->link >= 0)
+      ss_art_contact_response(m, d, c->link, J, J + 18, c->G);
+    else if (c->nv > 0 && (c->type == SS_CONTACT_SOIL || c->type == SS_CONTACT_RIGID))
+      ss_dyn_contact_response(m, m->geom_body[c->geom], J, J + 3 * c->nv, c->G);
     if (c->type == SS_CONTACT_SOIL) ss_point_setup(&m->hfield_soilmat[c->hfield], dt, c);
   }
   Group g = {NULL, NULL, NULL, {0}, {0}};

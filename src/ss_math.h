@@ -10,6 +10,11 @@
 #define M_PI 3.14159265358979323846
 #endif
 
+/* max and min of two numbers that are not NaN: plain comparisons, where
+ * fmax and fmin (which must pass over a NaN) are calls into libm */
+static inline double ss_max(double a, double b) { return a > b ? a : b; }
+static inline double ss_min(double a, double b) { return a < b ? a : b; }
+
 static inline void ss_v3_set(double r[3], double x, double y, double z) { r[0] = x; r[1] = y; r[2] = z; }
 static inline void ss_v3_copy(double r[3], const double a[3]) { r[0] = a[0]; r[1] = a[1]; r[2] = a[2]; }
 static inline void ss_v3_add(double r[3], const double a[3], const double b[3]) { r[0] = a[0] + b[0]; r[1] = a[1] + b[1]; r[2] = a[2] + b[2]; }

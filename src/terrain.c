@@ -38,8 +38,9 @@ static long contact_jlen(const ssModel *m, int sys)
   return m->sys_type[sys] == SS_SYS_ARTICULATED ? 36 : 6L * m->sys_nv[sys];
 }
 
-/* fill the system-dependent part of a contact: Jacobian, response, G (a
- * link contact: its rows X only) */
+/* fill the system-dependent part of a contact: its Jacobian (a link
+ * contact: its rows X) and a rigid body's response W; the rest, which only
+ * the sweeps use, when they run (ss_solver_solve) */
 static void attach(const ssModel *m, ssData *d, ssContact *c, int sys)
 {
   if (sys >= 0 && m->sys_nv[sys] > 0) {
@@ -54,7 +55,7 @@ static void attach(const ssModel *m, ssData *d, ssContact *c, int sys)
        * (ss_art_contact_response) */
       ss_art_contact_rows(c->pos, c->frame, J);
     } else {
-      ss_dyn_contact_jacobian(m, d, b, c->pos, c->frame, J, J + 3 * c->nv, c->G);
+      ss_dyn_contact_jacobian(m, d, b, c->pos, c->frame, J, J + 3 * c->nv);
     }
   } else {
     c->sys = -1;
