@@ -14,6 +14,7 @@
 #include "ss_math.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -57,7 +58,9 @@ ssContact *ss_contact_new(ssData *d, long njac)
     d->jac = q;
     d->cap_jac = cap;
   }
-  memset(c, 0, sizeof *c);
+  memset(c, 0, offsetof(ssContact, cache));
+  c->cache.law.ps = 0; /* empty (see ssPointCache) */
+  c->cache.ready = 0;
   c->link = -1;
   c->jadr = jadr;
   c->jlen = njac;

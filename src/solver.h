@@ -55,10 +55,12 @@ struct ssContact {
   int dof;           /* PD, limit: global velocity index */
   double v[3];       /* contact-frame velocity at the end of the solve */
   int loaded;        /* soil: 1 if the point carries load at the end */
-  ssPointCache cache;/* soil: the point solve's law and reused values */
   double warm_t[3];  /* soil: the cached traction its warm start came from */
   int warm_trend;    /* soil: 1 when warm_t is a converged step's traction,
                         so that this step's change can be formed */
+  ssPointCache cache;/* soil: the point solve's law and reused values (last:
+                        ss_contact_new zeroes what comes before it and marks
+                        it empty, without clearing its 264 bytes) */
 };
 
 /* A cached traction from the previous step (warm start).  The next step
@@ -80,9 +82,9 @@ struct ssWarmEntry {
   double rate[3];    /* traction change over the last step (Pa); 0 for rows */
 };
 
-/* Room for one more contact (zeroed, link = -1) with njac doubles of
- * Jacobian storage in d->jac (6 nv for J and W, 36 for a link contact's
- * X and LX); NULL when out of memory. */
+/* Room for one more contact (zeroed, its point cache empty, link = -1)
+ * with njac doubles of Jacobian storage in d->jac (6 nv for J and W, 36
+ * for a link contact's X and LX); NULL when out of memory. */
 ssContact *ss_contact_new(ssData *d, long njac);
 
 /* Solve all contacts in d->contact; d->qvel holds the free velocity on entry
