@@ -69,40 +69,46 @@ ssStatus ss_dyn_free_velocity(const ssModel *m, ssData *d, ssError *err)
 
 void ss_dyn_contact_jacobian(const ssModel *m, ssData *d, int b,
                              const double p[3], const double frame[9],
-                             double *J, double *W)
+                             double *J)
 {
-  double r[3], inv_m = 1.0 / m->body_mass[b];
-  const double *Iinv = d->body_iinv + 9 * b;
+  (void)m;
+  double r[3];
   ss_v3_sub(r, p, d->body_xipos + 3 * b);
-  double ang[3][3], wang[3][3];
-#pragma GCC unroll 3
+  /* J row k = [f, r x f] */
   for (int k = 0; k < 3; k++) {
     const double *f = frame + 3 * k;
-    ss_v3_cross(ang[k], r, f);
-    ss_m3_mulv(wang[k], Iinv, ang[k]);
-    /* J row k = [f, r x f]; W column k = [f / m, I^-1 (r x f)] */
-#pragma GCC unroll 3
+    ss_v3_copy(J + 6 * k, f);
+    ss_v3_cross(J + 6 * k + 3, r, f);
+  }
+}
+
+void ss_dyn_contact_response(const ssModel *m, ssData *d, int b,
+                             const double *J, double *W, double G[9])
+{
+  double inv_m = 1.0 / m->body_mass[b];
+  const double *Iinv = d->body_iinv + 9 * b;
+  double wang[3][3];
+  for (int k = 0; k < 3; k++) {
+    /* W column k = [f / m, I^-1 (r x f)] */
+    const double *f = J + 6 * k;
+    ss_m3_mulv(wang[k], Iinv, J + 6 * k + 3);
     for (int i = 0; i < 3; i++) {
-      J[6 * k + i] = f[i];
-      J[6 * k + 3 + i] = ang[k][i];
       W[3 * i + k] = f[i] * inv_m;
       W[3 * (3 + i) + k] = wang[k][i];
     }
   }
+  for (int a = 0; a < 3; a++)
+    for (int c = 0; c < 3; c++)
+      G[3 * a + c] = ss_v3_dot(J + 6 * a, J + 6 * c) * inv_m + ss_v3_dot(J + 6 * a + 3, wang[c]);
 }
 
-void ss_dyn_contact_response(const ssModel *m, int b, const double *J,
-                             const double *W, double G[9])
+void ss_dyn_body_impulse(const ssModel *m, ssData *d, int b, const double F[6])
 {
+  double *u = d->qvel + m->sys_vadr[m->body_sys[b]], dw[3];
   double inv_m = 1.0 / m->body_mass[b];
-  for (int a = 0; a < 3; a++) {
-    const double *f = J + 6 * a, *ang = J + 6 * a + 3;
-    for (int c = 0; c < 3; c++) {
-      const double *fc = J + 6 * c;
-      double wang[3] = {W[9 + c], W[12 + c], W[15 + c]};
-      G[3 * a + c] = ss_v3_dot(f, fc) * inv_m + ss_v3_dot(ang, wang);
-    }
-  }
+  for (int i = 0; i < 3; i++) u[i] += F[i] * inv_m;
+  ss_m3_mulv(dw, d->body_iinv + 9 * b, F + 3);
+  ss_v3_add(u + 3, u + 3, dw);
 }
 
 void ss_dyn_point_velocity(const ssModel *m, const ssData *d, int b,

@@ -9,16 +9,21 @@
  * for articulated systems with their force elements and loop closures. */
 ssStatus ss_dyn_free_velocity(const ssModel *m, ssData *d, ssError *err);
 /* Contact Jacobian rows (frame rows n, t1, t2) of a point on single rigid
- * body b: J (3 x 6) and W = M^-1 J^T (6 x 3).  Articulated links use
- * ss_art_contact_rows and ss_art_contact_response. */
+ * body b: J (3 x 6), row k = [f_k, r x f_k] with r from the centre of
+ * mass.  Articulated links use ss_art_contact_rows and
+ * ss_art_contact_response. */
 void ss_dyn_contact_jacobian(const ssModel *m, ssData *d, int body,
                              const double point[3], const double frame[9],
-                             double *J, double *W);
-/* G = J W (3 x 3) of such a contact, from its J and W (the same bits as
- * forming it with them).  Only the Gauss-Seidel sweeps need it: the solver
- * forms it when sweeps follow the Newton phase. */
-void ss_dyn_contact_response(const ssModel *m, int body, const double *J,
-                             const double *W, double G[9]);
+                             double *J);
+/* The response of such a contact, from its J: W = M^-1 J^T (6 x 3) and
+ * G = J W (3 x 3).  Only the Gauss-Seidel sweeps need them: the solver
+ * forms them when sweeps follow the Newton phase. */
+void ss_dyn_contact_response(const ssModel *m, ssData *d, int body,
+                             const double *J, double *W, double G[9]);
+/* qvel of body b += M^-1 F for an impulse F = (force; torque about the
+ * centre of mass), the layout of J^T lambda. */
+void ss_dyn_body_impulse(const ssModel *m, ssData *d, int body,
+                         const double F[6]);
 /* Velocity of a world point on body b. */
 void ss_dyn_point_velocity(const ssModel *m, const ssData *d, int body,
                            const double point[3], double v[3]);

@@ -245,6 +245,22 @@ static const ssWarmEntry *find_warm(const ssData *d, const ssWarmEntry *key,
   return e;
 }
 
+/* A rigid body's run of contacts in the warm start: the sum of their
+ * J^T lambda (force; torque about the centre of mass), applied at the
+ * run's end */
+typedef struct BodyRun {
+  int body; /* -1: none open */
+  double F[6];
+} BodyRun;
+
+static void body_run_close(const ssModel *m, ssData *d, BodyRun *r)
+{
+  if (r->body < 0) return;
+  ss_dyn_body_impulse(m, d, r->body, r->F);
+  r->body = -1;
+  memset(r->F, 0, sizeof r->F);
+}
+
 /* Initial impulses from last step's tractions extrapolated by their rate
  * (ssWarmEntry), scaled by the current area and time step and projected
  * into the current bounds; joint rows start from last step's impulse
@@ -254,6 +270,7 @@ static void warm_start(const ssModel *m, ssData *d, int converged)
 {
   const double dt = m->opt.timestep;
   Group g = {NULL, NULL, NULL, {0}, {0}};
+  BodyRun br = {-1, {0}};
   int cursor = 0;
   for (int i = 0; i < d->ncontact; i++) {
     ssContact *c = d->contact + i;
@@ -287,8 +304,20 @@ static void warm_start(const ssModel *m, ssData *d, int converged)
       c->lambda[2] = lt1;
     }
     if (!c->nv) continue;
-    if (c->link >= 0 && !d->solver_full) {
+    if (c->link < 0 && c->type == SS_CONTACT_SOIL) {
+      /* a rigid body's run likewise, as J^T lambda (its W is formed only
+       * for the sweeps) */
+      group_close(d, &g);
+      int b = m->geom_body[c->geom];
+      if (br.body != b) {
+        body_run_close(m, d, &br);
+        br.body = b;
+      }
+      const double *J = d->jac + c->jadr;
+      for (int k = 0; k < 6; k++) br.F[k] += J[k] * c->lambda[0] + J[6 + k] * c->lambda[1] + J[12 + k] * c->lambda[2];
+    } else if (c->link >= 0 && !d->solver_full) {
       /* a link run's impulses reach u once, at the run's end */
+      body_run_close(m, d, &br);
       if (!g.first || g.first->link != c->link) {
         group_close(d, &g);
         g.first = c;
@@ -300,10 +329,12 @@ static void warm_start(const ssModel *m, ssData *d, int converged)
       for (int k = 0; k < 6; k++) g.F[k] += w[k];
     } else {
       group_close(d, &g);
+      body_run_close(m, d, &br);
       apply_impulse(m, d, c, c->lambda);
     }
   }
   group_close(d, &g);
+  body_run_close(m, d, &br);
 }
 
 static int cached(const ssContact *c)
@@ -470,16 +501,16 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
     }
   }
 
-  /* what only the sweeps use: the body contacts' responses G (and a link
-   * contact's LX), and the soil points' laws (the Newton phase has its
-   * own) */
+  /* what only the sweeps use: the body contacts' responses (a rigid
+   * body's W and G, a link contact's LX and G), and the soil points' laws
+   * (the Newton phase has its own) */
   for (int i = 0; i < d->ncontact && sweeps > 0; i++) {
     ssContact *c = d->contact + i;
     double *J = d->jac + c->jadr;
     if (c->link >= 0)
       ss_art_contact_response(m, d, c->link, J, J + 18, c->G);
     else if (c->nv > 0 && (c->type == SS_CONTACT_SOIL || c->type == SS_CONTACT_RIGID))
-      ss_dyn_contact_response(m, m->geom_body[c->geom], J, J + 3 * c->nv, c->G);
+      ss_dyn_contact_response(m, d, m->geom_body[c->geom], J, J + 3 * c->nv, c->G);
     if (c->type == SS_CONTACT_SOIL) ss_point_setup(&m->hfield_soilmat[c->hfield], dt, c);
   }
   Group g = {NULL, NULL, NULL, {0}, {0}};

@@ -39,8 +39,8 @@ static long contact_jlen(const ssModel *m, int sys)
 }
 
 /* fill the system-dependent part of a contact: its Jacobian (a link
- * contact: its rows X) and a rigid body's response W; the rest, which only
- * the sweeps use, when they run (ss_solver_solve) */
+ * contact: its rows X); its response, which only the sweeps use, comes
+ * when they run (ss_solver_solve) */
 static void attach(const ssModel *m, ssData *d, ssContact *c, int sys)
 {
   if (sys >= 0 && m->sys_nv[sys] > 0) {
@@ -55,7 +55,7 @@ static void attach(const ssModel *m, ssData *d, ssContact *c, int sys)
        * (ss_art_contact_response) */
       ss_art_contact_rows(c->pos, c->frame, J);
     } else {
-      ss_dyn_contact_jacobian(m, d, b, c->pos, c->frame, J, J + 3 * c->nv);
+      ss_dyn_contact_jacobian(m, d, b, c->pos, c->frame, J);
     }
   } else {
     c->sys = -1;
