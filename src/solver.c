@@ -314,7 +314,8 @@ static void warm_start(const ssModel *m, ssData *d, int converged)
         br.body = b;
       }
       const double *J = d->jac + c->jadr;
-      for (int k = 0; k < 6; k++) br.F[k] += J[k] * c->lambda[0] + J[6 + k] * c->lambda[1] + J[12 + k] * c->lambda[2];
+      const double *l = c->lambda;
+      for (int k = 0; k < 6; k++) br.F[k] += J[k] * l[0] + J[6 + k] * l[1] + J[12 + k] * l[2];
     } else if (c->link >= 0 && !d->solver_full) {
       /* a link run's impulses reach u once, at the run's end */
       body_run_close(m, d, &br);
