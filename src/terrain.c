@@ -424,8 +424,9 @@ void ss_terrain_update(const ssModel *m, ssData *d)
     if (c->type == SS_CONTACT_SOIL && c->loaded) d->soil_loaded[n++] = c->vertex;
   }
   /* one collider's vertices come in order already (then the sort only
-   * checks them); several colliders' are merged */
-  const int *v = merge_sort_runs(d->soil_loaded, d->soil_loaded + n, n);
+   * checks them); several colliders' are merged.  (With none loaded the
+   * list may not exist yet: no arithmetic on its NULL.) */
+  const int *v = n > 1 ? merge_sort_runs(d->soil_loaded, d->soil_loaded + n, n) : d->soil_loaded;
   int u = 0;
   for (int i = 0; i < n; i++)
     if (u == 0 || d->soil_loaded[u - 1] != v[i]) d->soil_loaded[u++] = v[i];
