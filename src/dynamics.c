@@ -67,11 +67,9 @@ ssStatus ss_dyn_free_velocity(const ssModel *m, ssData *d, ssError *err)
   return SS_OK;
 }
 
-void ss_dyn_contact_jacobian(const ssModel *m, ssData *d, int b,
-                             const double p[3], const double frame[9],
-                             double *J)
+void ss_dyn_contact_jacobian(const ssData *d, int b, const double p[3],
+                             const double frame[9], double *J)
 {
-  (void)m;
   double r[3];
   ss_v3_sub(r, p, d->body_xipos + 3 * b);
   /* J row k = [f, r x f] */

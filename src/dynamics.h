@@ -12,9 +12,8 @@ ssStatus ss_dyn_free_velocity(const ssModel *m, ssData *d, ssError *err);
  * body b: J (3 x 6), row k = [f_k, r x f_k] with r from the centre of
  * mass.  Articulated links use ss_art_contact_rows and
  * ss_art_contact_response. */
-void ss_dyn_contact_jacobian(const ssModel *m, ssData *d, int body,
-                             const double point[3], const double frame[9],
-                             double *J);
+void ss_dyn_contact_jacobian(const ssData *d, int body, const double point[3],
+                             const double frame[9], double *J);
 /* The response of such a contact, from its J: W = M^-1 J^T (6 x 3) and
  * G = J W (3 x 3).  Only the Gauss-Seidel sweeps need them: the solver
  * forms them when sweeps follow the Newton phase. */

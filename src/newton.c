@@ -214,29 +214,37 @@ static void group_T(const NGroup *G, double T[36])
     }
 }
 
+/* out = P A P^T (6 x 6), the sums in one fixed order */
+static void congruence6(const double P[36], const double A[36], double out[36])
+{
+  double AP[36];
+  for (int a = 0; a < 6; a++)
+    for (int b = 0; b < 6; b++) {
+      double t = 0;
+      for (int k = 0; k < 6; k++) t += A[6 * a + k] * P[6 * b + k];
+      AP[6 * a + b] = t;
+    }
+  for (int a = 0; a < 6; a++)
+    for (int b = 0; b < 6; b++) {
+      double t = 0;
+      for (int k = 0; k < 6; k++) t += P[6 * a + k] * AP[6 * k + b];
+      out[6 * a + b] = t;
+    }
+}
+
 static void from_group(const NGroup *G, const double Fg[6], const double Hg[36],
                        double F[6], double H[36])
 {
-  double T[36];
+  double T[36], Tt[36];
   group_T(G, T);
   for (int a = 0; a < 6; a++) {
     double t = 0;
     for (int k = 0; k < 6; k++) t += T[6 * k + a] * Fg[k];
     F[a] = t;
   }
-  double HT[36];
   for (int a = 0; a < 6; a++)
-    for (int b = 0; b < 6; b++) {
-      double t = 0;
-      for (int k = 0; k < 6; k++) t += Hg[6 * a + k] * T[6 * k + b];
-      HT[6 * a + b] = t;
-    }
-  for (int a = 0; a < 6; a++)
-    for (int b = 0; b < 6; b++) {
-      double t = 0;
-      for (int k = 0; k < 6; k++) t += T[6 * k + a] * HT[6 * k + b];
-      H[6 * a + b] = t;
-    }
+    for (int b = 0; b < 6; b++) Tt[6 * a + b] = T[6 * b + a];
+  congruence6(Tt, Hg, H);
 }
 
 /* A group's body velocity y_b = (omega; v_O) from its system's
@@ -292,20 +300,9 @@ static const double *group_block(const ssModel *m, ssData *d, const NGroup *G)
  * and its G_kk = x_k^T Lam' x_k is a quadratic in r */
 static void group_lam(const NGroup *G, const double Lam[36], double Lg[36])
 {
-  double T[36], LT[36];
+  double T[36];
   group_T(G, T);
-  for (int a = 0; a < 6; a++)
-    for (int b = 0; b < 6; b++) {
-      double t = 0;
-      for (int k = 0; k < 6; k++) t += Lam[6 * a + k] * T[6 * b + k];
-      LT[6 * a + b] = t;
-    }
-  for (int a = 0; a < 6; a++)
-    for (int b = 0; b < 6; b++) {
-      double t = 0;
-      for (int k = 0; k < 6; k++) t += T[6 * a + k] * LT[6 * k + b];
-      Lg[6 * a + b] = t;
-    }
+  congruence6(T, Lam, Lg);
 }
 
 /* max(G_11, G_22) of a point at r (group frame) from Lam' (group_lam):
@@ -774,23 +771,7 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
       G->mat = &m->hfield_soilmat[c->hfield];
       memcpy(G->R, c->frame, sizeof G->R);
       memcpy(G->o, c->pos, sizeof G->o);
-      const double *Lam;
-      double Lb[36];
-      if (c->link < 0) {
-        /* the body's Lam = J_b Y, a column per unit spatial impulse */
-        body_block(m, d, G->body, G->Yb);
-        for (int k = 0; k < 6; k++) {
-          double u[6], V[6];
-          for (int r = 0; r < 6; r++) u[r] = G->Yb[6 * r + k];
-          group_motion(m, d, G, u, V);
-          for (int a = 0; a < 6; a++) Lb[6 * a + k] = V[a];
-        }
-        Lam = Lb;
-      } else {
-        const double *Y;
-        ss_art_link_block(m, d, c->link, &Y, &Lam);
-      }
-      group_lam(G, Lam, G->Lg);
+      if (c->link < 0) body_block(m, d, G->body, G->Yb);
     } else if (memcmp(G->R, c->frame, sizeof G->R)) {
       return 0;
     }
@@ -807,7 +788,6 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
     P->k = (c->width > 0 && mat->bekker_kc != 0 ? mat->bekker_kc / c->width : 0) + mat->bekker_kphi;
     P->tf0 = P->S * mat->cohesion;
     P->x0 = mat->shear_displacement > 0 ? c->j / mat->shear_displacement : 0;
-    P->gtt = slip_response(G->Lg, P->r);
     P->ps = 0;
     P->mob.x = -1;
   }
@@ -815,6 +795,16 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
   Setup s = {ngroup, nrow, n, first_row};
 
   lam_matrix(m, d, &s, w);
+  /* the stick test's G_tt of each point, from its group's diagonal block
+   * of Lam */
+  for (int g = 0; g < ngroup; g++) {
+    double Lb[36];
+    for (int a = 0; a < 6; a++)
+      for (int k = 0; k < 6; k++) Lb[6 * a + k] = w->Lam[(size_t)(6 * g + a) * n + 6 * g + k];
+    group_lam(w->grp + g, Lb, w->grp[g].Lg);
+  }
+  for (int i = 0; i < first_row; i++)
+    w->pt[i].gtt = slip_response(w->grp[w->group_of[i]].Lg, w->pt[i].r);
   unknowns_of(m, d, &s, w, d->qvel_free, w->yfree);
   unknowns_of(m, d, &s, w, d->qvel, w->y);
   /* Newton with backtracking on |phi|^2, until |phi| is within ten times

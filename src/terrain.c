@@ -55,7 +55,7 @@ static void attach(const ssModel *m, ssData *d, ssContact *c, int sys)
        * (ss_art_contact_response) */
       ss_art_contact_rows(c->pos, c->frame, J);
     } else {
-      ss_dyn_contact_jacobian(m, d, b, c->pos, c->frame, J);
+      ss_dyn_contact_jacobian(d, b, c->pos, c->frame, J);
     }
   } else {
     c->sys = -1;
