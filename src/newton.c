@@ -57,7 +57,7 @@ typedef struct NPoint {
   double g0, sp, S;   /* start separation, rut depth, A dt */
   double k, tf0;      /* k_c/b + k_phi; A dt c */
   double x0, gtt;     /* j/K_j; largest diagonal entry of G_tt */
-  double ps, pv;      /* last s and s^(n-1) (ps = 0: none) */
+  ssPowMemo pw;       /* last s^(n-1) (pw.s = 0: none) */
   ssExpMemo mob;      /* last x = x0 + sigma dt/K_j, 1 - exp(-x), exp(-x)
                          (mob.x < 0: none) */
 } NPoint;
@@ -164,9 +164,10 @@ static ssNewtonWork *work(ssData *d, int n, int nc, int nv, int ng)
 /* the series are ss_math.h's (shared with src/point.c) */
 
 /* s^(n-1) of point P, moved from its last value when near */
-static inline __attribute__((always_inline)) double pow_point(NPoint *P, double s, double m1)
+static inline __attribute__((always_inline)) double pow_point(NPoint *P, double s,
+                                                             const ssPowSeries *ser)
 {
-  return ss_pow_moved(&P->ps, &P->pv, s, m1);
+  return ss_pow_moved(&P->pw, s, ser);
 }
 
 /* Janosi mobilisation 1 - exp(-x) of point P and exp(-x) in *e */
@@ -322,16 +323,18 @@ static double slip_response(const double Lg[36], const double r[3])
 
 /* a bed material's constants as the law uses them */
 typedef struct Mat {
-  double dt, n, m1, Ke, D, mu, rj; /* rj = dt / K_j, 0 when K_j = 0 */
+  double dt, n, Ke, D, mu, rj; /* rj = dt / K_j, 0 when K_j = 0 */
   int linear;
+  ssPowSeries pser;                 /* of s^(n-1), when not linear */
 } Mat;
 
 static Mat mat_of(const ssSoilMaterial *mat, double dt)
 {
-  Mat M = {dt, mat->sinkage_exponent, mat->sinkage_exponent - 1,
+  Mat M = {dt, mat->sinkage_exponent,
            mat->elastic_stiffness, mat->damping, mat->friction_coefficient,
            mat->shear_displacement > 0 ? dt / mat->shear_displacement : 0,
-           mat->sinkage_exponent == 1.0};
+           mat->sinkage_exponent == 1.0, {0, {0}, 0}};
+  if (!M.linear) M.pser = ss_pow_series(M.n - 1);
   return M;
 }
 
@@ -356,7 +359,7 @@ static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint 
   }
   double v1 = V[4] + V[2] * r[0] - V[0] * r[2];
   double v2 = V[5] + V[0] * r[1] - V[1] * r[0];
-  double sk = P->sp + delta, sn1 = M->linear ? 1.0 : pow_point(P, sk, M->m1);
+  double sk = P->sp + delta, sn1 = M->linear ? 1.0 : pow_point(P, sk, &M->pser);
   double pe = M->Ke * delta, py = P->k * sk * sn1, p, slope;
   if (pe <= py) {
     p = pe;
@@ -788,7 +791,7 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
     P->k = (c->width > 0 && mat->bekker_kc != 0 ? mat->bekker_kc / c->width : 0) + mat->bekker_kphi;
     P->tf0 = P->S * mat->cohesion;
     P->x0 = mat->shear_displacement > 0 ? c->j / mat->shear_displacement : 0;
-    P->ps = 0;
+    P->pw.s = 0;
     P->mob.x = -1;
   }
   n = 6 * ngroup + nrow;

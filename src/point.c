@@ -83,7 +83,7 @@ typedef ssLaw Law;
  * it: seven terms where pow would cost a log and an exp */
 static inline double pow_near(Law *L, double s)
 {
-  return ss_pow_moved(&L->ps, &L->pv, s, L->m1);
+  return ss_pow_moved(&L->pw, s, &L->pser);
 }
 
 /* Normal pressure at end-of-step normal velocity vn (DESIGN 3.1) and its
@@ -351,15 +351,18 @@ static inline void slip_eval(const TBlock *B, Mobil *J, double tf, const double 
     z->w[0] = z->w[1] = 0;
     return;
   }
-  double id = 1 / det;
+  /* w = adj(M) c / det: |adj(M) c| and its root do not wait for the
+   * division, and q = det / |adj(M) c| takes one more */
+  double wa0 = M[3] * ct[0] - M[1] * ct[1], wa1 = M[0] * ct[1] - M[2] * ct[0];
+  double ra = sqrt(wa0 * wa0 + wa1 * wa1), id = 1 / det;
+  z->q = det / ra;
+  z->wn = ra * id;
+  z->w[0] = wa0 * id;
+  z->w[1] = wa1 * id;
   z->Mi[0] = M[3] * id;
   z->Mi[1] = -M[1] * id;
   z->Mi[2] = -M[2] * id;
   z->Mi[3] = M[0] * id;
-  mul2(z->Mi, ct, z->w);
-  double W = z->w[0] * z->w[0] + z->w[1] * z->w[1];
-  z->wn = sqrt(W);
-  z->q = 1 / z->wn;
 }
 
 /* the slope of the evaluation z (only needed when it did not converge) */
@@ -636,11 +639,9 @@ void ss_point_setup(const ssSoilMaterial *mat, double dt, ssContact *c)
            (c->width > 0 && mat->bekker_kc != 0 ? mat->bekker_kc / c->width : 0) +
                mat->bekker_kphi,
            mat->sinkage_exponent, mat->sinkage_exponent - 1,
-           mat->elastic_stiffness, mat->damping, mat->sinkage_exponent == 1.0, 0, 0};
-  if (k->law.ps > 0 && k->law.m1 == L.m1) {
-    L.ps = k->law.ps;
-    L.pv = k->law.pv;
-  }
+           mat->elastic_stiffness, mat->damping, mat->sinkage_exponent == 1.0, {0, {0}, 0}, {0, 0, 0}};
+  if (!L.linear) L.pser = ss_pow_series(L.m1);
+  if (k->law.pw.s > 0 && k->law.m1 == L.m1) L.pw = k->law.pw;
   k->law = L;
   Mobil J;
   mobil_init(&J, c->j, mat->shear_displacement, dt);

@@ -21,7 +21,8 @@ typedef struct ssLaw {
   double k, n, m1;   /* k_c/b + k_phi, exponent, n - 1 */
   double Ke, D;
   int linear;        /* n == 1 */
-  double ps, pv;     /* last power: pv = ps^(n-1); ps = 0 none yet */
+  ssPowSeries pser;  /* the series of s^(n-1) (not formed when linear) */
+  ssPowMemo pw;      /* last power s^(n-1) (pw.s = 0: none yet) */
 } ssLaw;
 
 /* Janosi mobilisation m = 1 - exp(-x), x = (j + dt sigma)/K, and e = 1 - m

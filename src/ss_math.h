@@ -135,19 +135,34 @@ static inline void ss_quat_from_axis_angle(double q[4], const double axis[3], do
 
 /* (1 + u)^a - 1 for |u| <= SS_POW_SERIES_MAX, |a| <= 3: seven terms; the
  * first one dropped, |C(a, 8)| u^8 <= 45 2^-64, is below 3e-18 of the
- * leading 1, far under rounding.  The factors of the terms are independent,
- * so only the running product is a chain. */
+ * leading 1, far under rounding.  The binomial coefficients C(a, k) depend
+ * on the exponent only and are formed once (ss_pow_series); the powers of
+ * u are summed in pairs (Estrin) so that the chain of dependent operations
+ * is short. */
 #define SS_POW_SERIES_MAX (1.0 / 256)
-static inline double ss_pow1p_m1(double a, double u)
+typedef struct ssPowSeries {
+  double a;      /* the exponent */
+  double c[7];   /* C(a, 1) .. C(a, 7) */
+  int ok;        /* |a| <= 3: the series holds (else always libm) */
+} ssPowSeries;
+
+static inline ssPowSeries ss_pow_series(double a)
 {
-  double t = a * u, sum = t;
-  t *= (a - 1) * u * 0.5;         sum += t;
-  t *= (a - 2) * u * (1.0 / 3);   sum += t;
-  t *= (a - 3) * u * 0.25;        sum += t;
-  t *= (a - 4) * u * 0.2;         sum += t;
-  t *= (a - 5) * u * (1.0 / 6);   sum += t;
-  t *= (a - 6) * u * (1.0 / 7);   sum += t;
-  return sum;
+  static const double inv[7] = {1, 1.0 / 2, 1.0 / 3, 1.0 / 4, 1.0 / 5, 1.0 / 6, 1.0 / 7};
+  ssPowSeries p;
+  double t = 1;
+  for (int k = 0; k < 7; k++) p.c[k] = t *= (a - k) * inv[k];
+  p.a = a;
+  p.ok = fabs(a) <= 3;
+  return p;
+}
+
+static inline double ss_pow1p_m1(const ssPowSeries *p, double u)
+{
+  const double *c = p->c;
+  double u2 = u * u, u4 = u2 * u2;
+  double q = (c[0] + c[1] * u) + u2 * (c[2] + c[3] * u) + u4 * ((c[4] + c[5] * u) + u2 * c[6]);
+  return u * q;
 }
 
 /* expm1(-d) for |d| <= SS_EXP_SERIES_MAX: six terms (the first dropped,
@@ -163,16 +178,23 @@ static inline double ss_expm1_neg(double d)
   return p01 + d3 * (p23 + d2 * p45);
 }
 
-/* s^a, moved by the series from the last pair (*ps, *pv = ps^a; *ps = 0:
- * none) when s is within SS_POW_SERIES_MAX of ps, else from libm; the pair
- * becomes (s, s^a) */
-static inline double ss_pow_moved(double *ps, double *pv, double s, double a)
+/* s^a at the last s (s = 0: none), kept to be moved to a nearby s; is =
+ * 1/s, formed when s is stored so that the next move's ratio does not wait
+ * for a division */
+typedef struct ssPowMemo {
+  double s, v, is;
+} ssPowMemo;
+
+/* s^a, moved by the series p (exponent a) from the memo when s is within
+ * SS_POW_SERIES_MAX of it, else from libm; the memo moves to s */
+static inline double ss_pow_moved(ssPowMemo *c, double s, const ssPowSeries *p)
 {
-  double u = *ps > 0 ? (s - *ps) / *ps : INFINITY, v;
-  if (fabs(u) <= SS_POW_SERIES_MAX && fabs(a) <= 3) v = *pv + *pv * ss_pow1p_m1(a, u);
-  else v = pow(s, a);
-  *ps = s;
-  *pv = v;
+  double u = c->s > 0 ? (s - c->s) * c->is : INFINITY, v;
+  if (fabs(u) <= SS_POW_SERIES_MAX && p->ok) v = c->v + c->v * ss_pow1p_m1(p, u);
+  else v = pow(s, p->a);
+  c->s = s;
+  c->v = v;
+  c->is = 1 / s;
   return v;
 }
 
