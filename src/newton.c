@@ -97,6 +97,8 @@ struct ssNewtonWork {
   NPoint *pt;         /* (ncontact) the soil points' constants and caches */
   NGroup *grp;        /* (ngroup) */
   NSum *sum;          /* (ngroup) one evaluation's sums */
+  int settled;        /* the last solve took no Newton step: the next one
+                         forms its first H only if a step needs it */
 };
 
 void ss_newton_work_free(ssNewtonWork *w)
@@ -243,6 +245,7 @@ static void from_group(const NGroup *G, const double Fg[6], const double Hg[36],
     for (int k = 0; k < 6; k++) t += T[6 * k + a] * Fg[k];
     F[a] = t;
   }
+  if (!Hg) return;
   for (int a = 0; a < 6; a++)
     for (int b = 0; b < 6; b++) Tt[6 * a + b] = T[6 * b + a];
   congruence6(Tt, Hg, H);
@@ -402,10 +405,11 @@ static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint 
 
 /* F(y) and H(y) = dF/dy over all contacts, the soil points' impulses in
  * lam (3 each; the rows' are their entries of F).  H: a 6 x 6 block per
- * group, then one value per row.  Returns 1 if a loaded point sticks. */
-static int evaluate(const ssModel *m, const ssData *d, const Setup *s,
-                    const ssNewtonWork *w, const double *y, double *F, double *H,
-                    double *lam_out)
+ * group, then one value per row; with_H = 0: F alone (H not touched).
+ * Returns 1 if a loaded point sticks. */
+static inline __attribute__((always_inline)) int
+evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWork *w,
+            const double *y, double *F, double *H, double *lam_out, const int with_H)
 {
   const double dt = m->opt.timestep;
   memset(F, 0, (size_t)s->n * sizeof(double));
@@ -428,7 +432,7 @@ static int evaluate(const ssModel *m, const ssData *d, const Setup *s,
       M = mat_of(w->grp[g].mat, dt);
     }
     double *lam = lam_out + 3 * i, K[6];
-    int st = point_law(&M, P, A->V, lam, K);
+    int st = point_law(&M, P, A->V, lam, with_H ? K : NULL);
     if (st == UNLOADED) continue;
     if (st == STICKS) return 1;
     const double r0 = P->r[0], r1 = P->r[1], r2 = P->r[2];
@@ -439,6 +443,7 @@ static int evaluate(const ssModel *m, const ssData *d, const Setup *s,
     A->F[3] += ln;
     A->F[4] += l1;
     A->F[5] += l2;
+    if (!with_H) continue;
     /* K = [[kn, 0, 0], [k1n, k11, k12], [k2n, k12, k22]] and the blocks of
      * J^T K J written out: K (-[r]x), [r]x K and [r]x K (-[r]x) */
     const double kn = K[0], k1n = K[1], k2n = K[2], k11 = K[3], k12 = K[4], k22 = K[5];
@@ -478,6 +483,10 @@ static int evaluate(const ssModel *m, const ssData *d, const Setup *s,
   }
   for (int g = 0; g < s->ngroup; g++) {
     const NSum *A = w->sum + g;
+    if (!with_H) {
+      from_group(w->grp + g, A->F, NULL, F + 6 * g, NULL);
+      continue;
+    }
     double Hg[36];
     double Kv[9] = {A->K[0], 0, 0, A->K[1], A->K[3], A->K[4], A->K[2], A->K[4], A->K[5]};
     for (int a = 0; a < 3; a++)
@@ -502,9 +511,24 @@ static int evaluate(const ssModel *m, const ssData *d, const Setup *s,
       h = 0;
     }
     F[k] = l;
-    H[36 * s->ngroup + r] = h;
+    if (with_H) H[36 * s->ngroup + r] = h;
   }
   return 0;
+}
+
+/* the two forms, each compiled for itself (without H, the Jacobian's work
+ * is dropped at compile time) */
+static int evaluate(const ssModel *m, const ssData *d, const Setup *s,
+                    const ssNewtonWork *w, const double *y, double *F, double *H,
+                    double *lam_out)
+{
+  return evaluate_at(m, d, s, w, y, F, H, lam_out, 1);
+}
+
+static int evaluate_F(const ssModel *m, const ssData *d, const Setup *s,
+                      const ssNewtonWork *w, const double *y, double *F, double *lam_out)
+{
+  return evaluate_at(m, d, s, w, y, F, NULL, lam_out, 0);
 }
 
 /* The check of a converged Newton solve, an exact residual: with the
@@ -532,8 +556,12 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
       gprev = g;
       M = mat_of(w->grp[g].mat, dt);
     }
+    /* on a copy: the points' memos stay at the last evaluation's y, so
+     * that H formed there later (ss_newton_solve) is what the evaluation
+     * would have formed */
+    NPoint P = w->pt[i];
     double lam[3];
-    if (point_law(&M, w->pt + i, w->sum[g].V, lam, NULL) == STICKS) return INFINITY;
+    if (point_law(&M, &P, w->sum[g].V, lam, NULL) == STICKS) return INFINITY;
     double dn = fabs(lam[0] - c->lambda[0]) + fabs(lam[1] - c->lambda[1]) + fabs(lam[2] - c->lambda[2]);
     double ln = fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]);
     /* not fmax: a libm call here, and it would pass over a NaN */
@@ -819,7 +847,15 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
    * contacts and d->qvel are untouched until an answer is applied. */
   const double tol = m->opt.solver_tolerance, tol2 = tol * tol, try2 = 100 * tol2;
   double size, size_try;
-  if (evaluate(m, d, &s, w, w->y, w->F, w->H, w->lam)) return 0;
+  /* After a step that needed no Newton step the warm start usually
+   * passes the check at once, and H would go unused: it is then formed
+   * only when a step needs it, by a second pass at the same y (into the
+   * trial buffers, F and lam kept). */
+  int have_H = !w->settled;
+  w->settled = 0;
+  if (have_H ? evaluate(m, d, &s, w, w->y, w->F, w->H, w->lam)
+             : evaluate_F(m, d, &s, w, w->y, w->F, w->lam))
+    return 0;
   double f = residual(&s, w, w->y, w->F, w->phi, &size);
   int it = 0, stalled = 0;
   for (;;) {
@@ -832,8 +868,13 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
       *residual_out = check(m, d, &s, w);
       if (*residual_out <= tol || stalled || it == MAX_ITER) {
         *iterations = it;
+        w->settled = it == 0;
         return 1;
       }
+    }
+    if (!have_H) {
+      if (evaluate(m, d, &s, w, w->y, w->Ftry, w->H, w->lamtry)) return 0;
+      have_H = 1;
     }
     it++;
     newton_matrix(&s, w, w->H);
