@@ -328,7 +328,7 @@ static double slip_response(const double Lg[36], const double r[3])
 typedef struct Mat {
   double dt, n, Ke, D, mu, rj; /* rj = dt / K_j, 0 when K_j = 0 */
   int linear;
-  ssPowSeries pser;                 /* of s^(n-1), when not linear */
+  ssPowSeries pser;            /* of s^(n-1), when not linear */
 } Mat;
 
 static Mat mat_of(const ssSoilMaterial *mat, double dt)
