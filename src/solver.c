@@ -107,19 +107,22 @@ static void contact_velocity(const ssModel *m, const ssData *d,
     rows_velocity(d->jac + c->jadr, V, v);
     return;
   }
-  const double *J = d->jac + c->jadr, *u = d->qvel + c->vadr;
-  int nv = c->nv;
-  if (nv == 6) {
-    /* a single rigid body */
-    for (int k = 0; k < 3; k++) {
-      const double *j = J + 6 * k;
-      v[k] = j[0] * u[0] + j[1] * u[1] + j[2] * u[2] + j[3] * u[3] + j[4] * u[4] + j[5] * u[5];
-    }
+  const double *u = d->qvel + c->vadr;
+  if (c->type == SS_CONTACT_SOIL || c->type == SS_CONTACT_RIGID) {
+    /* a rigid body: J u = frame (v + omega x r), r from the centre of
+     * mass, without J (formed only for the sweeps) */
+    double r[3], w[3];
+    ss_v3_sub(r, c->pos, d->body_xipos + 3 * m->geom_body[c->geom]);
+    ss_v3_cross(w, u + 3, r);
+    ss_v3_add(w, w, u);
+    ss_m3_mulv(v, c->frame, w);
     return;
   }
+  /* a joint row: J (3 x nv) stored */
+  const double *J = d->jac + c->jadr;
   for (int k = 0; k < 3; k++) {
     double s = 0;
-    for (int i = 0; i < nv; i++) s += J[k * nv + i] * u[i];
+    for (int i = 0; i < c->nv; i++) s += J[k * c->nv + i] * u[i];
     v[k] = s;
   }
 }
@@ -305,17 +308,24 @@ static void warm_start(const ssModel *m, ssData *d, int converged)
     }
     if (!c->nv) continue;
     if (c->link < 0 && c->type == SS_CONTACT_SOIL) {
-      /* a rigid body's run likewise, as J^T lambda (its W is formed only
-       * for the sweeps) */
+      /* a rigid body's run likewise, as J^T lambda */
       group_close(d, &g);
       int b = m->geom_body[c->geom];
       if (br.body != b) {
         body_run_close(m, d, &br);
         br.body = b;
       }
-      const double *J = d->jac + c->jadr;
-      const double *l = c->lambda;
-      for (int k = 0; k < 6; k++) br.F[k] += J[k] * l[0] + J[6 + k] * l[1] + J[12 + k] * l[2];
+      /* J^T lambda = (f; r x f), f = frame^T lambda, r from the centre of
+       * mass (J is formed only for the sweeps) */
+      const double *fr = c->frame, *l = c->lambda;
+      double f[3], r[3], t[3];
+      for (int k = 0; k < 3; k++) f[k] = fr[k] * l[0] + fr[3 + k] * l[1] + fr[6 + k] * l[2];
+      ss_v3_sub(r, c->pos, d->body_xipos + 3 * b);
+      ss_v3_cross(t, r, f);
+      for (int k = 0; k < 3; k++) {
+        br.F[k] += f[k];
+        br.F[3 + k] += t[k];
+      }
     } else if (c->link >= 0 && !d->solver_full) {
       /* a link run's impulses reach u once, at the run's end */
       body_run_close(m, d, &br);
@@ -503,15 +513,18 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   }
 
   /* what only the sweeps use: the body contacts' responses (a rigid
-   * body's W and G, a link contact's LX and G), and the soil points' laws
+   * body's J, W and G, a link contact's LX and G), and the soil points' laws
    * (the Newton phase has its own) */
   for (int i = 0; i < d->ncontact && sweeps > 0; i++) {
     ssContact *c = d->contact + i;
     double *J = d->jac + c->jadr;
     if (c->link >= 0)
       ss_art_contact_response(m, d, c->link, J, J + 18, c->G);
-    else if (c->nv > 0 && (c->type == SS_CONTACT_SOIL || c->type == SS_CONTACT_RIGID))
-      ss_dyn_contact_response(m, d, m->geom_body[c->geom], J, J + 3 * c->nv, c->G);
+    else if (c->nv > 0 && (c->type == SS_CONTACT_SOIL || c->type == SS_CONTACT_RIGID)) {
+      int b = m->geom_body[c->geom];
+      ss_dyn_contact_jacobian(d, b, c->pos, c->frame, J);
+      ss_dyn_contact_response(m, d, b, J, J + 3 * c->nv, c->G);
+    }
     if (c->type == SS_CONTACT_SOIL) ss_point_setup(&m->hfield_soilmat[c->hfield], dt, c);
   }
   Group g = {NULL, NULL, NULL, {0}, {0}};
