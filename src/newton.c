@@ -68,7 +68,8 @@ typedef struct NGroup {
   int link;           /* articulated link, or -1: the free body `body` */
   int body, sys;
   double Yb[36];      /* free body: its response Y (see body_block) */
-  double Lg[36];      /* its Lam in the group's frame (group_lam) */
+  double gq[12];      /* the points' G_11, G_22 as quadratics in r
+                         (slip_quadratics of its Lam', group_lam) */
   const ssSoilMaterial *mat;
   double R[9];        /* contact frame rows n, t1, t2 (world) */
   double o[3];        /* origin of the points' r (world) */
@@ -309,18 +310,35 @@ static void group_lam(const NGroup *G, const double Lam[36], double Lg[36])
   congruence6(T, Lam, Lg);
 }
 
-/* max(G_11, G_22) of a point at r (group frame) from Lam' (group_lam):
- * x_1 has -r_2, r_0, 1 at 0, 2, 4; x_2 has r_1, -r_0, 1 at 0, 1, 5 */
-static double slip_response(const double Lg[36], const double r[3])
+/* G_11 and G_22 of a point at r (group frame) as quadratics in r, from
+ * Lam' (group_lam): x_1 has -r_2, r_0, 1 at 0, 2, 4 and x_2 has r_1, -r_0,
+ * 1 at 0, 1, 5, so
+ *   G_11 = L00 r2^2 + L22 r0^2 + L44 - L02' r0 r2 - L04' r2 + L24' r0,
+ *   G_22 = L00 r1^2 + L11 r0^2 + L55 - L01' r0 r1 + L05' r1 - L15' r0
+ * with Lab' = Lab + Lba; q holds the twelve coefficients in that order */
+static void slip_quadratics(const double Lg[36], double q[12])
 {
-  const int i1[3] = {0, 2, 4}, i2[3] = {0, 1, 5};
-  const double x1[3] = {-r[2], r[0], 1}, x2[3] = {r[1], -r[0], 1};
-  double g1 = 0, g2 = 0;
-  for (int a = 0; a < 3; a++)
-    for (int b = 0; b < 3; b++) {
-      g1 += x1[a] * Lg[6 * i1[a] + i1[b]] * x1[b];
-      g2 += x2[a] * Lg[6 * i2[a] + i2[b]] * x2[b];
-    }
+  q[0] = Lg[0];
+  q[1] = Lg[14];
+  q[2] = Lg[28];
+  q[3] = Lg[2] + Lg[12];
+  q[4] = Lg[4] + Lg[24];
+  q[5] = Lg[16] + Lg[26];
+  q[6] = Lg[0];
+  q[7] = Lg[7];
+  q[8] = Lg[35];
+  q[9] = Lg[1] + Lg[6];
+  q[10] = Lg[5] + Lg[30];
+  q[11] = Lg[11] + Lg[31];
+}
+
+/* max(G_11, G_22) of a point at r, from slip_quadratics' q */
+static double slip_response(const double q[12], const double r[3])
+{
+  double g1 = q[0] * r[2] * r[2] + q[1] * r[0] * r[0] + q[2] - q[3] * r[0] * r[2] -
+              q[4] * r[2] + q[5] * r[0];
+  double g2 = q[6] * r[1] * r[1] + q[7] * r[0] * r[0] + q[8] - q[9] * r[0] * r[1] +
+              q[10] * r[1] - q[11] * r[0];
   return g1 > g2 ? g1 : g2;
 }
 
@@ -814,16 +832,25 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
   ssNewtonWork *w = work(d, n, d->ncontact, m->nv, ngroup);
   if (!w) return 0;
   /* groups: one per link (or body) and bed (a link's contacts may come in
-   * several runs); every point of a bed shares the bed's frame */
+   * several runs); every point of a bed shares the bed's frame (the
+   * bed's axes, terrain.c's frame_from_bed: the same bits for all its
+   * points of a step), so it is compared only where a run starts */
   ngroup = 0;
   for (int i = 0; i < first_row; i++) {
     const ssContact *c = d->contact + i;
     int g = 0;
-    while (g < ngroup && !(w->grp[g].link == c->link && w->grp[g].sys == c->sys &&
-                           w->grp[g].mat == &m->hfield_soilmat[c->hfield]))
-      g++;
+    if (i > 0 && c[-1].link == c->link && c[-1].sys == c->sys && c[-1].hfield == c->hfield) {
+      w->group_of[i] = g = w->group_of[i - 1];
+    } else {
+      while (g < ngroup && !(w->grp[g].link == c->link && w->grp[g].sys == c->sys &&
+                             w->grp[g].mat == &m->hfield_soilmat[c->hfield]))
+        g++;
+      w->group_of[i] = g;
+    }
     NGroup *G = w->grp + g;
-    if (g == ngroup) {
+    if (i > 0 && g == w->group_of[i - 1] && c[-1].hfield == c->hfield) {
+      /* the run goes on: the group and frame are the last point's */
+    } else if (g == ngroup) {
       ngroup++;
       G->link = c->link;
       G->sys = c->sys;
@@ -835,7 +862,6 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
     } else if (memcmp(G->R, c->frame, sizeof G->R)) {
       return 0;
     }
-    w->group_of[i] = g;
     /* the point's constants, its caches empty */
     NPoint *P = w->pt + i;
     const ssSoilMaterial *mat = G->mat;
@@ -858,13 +884,14 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
   /* the stick test's G_tt of each point, from its group's diagonal block
    * of Lam */
   for (int g = 0; g < ngroup; g++) {
-    double Lb[36];
+    double Lb[36], Lg[36];
     for (int a = 0; a < 6; a++)
       for (int k = 0; k < 6; k++) Lb[6 * a + k] = w->Lam[(size_t)(6 * g + a) * n + 6 * g + k];
-    group_lam(w->grp + g, Lb, w->grp[g].Lg);
+    group_lam(w->grp + g, Lb, Lg);
+    slip_quadratics(Lg, w->grp[g].gq);
   }
   for (int i = 0; i < first_row; i++)
-    w->pt[i].gtt = slip_response(w->grp[w->group_of[i]].Lg, w->pt[i].r);
+    w->pt[i].gtt = slip_response(w->grp[w->group_of[i]].gq, w->pt[i].r);
   unknowns_of(m, d, &s, w, d->qvel_free, w->yfree);
   unknowns_of(m, d, &s, w, d->qvel, w->y);
   /* Newton with backtracking on |phi|^2, until |phi| is within ten times
