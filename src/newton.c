@@ -28,11 +28,18 @@
  * The phase is an accelerator, not a second solver: it only moves the
  * sweeps' starting point.  Gauss-Seidel sweeps follow it and decide
  * convergence with the same test as always (solver.c), so the answer meets
- * the same tolerance whatever happened here.  The phase declines (and
- * leaves impulses and velocities as it found them) when a contact is not a
- * soil point on an articulated link or a PD row, when a loaded point does
- * not clearly slip (sticking: the velocity form is set-valued there; the
- * sweeps handle it), or when Newton does not converge fast. */
+ * the same tolerance whatever happened here.
+ *
+ * A point that sticks or nearly so (the point nearest the centre of a
+ * turning wheel's slip field) has no usable velocity form: its slip
+ * direction turns with every step.  Up to NS_MAX such points are solved
+ * in impulse form instead (NImp): their tangential impulses join the
+ * unknowns, with the friction law as a projection (the natural map),
+ * smooth enough for Newton on either side of sticking.  The phase
+ * declines (and leaves impulses and velocities as it found them) when a
+ * contact is not a soil point on an articulated link or a free body or a
+ * PD row, when more points stick than the impulse form takes (a resting
+ * patch: the sweeps handle it), or when Newton does not converge fast. */
 #include "solver.h"
 #include "articulated.h"
 #include "ss_math.h"
@@ -46,6 +53,13 @@
  * velocity form is too stiff for Newton: the phase declines. */
 #define STICK_RATIO 1e3
 #define MAX_ITER 8
+/* A loaded point whose T/|v_t| passes this many times 1/G_tt at an
+ * accepted iterate (or that sticks at the start) is solved in impulse form
+ * from then on (NImp): its slip direction turns fast with the velocity
+ * there, which the velocity form's Newton steps cannot follow.  At most
+ * NS_MAX such points a solve. */
+#define IMP_RATIO 100
+#define NS_MAX 16
 
 /* A soil point as the Newton phase sees it: its law's constants for this
  * step, its place in its group's frame, and the last values of its two
@@ -60,7 +74,30 @@ typedef struct NPoint {
   ssPowMemo pw;       /* last s^(n-1) (pw.s = 0: none) */
   ssExpMemo mob;      /* last x = x0 + sigma dt/K_j, 1 - exp(-x), exp(-x)
                          (mob.x < 0: none) */
+  int near;           /* the last evaluation found it loaded with T/|v_t|
+                         above IMP_RATIO / G_tt: 1, or sticking: 2 */
+  int imp;            /* its NImp, or -1: velocity form */
 } NPoint;
+
+/* A point solved in impulse form: its tangential impulse mu is an unknown
+ * of Newton's, with the equation of the friction law as a projection (the
+ * natural map), phi = (mu - proj(mu - rho v_t)) / rho = 0, proj onto the
+ * disc of radius T(|v_t|) = tf m(j + dt |v_t|), rho = 1/G_tt: mu = -T v_t/
+ * |v_t| while slipping, |mu| <= T(0) and v_t = 0 while sticking, one
+ * piecewise smooth equation for both, where the velocity form turns set-
+ * valued.  Its normal impulse stays the explicit law of its velocity. */
+typedef struct NImp {
+  int pt, g;          /* its point and group */
+  double c[3][6];     /* d (v_n, v_t1, v_t2) / d y_g: its rows X' T */
+} NImp;
+
+/* one evaluation's values at an impulse-form point */
+typedef struct NImpEval {
+  double phi[2];      /* (mu - proj(mu - rho v_t)) / rho */
+  double Dm[4];       /* d phi / d mu (2 x 2) */
+  double Dv[4];       /* d phi / d v_t (2 x 2) */
+  double e[2];        /* d phi / d v_n (through lambda_n and tf) */
+} NImpEval;
 
 /* A group: the soil points of one link (or free rigid body) on one bed,
  * in that bed's frame */
@@ -68,8 +105,9 @@ typedef struct NGroup {
   int link;           /* articulated link, or -1: the free body `body` */
   int body, sys;
   double Yb[36];      /* free body: its response Y (see body_block) */
+  double Lg[36];      /* its Lam in the group's frame (group_lam) */
   double gq[12];      /* the points' G_11, G_22 as quadratics in r
-                         (slip_quadratics of its Lam', group_lam) */
+                         (slip_quadratics of Lg) */
   const ssSoilMaterial *mat;
   double R[9];        /* contact frame rows n, t1, t2 (world) */
   double o[3];        /* origin of the points' r (world) */
@@ -100,6 +138,10 @@ struct ssNewtonWork {
   NSum *sum;          /* (ngroup) one evaluation's sums */
   int settled;        /* the last solve took no Newton step: the next one
                          forms its first H only if a step needs it */
+  int ns;             /* impulse-form points of this solve */
+  NImp imp[NS_MAX];
+  double mubuf[2][2 * NS_MAX], *mu, *mutry;    /* their mu, at y and trial */
+  NImpEval iebuf[2][NS_MAX], *ie, *ietry;     /* their evaluations */
 };
 
 void ss_newton_work_free(ssNewtonWork *w)
@@ -145,16 +187,19 @@ static ssNewtonWork *work(ssData *d, int n, int nc, int nv, int ng)
     w->cap_g = ng;
   }
   if (n > w->cap_n) {
-    double **vec[] = {&w->y, &w->yfree, &w->phi, &w->dy, &w->F,
+    /* the Newton system has up to 2 NS_MAX more unknowns (NImp) */
+    size_t na = (size_t)n + 2 * NS_MAX;
+    double **vec[] = {&w->y, &w->yfree, &w->phi, &w->F,
                       &w->ytry, &w->Ftry, &w->phitry};
     for (size_t k = 0; k < sizeof vec / sizeof *vec; k++)
       if (!grow(vec[k], (size_t)n, sizeof(double))) return NULL;
     /* H needs at most 36 per group (6 unknowns): 6 n */
-    if (!grow(&w->H, 6 * (size_t)n, sizeof(double)) ||
+    if (!grow(&w->dy, na, sizeof(double)) ||
+        !grow(&w->H, 6 * (size_t)n, sizeof(double)) ||
         !grow(&w->Htry, 6 * (size_t)n, sizeof(double)) ||
         !grow(&w->Lam, (size_t)n * n, sizeof(double)) ||
-        !grow(&w->A, (size_t)n * n, sizeof(double)) ||
-        !grow(&w->piv, (size_t)n, sizeof(int)))
+        !grow(&w->A, na * na, sizeof(double)) ||
+        !grow(&w->piv, na, sizeof(int)))
       return NULL;
     w->cap_n = n;
   }
@@ -360,26 +405,18 @@ static Mat mat_of(const ssSoilMaterial *mat, double dt)
 }
 
 enum { UNLOADED = 0, LOADED = 1, STICKS = 2 };
+enum { STUCK = 1, NEAR_STICK = 2 }; /* evaluate's flags */
 
-/* The law of point P at its group's velocity V (frame about o): impulse
- * lam, and with K non-NULL the entries of K = d lambda / d v, (nn, 1n, 2n,
- * 11, 12, 22) (K_n1 = K_n2 = 0: the normal law does not see the slip).
- * Returns UNLOADED (lam = 0), LOADED, or STICKS when the point sticks or so
- * nearly that T / |v_t| exceeds STICK_RATIO times its own tangential
- * response 1/G_tt: the velocity form is set-valued there. */
-static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint *P, const double V[6],
-                            double lam[3], double *K)
+/* The normal law of point P at normal velocity vn: lambda_n, and its
+ * derivative d lambda_n / d v_n in *kn; -1 when unloaded (no overlap) */
+static inline __attribute__((always_inline)) double point_normal(const Mat *M, NPoint *P,
+                                                                 double vn, double *kn)
 {
-  const double *r = P->r;
-  /* v = v_o + omega x r */
-  double vn = V[3] + V[1] * r[2] - V[2] * r[1];
   double delta = -(P->g0 + M->dt * vn);
   if (!(delta > 0)) {
-    lam[0] = lam[1] = lam[2] = 0;
-    return UNLOADED;
+    *kn = 0;
+    return -1;
   }
-  double v1 = V[4] + V[2] * r[0] - V[0] * r[2];
-  double v2 = V[5] + V[0] * r[1] - V[1] * r[0];
   double sk = P->sp + delta, sn1 = M->linear ? 1.0 : pow_point(P, sk, &M->pser);
   double pe = M->Ke * delta, py = P->k * sk * sn1, p, slope;
   if (pe <= py) {
@@ -394,7 +431,30 @@ static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint 
     p -= M->D * vn;
     dpdv -= M->D;
   }
-  double ln = P->S * p;
+  *kn = P->S * dpdv;
+  return P->S * p;
+}
+
+/* The law of point P at its group's velocity V (frame about o): impulse
+ * lam, and with K non-NULL the entries of K = d lambda / d v, (nn, 1n, 2n,
+ * 11, 12, 22) (K_n1 = K_n2 = 0: the normal law does not see the slip).
+ * Returns UNLOADED (lam = 0), LOADED, or STICKS when the point sticks or so
+ * nearly that T / |v_t| exceeds STICK_RATIO times its own tangential
+ * response 1/G_tt: the velocity form is set-valued there.  Marks P->near
+ * for the switch to impulse form (switch_points). */
+static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint *P, const double V[6],
+                            double lam[3], double *K)
+{
+  const double *r = P->r;
+  /* v = v_o + omega x r */
+  double vn = V[3] + V[1] * r[2] - V[2] * r[1], kn;
+  double ln = point_normal(M, P, vn, &kn);
+  if (ln < 0) {
+    lam[0] = lam[1] = lam[2] = 0;
+    return UNLOADED;
+  }
+  double v1 = V[4] + V[2] * r[0] - V[0] * r[2];
+  double v2 = V[5] + V[0] * r[1] - V[1] * r[0];
   /* shear: the bound T = tf m(sigma) opposes the slip */
   double sigma = sqrt(v1 * v1 + v2 * v2), tf = P->tf0 + M->mu * ln, mob = 1, e = 0;
   if (M->rj > 0) mob = mobil_point(P, P->x0 + M->rj * sigma, &e);
@@ -402,9 +462,14 @@ static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint 
   lam[0] = ln;
   lam[1] = lam[2] = 0;
   if (K) K[1] = K[2] = K[3] = K[4] = K[5] = 0;
-  if (K) K[0] = P->S * dpdv;
+  if (K) K[0] = kn;
+  double Tg = T * P->gtt;
+  P->near = Tg > IMP_RATIO * sigma;
   if (!(T > 0)) return LOADED;
-  if (!(sigma > 0) || T * P->gtt > STICK_RATIO * sigma) return STICKS;
+  if (!(sigma > 0) || Tg > STICK_RATIO * sigma) {
+    P->near = 2;
+    return STICKS;
+  }
   double t1 = v1 / sigma, t2 = v2 / sigma;
   lam[1] = -T * t1;
   lam[2] = -T * t2;
@@ -421,13 +486,86 @@ static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint 
   return LOADED;
 }
 
-/* F(y) and H(y) = dF/dy over all contacts, the soil points' impulses in
- * lam (3 each; the rows' are their entries of F).  H: a 6 x 6 block per
- * group, then one value per row; with_H = 0: F alone (H not touched).
- * Returns 1 if a loaded point sticks. */
+/* The friction law of an impulse-form point in natural-map form at slip
+ * velocity v (2), normal impulse ln with d ln / d v_n = kn, tangential
+ * impulse mu: phi and its derivatives (NImpEval) */
+static void imp_map(const Mat *M, const NPoint *P, const double v[2], double ln, double kn,
+                    const double mu[2], NImpEval *ie)
+{
+  double rho = 1 / P->gtt, sigma = sqrt(v[0] * v[0] + v[1] * v[1]);
+  double tf = P->tf0 + M->mu * ln, mob = 1, ex = 0;
+  if (M->rj > 0) {
+    double x = P->x0 + M->rj * sigma;
+    mob = -expm1(-x);
+    ex = 1 - mob;
+  }
+  double T = tf * mob;
+  double z0 = mu[0] - rho * v[0], z1 = mu[1] - rho * v[1], zn = sqrt(z0 * z0 + z1 * z1);
+  if (!(zn > T)) {
+    /* inside the disc: phi = v_t (sticking, v_t = 0 at the answer) */
+    ie->phi[0] = v[0];
+    ie->phi[1] = v[1];
+    ie->Dm[0] = ie->Dm[1] = ie->Dm[2] = ie->Dm[3] = 0;
+    ie->Dv[0] = ie->Dv[3] = 1;
+    ie->Dv[1] = ie->Dv[2] = 0;
+    ie->e[0] = ie->e[1] = 0;
+    return;
+  }
+  /* on its rim: phi = (mu - T z/|z|) / rho */
+  double u0 = z0 / zn, u1 = z1 / zn, a = T / zn;
+  double dTs = tf * ex * M->rj, dTn = mob * M->mu * kn;
+  double w0 = sigma > 0 ? v[0] / sigma : 0, w1 = sigma > 0 ? v[1] / sigma : 0;
+  ie->phi[0] = (mu[0] - T * u0) / rho;
+  ie->phi[1] = (mu[1] - T * u1) / rho;
+  /* d phi / d mu = (I - a (I - u u^T)) / rho; d phi / d v = a (I - u u^T)
+   * - u dT/dsigma w^T / rho (w = v/|v|); d phi / d v_n = -u dT/dv_n / rho */
+  ie->Dm[0] = (1 - a * (1 - u0 * u0)) / rho;
+  ie->Dm[1] = ie->Dm[2] = a * u0 * u1 / rho;
+  ie->Dm[3] = (1 - a * (1 - u1 * u1)) / rho;
+  ie->Dv[0] = a * (1 - u0 * u0) - u0 * dTs * w0 / rho;
+  ie->Dv[1] = -a * u0 * u1 - u0 * dTs * w1 / rho;
+  ie->Dv[2] = -a * u0 * u1 - u1 * dTs * w0 / rho;
+  ie->Dv[3] = a * (1 - u1 * u1) - u1 * dTs * w1 / rho;
+  ie->e[0] = -u0 * dTn / rho;
+  ie->e[1] = -u1 * dTn / rho;
+}
+
+/* An impulse-form point at its group's velocity V with tangential
+ * impulse mu: lam = (lambda_n(v_n), mu), K's normal entry (the others 0:
+ * mu does not move with y), and its equation's value and derivatives in
+ * *ie.  Returns LOADED, or STICKS where it has no answer there
+ * (unloaded). */
+static inline __attribute__((always_inline)) int imp_law(const Mat *M, NPoint *P, const double V[6],
+                                                         const double mu[2], double lam[3],
+                                                         double *K, NImpEval *ie)
+{
+  const double *r = P->r;
+  double vn = V[3] + V[1] * r[2] - V[2] * r[1], kn;
+  double ln = point_normal(M, P, vn, &kn);
+  if (ln < 0) return STICKS;
+  double v[2] = {V[4] + V[2] * r[0] - V[0] * r[2], V[5] + V[0] * r[1] - V[1] * r[0]};
+  imp_map(M, P, v, ln, kn, mu, ie);
+  lam[0] = ln;
+  lam[1] = mu[0];
+  lam[2] = mu[1];
+  if (K) {
+    K[0] = kn;
+    K[1] = K[2] = K[3] = K[4] = K[5] = 0;
+  }
+  return LOADED;
+}
+
+/* F(y, mu) and H(y) = dF/dy over all contacts, the soil points' impulses
+ * in lam (3 each; the rows' are their entries of F), the impulse-form
+ * points' equations in ie.  H: a 6 x 6 block per group, then one value
+ * per row; with_H = 0: F alone (H not touched).  Returns NEAR_STICK if
+ * a velocity-form point is near sticking (NPoint.near), plus STUCK if one
+ * sticks or an impulse-form point has no answer (the evaluation is then
+ * no good). */
 static inline __attribute__((always_inline)) int
 evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWork *w,
-            const double *y, double *F, double *H, double *lam_out, const int with_H)
+            const double *y, const double *mu, double *F, double *H, double *lam_out,
+            NImpEval *ie, const int with_H)
 {
   const double dt = m->opt.timestep;
   memset(F, 0, (size_t)s->n * sizeof(double));
@@ -439,7 +577,7 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
     memset(A, 0, sizeof *A);
     to_group(w->grp + g, y + 6 * g, A->V);
   }
-  int gprev = -1;
+  int gprev = -1, sticks = 0, near = 0;
   Mat M = {0};
   for (int i = 0; i < s->first_row; i++) {
     NPoint *P = w->pt + i;
@@ -450,9 +588,15 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
       M = mat_of(w->grp[g].mat, dt);
     }
     double *lam = lam_out + 3 * i, K[6];
-    int st = point_law(&M, P, A->V, lam, with_H ? K : NULL);
+    int st = P->imp < 0 ? point_law(&M, P, A->V, lam, with_H ? K : NULL)
+                        : imp_law(&M, P, A->V, mu + 2 * P->imp, lam, with_H ? K : NULL,
+                                  ie + P->imp);
     if (st == UNLOADED) continue;
-    if (st == STICKS) return 1;
+    near |= P->imp < 0 && P->near;
+    if (st == STICKS) {
+      sticks = 1;
+      continue;
+    }
     const double r0 = P->r[0], r1 = P->r[1], r2 = P->r[2];
     const double ln = lam[0], l1 = lam[1], l2 = lam[2];
     A->F[0] += r1 * l2 - r2 * l1;
@@ -531,29 +675,67 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
     F[k] = l;
     if (with_H) H[36 * s->ngroup + r] = h;
   }
-  return 0;
+  return (sticks ? STUCK : 0) | (near ? NEAR_STICK : 0);
 }
 
 /* the two forms, each compiled for itself (without H, the Jacobian's work
  * is dropped at compile time) */
 static int evaluate(const ssModel *m, const ssData *d, const Setup *s,
-                    const ssNewtonWork *w, const double *y, double *F, double *H,
-                    double *lam_out)
+                    const ssNewtonWork *w, const double *y, const double *mu, double *F,
+                    double *H, double *lam_out, NImpEval *ie)
 {
-  return evaluate_at(m, d, s, w, y, F, H, lam_out, 1);
+  return evaluate_at(m, d, s, w, y, mu, F, H, lam_out, ie, 1);
 }
 
 static int evaluate_F(const ssModel *m, const ssData *d, const Setup *s,
-                      const ssNewtonWork *w, const double *y, double *F, double *lam_out)
+                      const ssNewtonWork *w, const double *y, const double *mu, double *F,
+                      double *lam_out, NImpEval *ie)
 {
-  return evaluate_at(m, d, s, w, y, F, NULL, lam_out, 0);
+  return evaluate_at(m, d, s, w, y, mu, F, NULL, lam_out, ie, 0);
+}
+
+/* check's measure at an impulse-form point: the change a visit of the
+ * sweeps would make to its impulse lam (held) at group velocity V, the
+ * others held.  Normal: the law's impulse at v_n against the one held;
+ * tangential: the natural map's value phi at the held mu, and the step
+ * (d phi/d mu + d phi/d v G_tt)^-1 phi that the point's own equation
+ * takes from there (G_tt: its own tangential response): 0 exactly where
+ * the law holds.  INFINITY where it has no answer. */
+static double imp_check(const Mat *M, NPoint *P, const NGroup *G, const double V[6],
+                        const double lam[3])
+{
+  const double *r = P->r;
+  double vn = V[3] + V[1] * r[2] - V[2] * r[1], kn;
+  double ln = point_normal(M, P, vn, &kn);
+  if (ln < 0) ln = kn = 0;
+  double v[2] = {V[4] + V[2] * r[0] - V[0] * r[2], V[5] + V[0] * r[1] - V[1] * r[0]};
+  NImpEval ie;
+  imp_map(M, P, v, ln, kn, lam + 1, &ie);
+  const double x[2][6] = {{-r[2], 0, r[0], 0, 1, 0}, {r[1], -r[0], 0, 0, 0, 1}};
+  double Gt[4], A[4];
+  for (int a = 0; a < 2; a++)
+    for (int b = 0; b < 2; b++) {
+      double t = 0;
+      for (int i = 0; i < 6; i++)
+        for (int k = 0; k < 6; k++) t += x[a][i] * G->Lg[6 * i + k] * x[b][k];
+      Gt[2 * a + b] = t;
+    }
+  for (int a = 0; a < 2; a++)
+    for (int b = 0; b < 2; b++)
+      A[2 * a + b] = ie.Dm[2 * a + b] + ie.Dv[2 * a] * Gt[b] + ie.Dv[2 * a + 1] * Gt[2 + b];
+  double det = A[0] * A[3] - A[1] * A[2];
+  if (!(det != 0)) return INFINITY;
+  double d1 = (A[3] * ie.phi[0] - A[1] * ie.phi[1]) / det;
+  double d2 = (A[0] * ie.phi[1] - A[2] * ie.phi[0]) / det;
+  return fabs(ln - lam[0]) + fabs(d1) + fabs(d2);
 }
 
 /* The check of a converged Newton solve, an exact residual: with the
  * velocities u the contacts' impulses give, each contact's law at its
- * velocity against the impulse it holds.  Returns max |law - lambda|_1
- * over max |lambda|_1 (the sweeps' measure), or INFINITY if a loaded point
- * sticks there or a difference is not finite. */
+ * velocity against the impulse it holds (an impulse-form point: imp_check).
+ * Returns max |law - lambda|_1 over max |lambda|_1 (the sweeps' measure),
+ * or INFINITY if a velocity-form point sticks there or a difference is
+ * not finite. */
 static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonWork *w)
 {
   const double dt = m->opt.timestep;
@@ -578,9 +760,13 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
      * that H formed there later (ss_newton_solve) is what the evaluation
      * would have formed */
     NPoint P = w->pt[i];
-    double lam[3];
-    if (point_law(&M, &P, w->sum[g].V, lam, NULL) == STICKS) return INFINITY;
-    double dn = fabs(lam[0] - c->lambda[0]) + fabs(lam[1] - c->lambda[1]) + fabs(lam[2] - c->lambda[2]);
+    double lam[3], dn;
+    if (P.imp >= 0) {
+      dn = imp_check(&M, &P, w->grp + g, w->sum[g].V, c->lambda);
+    } else {
+      if (point_law(&M, &P, w->sum[g].V, lam, NULL) == STICKS) return INFINITY;
+      dn = fabs(lam[0] - c->lambda[0]) + fabs(lam[1] - c->lambda[1]) + fabs(lam[2] - c->lambda[2]);
+    }
     double ln = fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]);
     /* not fmax: a libm call here, and it would pass over a NaN */
     finite &= isfinite(dn);
@@ -633,9 +819,12 @@ static double warm_check(const ssData *d, const Setup *s, const ssNewtonWork *w)
 
 /* phi = y - yfree - Lam F.  Returns |phi|^2 and sets *size to |Lam F|^2,
  * both weighted by 1/Lam_kk (an energy-like norm in which linear and
- * angular velocities and the rows compare fairly). */
+ * angular velocities and the rows compare fairly); the impulse-form
+ * points' equations (velocities, in ie) add theirs weighted by 1/G_tt,
+ * and G_tt |mu|^2 to the size. */
 static double residual(const Setup *s, const ssNewtonWork *w, const double *y,
-                       const double *F, double *phi, double *size)
+                       const double *F, const double *mu, const NImpEval *ie,
+                       double *phi, double *size)
 {
   int n = s->n;
   double sum = 0, big = 0;
@@ -648,17 +837,27 @@ static double residual(const Setup *s, const ssNewtonWork *w, const double *y,
     sum += phi[a] * phi[a] * inv;
     big += t * t * inv;
   }
+  for (int k = 0; k < w->ns; k++) {
+    double g = w->pt[w->imp[k].pt].gtt;
+    sum += (ie[k].phi[0] * ie[k].phi[0] + ie[k].phi[1] * ie[k].phi[1]) / g;
+    big += g * (mu[2 * k] * mu[2 * k] + mu[2 * k + 1] * mu[2 * k + 1]);
+  }
   *size = big;
   return sum;
 }
 
-/* A = I - Lam H */
-static void newton_matrix(const Setup *s, ssNewtonWork *w, const double *H)
+/* The Newton matrix of (y, mu), na = n + 2 ns unknowns, row-major:
+ *   [ I - Lam H    -Lam B ]    B: an impulse-form point's mu reaches F_g
+ *   [ C            D      ]    through its rows X'_t T (NImp.c);
+ * C: d phi / d y_g = (d phi / d v_t) X'_t T + (d phi / d v_n) X'_n T;
+ * D = d phi / d mu (NImpEval) */
+static void newton_matrix(const Setup *s, ssNewtonWork *w, const double *H,
+                          const NImpEval *ie)
 {
-  int n = s->n;
+  int n = s->n, na = n + 2 * w->ns;
   for (int a = 0; a < n; a++) {
     const double *L = w->Lam + (size_t)a * n;
-    double *Ar = w->A + (size_t)a * n;
+    double *Ar = w->A + (size_t)a * na;
     for (int g = 0; g < s->ngroup; g++) {
       const double *Hg = H + 36 * g, *Lg = L + 6 * g;
       for (int j = 0; j < 6; j++)
@@ -670,6 +869,27 @@ static void newton_matrix(const Setup *s, ssNewtonWork *w, const double *H)
       Ar[k] = -L[k] * H[36 * s->ngroup + r];
     }
     Ar[a] += 1;
+    for (int k = 0; k < w->ns; k++) {
+      const NImp *I = w->imp + k;
+      const double *Lg = L + 6 * I->g;
+      for (int b = 0; b < 2; b++) {
+        const double *c = I->c[1 + b];
+        Ar[n + 2 * k + b] = -(Lg[0] * c[0] + Lg[1] * c[1] + Lg[2] * c[2] + Lg[3] * c[3] +
+                              Lg[4] * c[4] + Lg[5] * c[5]);
+      }
+    }
+  }
+  for (int k = 0; k < w->ns; k++) {
+    const NImp *I = w->imp + k;
+    for (int b = 0; b < 2; b++) {
+      double *Ar = w->A + (size_t)(n + 2 * k + b) * na;
+      memset(Ar, 0, (size_t)na * sizeof(double));
+      const double *Dv = ie[k].Dv + 2 * b;
+      for (int j = 0; j < 6; j++)
+        Ar[6 * I->g + j] = Dv[0] * I->c[1][j] + Dv[1] * I->c[2][j] + ie[k].e[b] * I->c[0][j];
+      Ar[n + 2 * k] = ie[k].Dm[2 * b];
+      Ar[n + 2 * k + 1] = ie[k].Dm[2 * b + 1];
+    }
   }
 }
 
@@ -720,6 +940,44 @@ static void lu_solve(const double *A, const int *piv, int n, double *x)
     for (int j = k + 1; j < n; j++) t -= A[k * n + j] * x[j];
     x[k] = t / A[k * n + k];
   }
+}
+
+/* Points of the last evaluation (lam) that stick or came near it (T G_tt
+ * above IMP_RATIO |v_t|) go to impulse form, from their impulse there or,
+ * sticking, the one their contact holds (the warm start).  Returns how
+ * many went (as many as NS_MAX leaves room for). */
+static int switch_points(const ssData *d, const Setup *s, ssNewtonWork *w)
+{
+  int moved = 0;
+  for (int i = 0; i < s->first_row; i++) {
+    NPoint *P = w->pt + i;
+    if (P->imp >= 0 || !(w->lam[3 * i] > 0) || !P->near) continue;
+    if (w->ns == NS_MAX) break;
+    const NGroup *G = w->grp + w->group_of[i];
+    const double *m0 = P->near == 2 ? d->contact[i].lambda + 1 : w->lam + 3 * i + 1;
+    int k = w->ns++;
+    NImp *I = w->imp + k;
+    I->pt = i;
+    I->g = w->group_of[i];
+    P->imp = k;
+    w->mu[2 * k] = m0[0];
+    w->mu[2 * k + 1] = m0[1];
+    /* its rows n, t1, t2 in the group frame, times T (y' = T y) */
+    const double *r = P->r;
+    const double x[3][6] = {{0, r[2], -r[1], 1, 0, 0},
+                            {-r[2], 0, r[0], 0, 1, 0},
+                            {r[1], -r[0], 0, 0, 0, 1}};
+    double T[36];
+    group_T(G, T);
+    for (int a = 0; a < 3; a++)
+      for (int j = 0; j < 6; j++) {
+        double t = 0;
+        for (int q = 0; q < 6; q++) t += x[a][q] * T[6 * q + j];
+        I->c[a][j] = t;
+      }
+    moved++;
+  }
+  return moved;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -810,9 +1068,10 @@ static void apply(const ssModel *m, ssData *d, const Setup *s, const ssNewtonWor
 }
 
 int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
-                    double *residual_out)
+                    int *sticking, double *residual_out)
 {
   *iterations = 0;
+  *sticking = 0;
   *residual_out = INFINITY;
   if (first_row == 0) return 0;
   /* suited: soil points on articulated links or free bodies, PD rows */
@@ -876,6 +1135,7 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
     P->x0 = mat->shear_displacement > 0 ? c->j / mat->shear_displacement : 0;
     P->pw.s = 0;
     P->mob.x = -1;
+    P->imp = -1;
   }
   n = 6 * ngroup + nrow;
   Setup s = {ngroup, nrow, n, first_row};
@@ -884,11 +1144,11 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
   /* the stick test's G_tt of each point, from its group's diagonal block
    * of Lam */
   for (int g = 0; g < ngroup; g++) {
-    double Lb[36], Lg[36];
+    double Lb[36];
     for (int a = 0; a < 6; a++)
       for (int k = 0; k < 6; k++) Lb[6 * a + k] = w->Lam[(size_t)(6 * g + a) * n + 6 * g + k];
-    group_lam(w->grp + g, Lb, Lg);
-    slip_quadratics(Lg, w->grp[g].gq);
+    group_lam(w->grp + g, Lb, w->grp[g].Lg);
+    slip_quadratics(w->grp[g].Lg, w->grp[g].gq);
   }
   for (int i = 0; i < first_row; i++)
     w->pt[i].gtt = slip_response(w->grp[w->group_of[i]].gq, w->pt[i].r);
@@ -909,50 +1169,69 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
    * trial buffers, F and lam kept). */
   int have_H = !w->settled;
   w->settled = 0;
-  if (have_H ? evaluate(m, d, &s, w, w->y, w->F, w->H, w->lam)
-             : evaluate_F(m, d, &s, w, w->y, w->F, w->lam))
-    return 0;
-  double f = residual(&s, w, w->y, w->F, w->phi, &size);
-  int it = 0, stalled = 0;
+  w->ns = 0;
+  w->mu = w->mubuf[0];
+  w->mutry = w->mubuf[1];
+  w->ie = w->iebuf[0];
+  w->ietry = w->iebuf[1];
+  int st = have_H ? evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->lam, w->ie)
+                  : evaluate_F(m, d, &s, w, w->y, w->mu, w->F, w->lam, w->ie);
+  /* points that stick or nearly so at the start: impulse form */
+  if (st && switch_points(d, &s, w)) {
+    st = evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->lam, w->ie);
+    have_H = 1;
+  }
+  if (st & STUCK) return 0;
+  double f = residual(&s, w, w->y, w->F, w->mu, w->ie, w->phi, &size);
+  int it = 0, stalled = 0, limit = MAX_ITER;
   for (;;) {
-    if (f <= try2 * size || stalled || it == MAX_ITER) {
+    if (f <= try2 * size || stalled || it >= limit) {
       /* stalled far from the answer (a patch near sticking, where the
        * velocity form is nearly set-valued): the sweeps do better from the
        * warm start */
       if (f > tol2 * size && !(f <= tol * size)) break;
       /* the warm start may stand as it is (a settled body): then neither
        * the apply nor check's pass is needed */
-      if (it == 0 && (*residual_out = warm_check(d, &s, w)) <= tol) {
+      if (it == 0 && w->ns == 0 && (*residual_out = warm_check(d, &s, w)) <= tol) {
         w->settled = 1;
         return 1;
       }
       apply(m, d, &s, w);
       *residual_out = check(m, d, &s, w);
-      if (*residual_out <= tol || stalled || it == MAX_ITER) {
+      if (*residual_out <= tol || stalled || it >= limit) {
         *iterations = it;
-        w->settled = it == 0;
+        *sticking = w->ns;
+        w->settled = it == 0 && w->ns == 0;
         return 1;
       }
     }
     if (!have_H) {
-      if (evaluate(m, d, &s, w, w->y, w->Ftry, w->H, w->lamtry)) return 0;
+      if (evaluate(m, d, &s, w, w->y, w->mu, w->Ftry, w->H, w->lamtry, w->ietry) & STUCK)
+        return 0;
       have_H = 1;
     }
     it++;
-    newton_matrix(&s, w, w->H);
-    if (!lu_factor(w->A, w->piv, n)) {
+    int na = n + 2 * w->ns;
+    newton_matrix(&s, w, w->H, w->ie);
+    if (!lu_factor(w->A, w->piv, na)) {
       stalled = 1;
       continue;
     }
     for (int a = 0; a < n; a++) w->dy[a] = -w->phi[a];
-    lu_solve(w->A, w->piv, n, w->dy);
+    for (int k = 0; k < w->ns; k++) {
+      w->dy[n + 2 * k] = -w->ie[k].phi[0];
+      w->dy[n + 2 * k + 1] = -w->ie[k].phi[1];
+    }
+    lu_solve(w->A, w->piv, na, w->dy);
     double alpha = 1, ftry = f;
-    int ok = 0;
+    int ok = 0, fl = 0;
     for (int ls = 0; ls < 8 && !ok; ls++, alpha *= 0.5) {
       for (int a = 0; a < n; a++) w->ytry[a] = w->y[a] + alpha * w->dy[a];
+      for (int a = 0; a < 2 * w->ns; a++) w->mutry[a] = w->mu[a] + alpha * w->dy[n + a];
       /* a trial that makes a point stick is no descent either */
-      if (evaluate(m, d, &s, w, w->ytry, w->Ftry, w->Htry, w->lamtry)) continue;
-      ftry = residual(&s, w, w->ytry, w->Ftry, w->phitry, &size_try);
+      fl = evaluate(m, d, &s, w, w->ytry, w->mutry, w->Ftry, w->Htry, w->lamtry, w->ietry);
+      if (fl & STUCK) continue;
+      ftry = residual(&s, w, w->ytry, w->Ftry, w->mutry, w->ietry, w->phitry, &size_try);
       ok = ftry <= (1 - 1e-4 * alpha) * f;
     }
     /* no descent: a kink Newton cannot cross, or round-off */
@@ -966,9 +1245,22 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
     t = w->H; w->H = w->Htry; w->Htry = t;
     t = w->phi; w->phi = w->phitry; w->phitry = t;
     t = w->lam; w->lam = w->lamtry; w->lamtry = t;
+    t = w->mu; w->mu = w->mutry; w->mutry = t;
+    NImpEval *te = w->ie;
+    w->ie = w->ietry;
+    w->ietry = te;
     f = ftry;
     size = size_try;
+    /* points that came near sticking: impulse form from here on, with a
+     * few more iterations to settle them */
+    if ((fl & NEAR_STICK) && switch_points(d, &s, w)) {
+      if (evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->lam, w->ie) & STUCK) break;
+      f = residual(&s, w, w->y, w->F, w->mu, w->ie, w->phi, &size);
+      limit = it + MAX_ITER / 2 > limit ? it + MAX_ITER / 2 : limit;
+      if (limit > 2 * MAX_ITER) limit = 2 * MAX_ITER;
+    }
   }
   *iterations = it;
+  *sticking = w->ns;
   return 0;
 }

@@ -392,6 +392,8 @@ typedef struct ssStepStats {
   int sweeps;               /* Gauss-Seidel sweeps used */
   int newton;               /* iterations of the Newton phase that started
                                the sweeps (0: it declined or did not apply) */
+  int newton_sticking;      /* soil points that phase solved in impulse form
+                               (sticking or nearly; see README) */
   double residual;          /* final relative impulse change */
   int converged;            /* 1 if the tolerance was met */
   /* wall time of each stage of the last step (s): forward kinematics, free

@@ -479,6 +479,7 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   int converged = st->converged; /* the previous step's */
   st->converged = 1;
   st->newton = 0;
+  st->newton_sticking = 0;
   if (m->nv) memcpy(d->qvel_free, d->qvel, (size_t)m->nv * sizeof(double));
   warm_start(m, d, converged);
 
@@ -506,7 +507,8 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   int sweeps = d->ncontact ? m->opt.solver_max_sweeps : 0;
   if (!d->solver_gs_only) {
     double res;
-    if (ss_newton_solve(m, d, first_row, &st->newton, &res) && res <= tol) {
+    if (ss_newton_solve(m, d, first_row, &st->newton, &st->newton_sticking, &res) &&
+        res <= tol) {
       st->residual = res;
       sweeps = 0;
     }

@@ -104,10 +104,11 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err);
  * velocity, and *residual the check of that answer against every
  * contact's law at that velocity (the sweeps' measure: max |change| /
  * max |impulse|); 0 when it declined (everything as on entry).
- * *iterations: the Newton iterations spent either way. */
+ * *iterations: the Newton iterations spent either way; *sticking: the
+ * soil points it solved in impulse form (sticking or nearly, newton.c). */
 typedef struct ssNewtonWork ssNewtonWork;
 int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
-                    double *residual);
+                    int *sticking, double *residual);
 void ss_newton_work_free(ssNewtonWork *w);
 
 /* The per-point soil solve (exposed for tests and benchmarks): given the

@@ -187,6 +187,45 @@ static void test_packed_groups(void)
   ss_model_free(m);
 }
 
+/* The turning buggy: where a wheel's slip field turns about a point in
+ * its patch, the point nearest it nearly sticks, its slip direction turns
+ * with every Newton step in velocity form, and the phase used to stall
+ * there (about a tenth of the turning steps, each then 100 sweeps).  Such
+ * points are solved in impulse form (newton.c, NImp).  Five steps that
+ * used it, each taken also by the sweeps alone from the same state: the
+ * same impulses (bound as in test_newton), and the Newton steps need no
+ * sweeps to speak of. */
+static void test_newton_sticking(void)
+{
+  ssModel *m;
+  ssData *d;
+  if (!load("tests/data/buggy_turn_4cm.xml", &m, &d)) {
+    ok(0, "buggy_turn_4cm.xml loads");
+    return;
+  }
+  run(m, d, 200, NULL);
+  const double tol = m->opt.solver_tolerance;
+  double worst = 0;
+  int good = 1, found = 0, sweeps[2] = {0, 0}, sticking = 0, k = 0;
+  for (; k < 600 && found < 5 && good; k++) {
+    PathCompare pc;
+    good = newton_paths(m, d, &pc);
+    if (!good || d->stats.newton_sticking == 0) continue;
+    good = pc.converged[0] && pc.converged[1];
+    found++;
+    worst = fmax(worst, pc.dlam);
+    sweeps[0] += pc.sweeps[0];
+    sweeps[1] += pc.sweeps[1];
+    sticking += d->stats.newton_sticking;
+  }
+  ok(good && found == 5 && worst <= 1e3 * tol && 10 * sweeps[0] <= sweeps[1],
+     "turning buggy: %d steps with %d points in impulse form (of %d tried): %d sweeps "
+     "after the Newton phase against %d alone; impulses %.2g apart relative (bound %.2g)",
+     found, sticking, k, sweeps[0], sweeps[1], worst, 1e3 * tol);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 /* The Newton phase against the sweeps alone on the driving buggy, ten
  * steps each taken both ways from the same state (bound: test_plate.c,
  * newton_case): the same impulses, and the sweeps that follow the phase a
@@ -372,6 +411,7 @@ int main(void)
   test_determinism();
   test_packed_groups();
   test_newton();
+  test_newton_sticking();
   test_drive();
   return done_testing();
 }
