@@ -32,14 +32,15 @@
  *
  * A point that sticks or nearly so (the point nearest the centre of a
  * turning wheel's slip field) has no usable velocity form: its slip
- * direction turns with every step.  Up to NS_MAX such points are solved
- * in impulse form instead (NImp): their tangential impulses join the
- * unknowns, with the friction law as a projection (the natural map),
- * smooth enough for Newton on either side of sticking.  The phase
- * declines (and leaves impulses and velocities as it found them) when a
- * contact is not a soil point on an articulated link or a free body or a
- * PD row, when more points stick than the impulse form takes (a resting
- * patch: the sweeps handle it), or when Newton does not converge fast. */
+ * direction turns with every step.  Such points are solved in impulse
+ * form instead (NImpEval): their tangential impulses join the unknowns,
+ * with the friction law as a projection (the natural map), smooth enough
+ * for Newton on either side of sticking; each Newton step eliminates them
+ * point by point (a Schur complement onto the links' velocities), so the
+ * linear system stays 6 per link.  The phase declines (and leaves
+ * impulses and velocities as it found them) when a contact is not a soil
+ * point on an articulated link or a free body or a PD row, or when Newton
+ * does not converge fast. */
 #include "solver.h"
 #include "articulated.h"
 #include "ss_math.h"
@@ -55,11 +56,14 @@
 #define MAX_ITER 8
 /* A loaded point whose T/|v_t| passes this many times 1/G_tt at an
  * accepted iterate (or that sticks at the start) is solved in impulse form
- * from then on (NImp): its slip direction turns fast with the velocity
- * there, which the velocity form's Newton steps cannot follow.  At most
- * NS_MAX such points a solve. */
+ * from then on (NImpEval): its slip direction turns fast with the
+ * velocity there, which the velocity form's Newton steps cannot follow. */
 #define IMP_RATIO 100
-#define NS_MAX 16
+/* The impulse form's d phi / d mu is 0 at a sticking point (the impulses
+ * of a sticking patch are statically indeterminate): its elimination uses
+ * d phi / d mu + IMP_REG G_tt, which moves the Newton step only along the
+ * indeterminate directions (and by that fraction elsewhere). */
+#define IMP_REG 1e-6
 
 /* A soil point as the Newton phase sees it: its law's constants for this
  * step, its place in its group's frame, and the last values of its two
@@ -76,7 +80,8 @@ typedef struct NPoint {
                          (mob.x < 0: none) */
   int near;           /* the last evaluation found it loaded with T/|v_t|
                          above IMP_RATIO / G_tt: 1, or sticking: 2 */
-  int imp;            /* its NImp, or -1: velocity form */
+  int imp;            /* 1: in impulse form (its mu and NImpEval are at 2 i
+                         and i of the work's arrays) */
 } NPoint;
 
 /* A point solved in impulse form: its tangential impulse mu is an unknown
@@ -86,11 +91,6 @@ typedef struct NPoint {
  * |v_t| while slipping, |mu| <= T(0) and v_t = 0 while sticking, one
  * piecewise smooth equation for both, where the velocity form turns set-
  * valued.  Its normal impulse stays the explicit law of its velocity. */
-typedef struct NImp {
-  int pt, g;          /* its point and group */
-  double c[3][6];     /* d (v_n, v_t1, v_t2) / d y_g: its rows X' T */
-} NImp;
-
 /* one evaluation's values at an impulse-form point */
 typedef struct NImpEval {
   double phi[2];      /* (mu - proj(mu - rho v_t)) / rho */
@@ -119,6 +119,8 @@ typedef struct NSum {
   double F[6];        /* sum (r x lambda; lambda) */
   double K[6];        /* sum of K's entries nn, 1n, 2n, 11, 12, 22 */
   double vw[9], wv[9], ww[9]; /* sums of K (-[r]x), [r]x K, [r]x K (-[r]x) */
+  double Q[36], q[6]; /* the impulse-form points' elimination: d F' / d V'
+                         and F' at the Newton step's constant part */
 } NSum;
 
 struct ssNewtonWork {
@@ -131,7 +133,10 @@ struct ssNewtonWork {
   int *piv;           /* (n) */
   double *y, *yfree, *phi, *dy, *F;           /* (n) */
   double *ytry, *Ftry, *phitry;               /* (n) line-search trial */
-  double *H, *Htry;   /* (ngroup x 36 + nrow) d F / d y, block diagonal */
+  double *H, *Htry;   /* (ngroup x 36 + nrow) d F / d y, block diagonal,
+                         the impulse-form points eliminated into it */
+  double *q, *qtry;   /* (6 ngroup) F's part from their equations' values:
+                         the step solves (I - Lam H) dy = -phi - Lam q */
   double *col;        /* (nv) one gathered response column */
   NPoint *pt;         /* (ncontact) the soil points' constants and caches */
   NGroup *grp;        /* (ngroup) */
@@ -139,9 +144,10 @@ struct ssNewtonWork {
   int settled;        /* the last solve took no Newton step: the next one
                          forms its first H only if a step needs it */
   int ns;             /* impulse-form points of this solve */
-  NImp imp[NS_MAX];
-  double mubuf[2][2 * NS_MAX], *mu, *mutry;    /* their mu, at y and trial */
-  NImpEval iebuf[2][NS_MAX], *ie, *ietry;     /* their evaluations */
+  int *imp;           /* (ncontact) their indices */
+  double *mu, *mutry, *dmu; /* (ncontact x 2) their mu at y, at the trial,
+                         the step */
+  NImpEval *ie, *ietry; /* (ncontact) their equations at y, at the trial */
 };
 
 void ss_newton_work_free(ssNewtonWork *w)
@@ -152,6 +158,8 @@ void ss_newton_work_free(ssNewtonWork *w)
   free(w->phi); free(w->dy); free(w->F); free(w->ytry); free(w->Ftry);
   free(w->phitry); free(w->H); free(w->Htry); free(w->col); free(w->pt);
   free(w->grp); free(w->sum);
+  free(w->q); free(w->qtry); free(w->imp); free(w->mu); free(w->mutry); free(w->dmu);
+  free(w->ie); free(w->ietry);
   free(w);
 }
 
@@ -172,7 +180,13 @@ static ssNewtonWork *work(ssData *d, int n, int nc, int nv, int ng)
     if (!grow(&w->group_of, (size_t)nc, sizeof(int)) ||
         !grow(&w->pt, (size_t)nc, sizeof(NPoint)) ||
         !grow(&w->lam, 3 * (size_t)nc, sizeof(double)) ||
-        !grow(&w->lamtry, 3 * (size_t)nc, sizeof(double)))
+        !grow(&w->lamtry, 3 * (size_t)nc, sizeof(double)) ||
+        !grow(&w->imp, (size_t)nc, sizeof(int)) ||
+        !grow(&w->mu, 2 * (size_t)nc, sizeof(double)) ||
+        !grow(&w->mutry, 2 * (size_t)nc, sizeof(double)) ||
+        !grow(&w->dmu, 2 * (size_t)nc, sizeof(double)) ||
+        !grow(&w->ie, (size_t)nc, sizeof(NImpEval)) ||
+        !grow(&w->ietry, (size_t)nc, sizeof(NImpEval)))
       return NULL;
     w->cap_c = nc;
   }
@@ -182,24 +196,23 @@ static ssNewtonWork *work(ssData *d, int n, int nc, int nv, int ng)
   }
   if (ng > w->cap_g) {
     if (!grow(&w->grp, (size_t)ng, sizeof(NGroup)) ||
-        !grow(&w->sum, (size_t)ng, sizeof(NSum)))
+        !grow(&w->sum, (size_t)ng, sizeof(NSum)) ||
+        !grow(&w->q, 6 * (size_t)ng, sizeof(double)) ||
+        !grow(&w->qtry, 6 * (size_t)ng, sizeof(double)))
       return NULL;
     w->cap_g = ng;
   }
   if (n > w->cap_n) {
-    /* the Newton system has up to 2 NS_MAX more unknowns (NImp) */
-    size_t na = (size_t)n + 2 * NS_MAX;
-    double **vec[] = {&w->y, &w->yfree, &w->phi, &w->F,
+    double **vec[] = {&w->y, &w->yfree, &w->phi, &w->dy, &w->F,
                       &w->ytry, &w->Ftry, &w->phitry};
     for (size_t k = 0; k < sizeof vec / sizeof *vec; k++)
       if (!grow(vec[k], (size_t)n, sizeof(double))) return NULL;
     /* H needs at most 36 per group (6 unknowns): 6 n */
-    if (!grow(&w->dy, na, sizeof(double)) ||
-        !grow(&w->H, 6 * (size_t)n, sizeof(double)) ||
+    if (!grow(&w->H, 6 * (size_t)n, sizeof(double)) ||
         !grow(&w->Htry, 6 * (size_t)n, sizeof(double)) ||
         !grow(&w->Lam, (size_t)n * n, sizeof(double)) ||
-        !grow(&w->A, na * na, sizeof(double)) ||
-        !grow(&w->piv, na, sizeof(int)))
+        !grow(&w->A, (size_t)n * n, sizeof(double)) ||
+        !grow(&w->piv, (size_t)n, sizeof(int)))
       return NULL;
     w->cap_n = n;
   }
@@ -535,7 +548,7 @@ static void imp_map(const Mat *M, const NPoint *P, const double v[2], double ln,
  * mu does not move with y), and its equation's value and derivatives in
  * *ie.  Returns LOADED, or STICKS where it has no answer there
  * (unloaded). */
-static inline __attribute__((always_inline)) int imp_law(const Mat *M, NPoint *P, const double V[6],
+static __attribute__((noinline)) int imp_law(const Mat *M, NPoint *P, const double V[6],
                                                          const double mu[2], double lam[3],
                                                          double *K, NImpEval *ie)
 {
@@ -555,6 +568,55 @@ static inline __attribute__((always_inline)) int imp_law(const Mat *M, NPoint *P
   return LOADED;
 }
 
+/* An impulse-form point's elimination into its group's sums (frame about
+ * o).  With W = (d phi / d mu + IMP_REG G_tt I)^-1 its Newton step is
+ * dmu = -W (phi + D_v dv_t + e dv_n), dv = X dV' (X: its rows n, t1, t2),
+ * so it adds X_t^T (-W [e | D_v]) X to d F' / d V' (Q) and X_t^T (-W phi)
+ * to F' at the step (q). */
+static __attribute__((noinline)) void imp_eliminate(const NPoint *P, const NImpEval *ie, NSum *A)
+{
+  const double *r = P->r;
+  double reg = IMP_REG * P->gtt;
+  double a = ie->Dm[0] + reg, b = ie->Dm[1], c = ie->Dm[2], dd = ie->Dm[3] + reg;
+  double det = a * dd - b * c;
+  const double W[4] = {dd / det, -b / det, -c / det, a / det};
+  const double x[3][6] = {{0, r[2], -r[1], 1, 0, 0},
+                          {-r[2], 0, r[0], 0, 1, 0},
+                          {r[1], -r[0], 0, 0, 0, 1}};
+  for (int t = 0; t < 2; t++) {
+    const double *Wt = W + 2 * t;
+    double kn = -(Wt[0] * ie->e[0] + Wt[1] * ie->e[1]);
+    double k1 = -(Wt[0] * ie->Dv[0] + Wt[1] * ie->Dv[2]);
+    double k2 = -(Wt[0] * ie->Dv[1] + Wt[1] * ie->Dv[3]);
+    double kx[6];
+    for (int j = 0; j < 6; j++) kx[j] = kn * x[0][j] + k1 * x[1][j] + k2 * x[2][j];
+    for (int i = 0; i < 6; i++) {
+      double xi = x[1 + t][i];
+      if (xi == 0) continue;
+      for (int j = 0; j < 6; j++) A->Q[6 * i + j] += xi * kx[j];
+    }
+  }
+  double w0 = W[0] * ie->phi[0] + W[1] * ie->phi[1], w1 = W[2] * ie->phi[0] + W[3] * ie->phi[1];
+  for (int i = 0; i < 6; i++) A->q[i] -= x[1][i] * w0 + x[2][i] * w1;
+}
+
+/* An impulse-form point's step dmu from its group's dV' (see
+ * imp_eliminate) */
+static void imp_step(const NPoint *P, const NImpEval *ie, const double dV[6], double dmu[2])
+{
+  const double *r = P->r;
+  double reg = IMP_REG * P->gtt;
+  double a = ie->Dm[0] + reg, b = ie->Dm[1], c = ie->Dm[2], dd = ie->Dm[3] + reg;
+  double det = a * dd - b * c;
+  double dvn = dV[3] + dV[1] * r[2] - dV[2] * r[1];
+  double dv1 = dV[4] + dV[2] * r[0] - dV[0] * r[2];
+  double dv2 = dV[5] + dV[0] * r[1] - dV[1] * r[0];
+  double g0 = ie->phi[0] + ie->Dv[0] * dv1 + ie->Dv[1] * dv2 + ie->e[0] * dvn;
+  double g1 = ie->phi[1] + ie->Dv[2] * dv1 + ie->Dv[3] * dv2 + ie->e[1] * dvn;
+  dmu[0] = -(dd * g0 - b * g1) / det;
+  dmu[1] = -(a * g1 - c * g0) / det;
+}
+
 /* F(y, mu) and H(y) = dF/dy over all contacts, the soil points' impulses
  * in lam (3 each; the rows' are their entries of F), the impulse-form
  * points' equations in ie.  H: a 6 x 6 block per group, then one value
@@ -564,8 +626,8 @@ static inline __attribute__((always_inline)) int imp_law(const Mat *M, NPoint *P
  * no good). */
 static inline __attribute__((always_inline)) int
 evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWork *w,
-            const double *y, const double *mu, double *F, double *H, double *lam_out,
-            NImpEval *ie, const int with_H)
+            const double *y, const double *mu, double *F, double *H, double *q,
+            double *lam_out, NImpEval *ie, const int with_H)
 {
   const double dt = m->opt.timestep;
   memset(F, 0, (size_t)s->n * sizeof(double));
@@ -588,11 +650,10 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
       M = mat_of(w->grp[g].mat, dt);
     }
     double *lam = lam_out + 3 * i, K[6];
-    int st = P->imp < 0 ? point_law(&M, P, A->V, lam, with_H ? K : NULL)
-                        : imp_law(&M, P, A->V, mu + 2 * P->imp, lam, with_H ? K : NULL,
-                                  ie + P->imp);
+    int st = !P->imp ? point_law(&M, P, A->V, lam, with_H ? K : NULL)
+                     : imp_law(&M, P, A->V, mu + 2 * i, lam, with_H ? K : NULL, ie + i);
     if (st == UNLOADED) continue;
-    near |= P->imp < 0 && P->near;
+    near |= !P->imp && P->near;
     if (st == STICKS) {
       sticks = 1;
       continue;
@@ -606,6 +667,7 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
     A->F[4] += l1;
     A->F[5] += l2;
     if (!with_H) continue;
+    if (P->imp) imp_eliminate(P, ie + i, A);
     /* K = [[kn, 0, 0], [k1n, k11, k12], [k2n, k12, k22]] and the blocks of
      * J^T K J written out: K (-[r]x), [r]x K and [r]x K (-[r]x) */
     const double kn = K[0], k1n = K[1], k2n = K[2], k11 = K[3], k12 = K[4], k22 = K[5];
@@ -658,6 +720,10 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
         Hg[6 * (a + 3) + b] = A->vw[3 * a + b];
         Hg[6 * (a + 3) + 3 + b] = Kv[3 * a + b];
       }
+    if (w->ns) {
+      for (int k = 0; k < 36; k++) Hg[k] += A->Q[k];
+      from_group(w->grp + g, A->q, NULL, q + 6 * g, NULL);
+    }
     from_group(w->grp + g, A->F, Hg, F + 6 * g, H + 36 * g);
   }
   /* PD rows: lambda = clamp(a - b v, -bound, bound) */
@@ -682,16 +748,16 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
  * is dropped at compile time) */
 static int evaluate(const ssModel *m, const ssData *d, const Setup *s,
                     const ssNewtonWork *w, const double *y, const double *mu, double *F,
-                    double *H, double *lam_out, NImpEval *ie)
+                    double *H, double *q, double *lam_out, NImpEval *ie)
 {
-  return evaluate_at(m, d, s, w, y, mu, F, H, lam_out, ie, 1);
+  return evaluate_at(m, d, s, w, y, mu, F, H, q, lam_out, ie, 1);
 }
 
 static int evaluate_F(const ssModel *m, const ssData *d, const Setup *s,
                       const ssNewtonWork *w, const double *y, const double *mu, double *F,
                       double *lam_out, NImpEval *ie)
 {
-  return evaluate_at(m, d, s, w, y, mu, F, NULL, lam_out, ie, 0);
+  return evaluate_at(m, d, s, w, y, mu, F, NULL, NULL, lam_out, ie, 0);
 }
 
 /* check's measure at an impulse-form point: the change a visit of the
@@ -761,7 +827,7 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
      * would have formed */
     NPoint P = w->pt[i];
     double lam[3], dn;
-    if (P.imp >= 0) {
+    if (P.imp) {
       dn = imp_check(&M, &P, w->grp + g, w->sum[g].V, c->lambda);
     } else {
       if (point_law(&M, &P, w->sum[g].V, lam, NULL) == STICKS) return INFINITY;
@@ -838,26 +904,22 @@ static double residual(const Setup *s, const ssNewtonWork *w, const double *y,
     big += t * t * inv;
   }
   for (int k = 0; k < w->ns; k++) {
-    double g = w->pt[w->imp[k].pt].gtt;
-    sum += (ie[k].phi[0] * ie[k].phi[0] + ie[k].phi[1] * ie[k].phi[1]) / g;
-    big += g * (mu[2 * k] * mu[2 * k] + mu[2 * k + 1] * mu[2 * k + 1]);
+    int i = w->imp[k];
+    double g = w->pt[i].gtt;
+    sum += (ie[i].phi[0] * ie[i].phi[0] + ie[i].phi[1] * ie[i].phi[1]) / g;
+    big += g * (mu[2 * i] * mu[2 * i] + mu[2 * i + 1] * mu[2 * i + 1]);
   }
   *size = big;
   return sum;
 }
 
-/* The Newton matrix of (y, mu), na = n + 2 ns unknowns, row-major:
- *   [ I - Lam H    -Lam B ]    B: an impulse-form point's mu reaches F_g
- *   [ C            D      ]    through its rows X'_t T (NImp.c);
- * C: d phi / d y_g = (d phi / d v_t) X'_t T + (d phi / d v_n) X'_n T;
- * D = d phi / d mu (NImpEval) */
-static void newton_matrix(const Setup *s, ssNewtonWork *w, const double *H,
-                          const NImpEval *ie)
+/* A = I - Lam H (the impulse-form points eliminated into H) */
+static void newton_matrix(const Setup *s, ssNewtonWork *w, const double *H)
 {
-  int n = s->n, na = n + 2 * w->ns;
+  int n = s->n;
   for (int a = 0; a < n; a++) {
     const double *L = w->Lam + (size_t)a * n;
-    double *Ar = w->A + (size_t)a * na;
+    double *Ar = w->A + (size_t)a * n;
     for (int g = 0; g < s->ngroup; g++) {
       const double *Hg = H + 36 * g, *Lg = L + 6 * g;
       for (int j = 0; j < 6; j++)
@@ -869,27 +931,6 @@ static void newton_matrix(const Setup *s, ssNewtonWork *w, const double *H,
       Ar[k] = -L[k] * H[36 * s->ngroup + r];
     }
     Ar[a] += 1;
-    for (int k = 0; k < w->ns; k++) {
-      const NImp *I = w->imp + k;
-      const double *Lg = L + 6 * I->g;
-      for (int b = 0; b < 2; b++) {
-        const double *c = I->c[1 + b];
-        Ar[n + 2 * k + b] = -(Lg[0] * c[0] + Lg[1] * c[1] + Lg[2] * c[2] + Lg[3] * c[3] +
-                              Lg[4] * c[4] + Lg[5] * c[5]);
-      }
-    }
-  }
-  for (int k = 0; k < w->ns; k++) {
-    const NImp *I = w->imp + k;
-    for (int b = 0; b < 2; b++) {
-      double *Ar = w->A + (size_t)(n + 2 * k + b) * na;
-      memset(Ar, 0, (size_t)na * sizeof(double));
-      const double *Dv = ie[k].Dv + 2 * b;
-      for (int j = 0; j < 6; j++)
-        Ar[6 * I->g + j] = Dv[0] * I->c[1][j] + Dv[1] * I->c[2][j] + ie[k].e[b] * I->c[0][j];
-      Ar[n + 2 * k] = ie[k].Dm[2 * b];
-      Ar[n + 2 * k + 1] = ie[k].Dm[2 * b + 1];
-    }
   }
 }
 
@@ -945,36 +986,18 @@ static void lu_solve(const double *A, const int *piv, int n, double *x)
 /* Points of the last evaluation (lam) that stick or came near it (T G_tt
  * above IMP_RATIO |v_t|) go to impulse form, from their impulse there or,
  * sticking, the one their contact holds (the warm start).  Returns how
- * many went (as many as NS_MAX leaves room for). */
+ * many went. */
 static int switch_points(const ssData *d, const Setup *s, ssNewtonWork *w)
 {
   int moved = 0;
   for (int i = 0; i < s->first_row; i++) {
     NPoint *P = w->pt + i;
-    if (P->imp >= 0 || !(w->lam[3 * i] > 0) || !P->near) continue;
-    if (w->ns == NS_MAX) break;
-    const NGroup *G = w->grp + w->group_of[i];
+    if (P->imp || !(w->lam[3 * i] > 0) || !P->near) continue;
     const double *m0 = P->near == 2 ? d->contact[i].lambda + 1 : w->lam + 3 * i + 1;
-    int k = w->ns++;
-    NImp *I = w->imp + k;
-    I->pt = i;
-    I->g = w->group_of[i];
-    P->imp = k;
-    w->mu[2 * k] = m0[0];
-    w->mu[2 * k + 1] = m0[1];
-    /* its rows n, t1, t2 in the group frame, times T (y' = T y) */
-    const double *r = P->r;
-    const double x[3][6] = {{0, r[2], -r[1], 1, 0, 0},
-                            {-r[2], 0, r[0], 0, 1, 0},
-                            {r[1], -r[0], 0, 0, 0, 1}};
-    double T[36];
-    group_T(G, T);
-    for (int a = 0; a < 3; a++)
-      for (int j = 0; j < 6; j++) {
-        double t = 0;
-        for (int q = 0; q < 6; q++) t += x[a][q] * T[6 * q + j];
-        I->c[a][j] = t;
-      }
+    P->imp = 1;
+    w->imp[w->ns++] = i;
+    w->mu[2 * i] = m0[0];
+    w->mu[2 * i + 1] = m0[1];
     moved++;
   }
   return moved;
@@ -1135,7 +1158,7 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
     P->x0 = mat->shear_displacement > 0 ? c->j / mat->shear_displacement : 0;
     P->pw.s = 0;
     P->mob.x = -1;
-    P->imp = -1;
+    P->imp = 0;
   }
   n = 6 * ngroup + nrow;
   Setup s = {ngroup, nrow, n, first_row};
@@ -1170,15 +1193,11 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
   int have_H = !w->settled;
   w->settled = 0;
   w->ns = 0;
-  w->mu = w->mubuf[0];
-  w->mutry = w->mubuf[1];
-  w->ie = w->iebuf[0];
-  w->ietry = w->iebuf[1];
-  int st = have_H ? evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->lam, w->ie)
+  int st = have_H ? evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->q, w->lam, w->ie)
                   : evaluate_F(m, d, &s, w, w->y, w->mu, w->F, w->lam, w->ie);
   /* points that stick or nearly so at the start: impulse form */
   if (st && switch_points(d, &s, w)) {
-    st = evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->lam, w->ie);
+    st = evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->q, w->lam, w->ie);
     have_H = 1;
   }
   if (st & STUCK) return 0;
@@ -1206,30 +1225,45 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
       }
     }
     if (!have_H) {
-      if (evaluate(m, d, &s, w, w->y, w->mu, w->Ftry, w->H, w->lamtry, w->ietry) & STUCK)
+      if (evaluate(m, d, &s, w, w->y, w->mu, w->Ftry, w->H, w->q, w->lamtry, w->ietry) &
+          STUCK)
         return 0;
       have_H = 1;
     }
     it++;
-    int na = n + 2 * w->ns;
-    newton_matrix(&s, w, w->H, w->ie);
-    if (!lu_factor(w->A, w->piv, na)) {
+    newton_matrix(&s, w, w->H);
+    if (!lu_factor(w->A, w->piv, n)) {
       stalled = 1;
       continue;
     }
-    for (int a = 0; a < n; a++) w->dy[a] = -w->phi[a];
-    for (int k = 0; k < w->ns; k++) {
-      w->dy[n + 2 * k] = -w->ie[k].phi[0];
-      w->dy[n + 2 * k + 1] = -w->ie[k].phi[1];
+    /* (I - Lam H) dy = -phi + Lam q, then each impulse-form point's dmu */
+    for (int a = 0; a < n; a++) {
+      double t = -w->phi[a];
+      if (w->ns) {
+        const double *L = w->Lam + (size_t)a * n;
+        for (int b = 0; b < 6 * ngroup; b++) t += L[b] * w->q[b];
+      }
+      w->dy[a] = t;
     }
-    lu_solve(w->A, w->piv, na, w->dy);
+    lu_solve(w->A, w->piv, n, w->dy);
+    for (int k = 0; k < w->ns; k++) {
+      int i = w->imp[k];
+      double dV[6];
+      to_group(w->grp + w->group_of[i], w->dy + 6 * w->group_of[i], dV);
+      imp_step(w->pt + i, w->ie + i, dV, w->dmu + 2 * i);
+    }
     double alpha = 1, ftry = f;
     int ok = 0, fl = 0;
     for (int ls = 0; ls < 8 && !ok; ls++, alpha *= 0.5) {
       for (int a = 0; a < n; a++) w->ytry[a] = w->y[a] + alpha * w->dy[a];
-      for (int a = 0; a < 2 * w->ns; a++) w->mutry[a] = w->mu[a] + alpha * w->dy[n + a];
+      for (int k = 0; k < w->ns; k++) {
+        int i = w->imp[k];
+        w->mutry[2 * i] = w->mu[2 * i] + alpha * w->dmu[2 * i];
+        w->mutry[2 * i + 1] = w->mu[2 * i + 1] + alpha * w->dmu[2 * i + 1];
+      }
       /* a trial that makes a point stick is no descent either */
-      fl = evaluate(m, d, &s, w, w->ytry, w->mutry, w->Ftry, w->Htry, w->lamtry, w->ietry);
+      fl = evaluate(m, d, &s, w, w->ytry, w->mutry, w->Ftry, w->Htry, w->qtry, w->lamtry,
+                    w->ietry);
       if (fl & STUCK) continue;
       ftry = residual(&s, w, w->ytry, w->Ftry, w->mutry, w->ietry, w->phitry, &size_try);
       ok = ftry <= (1 - 1e-4 * alpha) * f;
@@ -1243,6 +1277,7 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
     t = w->y; w->y = w->ytry; w->ytry = t;
     t = w->F; w->F = w->Ftry; w->Ftry = t;
     t = w->H; w->H = w->Htry; w->Htry = t;
+    t = w->q; w->q = w->qtry; w->qtry = t;
     t = w->phi; w->phi = w->phitry; w->phitry = t;
     t = w->lam; w->lam = w->lamtry; w->lamtry = t;
     t = w->mu; w->mu = w->mutry; w->mutry = t;
@@ -1251,11 +1286,12 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
     w->ietry = te;
     f = ftry;
     size = size_try;
-    /* points that came near sticking: impulse form from here on, with a
-     * few more iterations to settle them */
+    /* points that came near sticking: impulse form from here on (their
+     * mu at the trial were their law's, so the swap above kept them) */
     if ((fl & NEAR_STICK) && switch_points(d, &s, w)) {
-      if (evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->lam, w->ie) & STUCK) break;
+      if (evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->q, w->lam, w->ie) & STUCK) break;
       f = residual(&s, w, w->y, w->F, w->mu, w->ie, w->phi, &size);
+      /* and a few more iterations to settle them */
       limit = it + MAX_ITER / 2 > limit ? it + MAX_ITER / 2 : limit;
       if (limit > 2 * MAX_ITER) limit = 2 * MAX_ITER;
     }

@@ -191,7 +191,7 @@ static void test_packed_groups(void)
  * its patch, the point nearest it nearly sticks, its slip direction turns
  * with every Newton step in velocity form, and the phase used to stall
  * there (about a tenth of the turning steps, each then 100 sweeps).  Such
- * points are solved in impulse form (newton.c, NImp).  Five steps that
+ * points are solved in impulse form (newton.c, NImpEval).  Five steps that
  * used it, each taken also by the sweeps alone from the same state: the
  * same impulses (bound as in test_newton), and the Newton steps need no
  * sweeps to speak of. */
