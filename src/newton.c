@@ -50,8 +50,9 @@
 #include <string.h>
 
 /* A loaded point whose slip stiffness T/|v_t| exceeds this many times its
- * own tangential response 1/G_tt is sticking, or so nearly that the
- * velocity form is too stiff for Newton: the phase declines. */
+ * own tangential response 1/G_tt is sticking, or so nearly that its
+ * velocity form is no use: a trial that puts a velocity-form point there
+ * is no descent, and at the start such a point goes to impulse form. */
 #define STICK_RATIO 1e3
 #define MAX_ITER 8
 /* A loaded point whose T/|v_t| passes this many times 1/G_tt at an
@@ -549,8 +550,8 @@ static void imp_map(const Mat *M, const NPoint *P, const double v[2], double ln,
  * *ie.  Returns LOADED, or STICKS where it has no answer there
  * (unloaded). */
 static __attribute__((noinline)) int imp_law(const Mat *M, NPoint *P, const double V[6],
-                                                         const double mu[2], double lam[3],
-                                                         double *K, NImpEval *ie)
+                                             const double mu[2], double lam[3], double *K,
+                                             NImpEval *ie)
 {
   const double *r = P->r;
   double vn = V[3] + V[1] * r[2] - V[2] * r[1], kn;
