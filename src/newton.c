@@ -1004,6 +1004,24 @@ static int switch_points(const ssData *d, const Setup *s, ssNewtonWork *w)
   return moved;
 }
 
+/* After a failed line search: every loaded velocity-form point goes to
+ * impulse form, from its law's impulse at y.  Returns how many went. */
+static int switch_all(ssNewtonWork *w, const Setup *s)
+{
+  int moved = 0;
+  for (int i = 0; i < s->first_row; i++) {
+    NPoint *P = w->pt + i;
+    const double *l = w->lam + 3 * i;
+    if (P->imp || !(l[0] > 0)) continue;
+    P->imp = 1;
+    w->imp[w->ns++] = i;
+    w->mu[2 * i] = l[1];
+    w->mu[2 * i + 1] = l[2];
+    moved++;
+  }
+  return moved;
+}
+
 /* ---------------------------------------------------------------------- */
 /* set-up                                                                  */
 
@@ -1203,7 +1221,7 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
   }
   if (st & STUCK) return 0;
   double f = residual(&s, w, w->y, w->F, w->mu, w->ie, w->phi, &size);
-  int it = 0, stalled = 0, limit = MAX_ITER;
+  int it = 0, stalled = 0, limit = MAX_ITER, rescued = 0;
   for (;;) {
     if (f <= try2 * size || stalled || it >= limit) {
       /* stalled far from the answer (a patch near sticking, where the
@@ -1269,7 +1287,20 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
       ftry = residual(&s, w, w->ytry, w->Ftry, w->mutry, w->ietry, w->phitry, &size_try);
       ok = ftry <= (1 - 1e-4 * alpha) * f;
     }
-    /* no descent: a kink Newton cannot cross, or round-off */
+    /* no descent: a kink Newton cannot cross, or round-off.  Once, where
+     * velocity-form points are left, all go to impulse form (a patch
+     * creeping near sticking, whose slip directions are too sensitive for
+     * the velocity form even below IMP_RATIO) and Newton tries again. */
+    if (!ok && !rescued) {
+      rescued = 1;
+      if (switch_all(w, &s) &&
+          !(evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->q, w->lam, w->ie) & STUCK)) {
+        f = residual(&s, w, w->y, w->F, w->mu, w->ie, w->phi, &size);
+        limit = it + MAX_ITER / 2 > limit ? it + MAX_ITER / 2 : limit;
+        if (limit > 2 * MAX_ITER) limit = 2 * MAX_ITER;
+        continue;
+      }
+    }
     if (!ok) {
       stalled = 1;
       continue;
