@@ -79,8 +79,6 @@ typedef struct NPoint {
   ssPowMemo pw;       /* last s^(n-1) (pw.s = 0: none) */
   ssExpMemo mob;      /* last x = x0 + sigma dt/K_j, 1 - exp(-x), exp(-x)
                          (mob.x < 0: none) */
-  int near;           /* the last evaluation found it loaded with T/|v_t|
-                         above IMP_RATIO / G_tt: 1, or sticking: 2 */
   int imp;            /* 1: in impulse form (its mu and NImpEval are at 2 i
                          and i of the work's arrays) */
 } NPoint;
@@ -418,7 +416,7 @@ static Mat mat_of(const ssSoilMaterial *mat, double dt)
   return M;
 }
 
-enum { UNLOADED = 0, LOADED = 1, STICKS = 2 };
+enum { UNLOADED = 0, LOADED = 1, STICKS = 2, NEAR = 3 };
 enum { STUCK = 1, NEAR_STICK = 2 }; /* evaluate's flags */
 
 /* The normal law of point P at normal velocity vn: lambda_n, and its
@@ -452,10 +450,10 @@ static inline __attribute__((always_inline)) double point_normal(const Mat *M, N
 /* The law of point P at its group's velocity V (frame about o): impulse
  * lam, and with K non-NULL the entries of K = d lambda / d v, (nn, 1n, 2n,
  * 11, 12, 22) (K_n1 = K_n2 = 0: the normal law does not see the slip).
- * Returns UNLOADED (lam = 0), LOADED, or STICKS when the point sticks or so
- * nearly that T / |v_t| exceeds STICK_RATIO times its own tangential
- * response 1/G_tt: the velocity form is set-valued there.  Marks P->near
- * for the switch to impulse form (switch_points). */
+ * Returns UNLOADED (lam = 0), LOADED, NEAR (loaded, and T / |v_t| above
+ * IMP_RATIO times its own tangential response 1/G_tt: switch_points), or
+ * STICKS when the point sticks or so nearly that T / |v_t| exceeds
+ * STICK_RATIO / G_tt: the velocity form is set-valued there. */
 static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint *P, const double V[6],
                             double lam[3], double *K)
 {
@@ -477,13 +475,9 @@ static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint 
   lam[1] = lam[2] = 0;
   if (K) K[1] = K[2] = K[3] = K[4] = K[5] = 0;
   if (K) K[0] = kn;
-  double Tg = T * P->gtt;
-  P->near = Tg > IMP_RATIO * sigma;
   if (!(T > 0)) return LOADED;
-  if (!(sigma > 0) || Tg > STICK_RATIO * sigma) {
-    P->near = 2;
-    return STICKS;
-  }
+  double Tg = T * P->gtt;
+  if (!(sigma > 0) || Tg > STICK_RATIO * sigma) return STICKS;
   double t1 = v1 / sigma, t2 = v2 / sigma;
   lam[1] = -T * t1;
   lam[2] = -T * t2;
@@ -497,7 +491,7 @@ static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint 
     K[4] = (a - b) * t1 * t2;
     K[5] = -a * (1 - t2 * t2) - b * t2 * t2;
   }
-  return LOADED;
+  return Tg > IMP_RATIO * sigma ? NEAR : LOADED;
 }
 
 /* The friction law of an impulse-form point in natural-map form at slip
@@ -622,7 +616,7 @@ static void imp_step(const NPoint *P, const NImpEval *ie, const double dV[6], do
  * in lam (3 each; the rows' are their entries of F), the impulse-form
  * points' equations in ie.  H: a 6 x 6 block per group, then one value
  * per row; with_H = 0: F alone (H not touched).  Returns NEAR_STICK if
- * a velocity-form point is near sticking (NPoint.near), plus STUCK if one
+ * a velocity-form point is near sticking (point_law's NEAR), plus STUCK if one
  * sticks or an impulse-form point has no answer (the evaluation is then
  * no good). */
 static inline __attribute__((always_inline)) int
@@ -654,7 +648,7 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
     int st = !P->imp ? point_law(&M, P, A->V, lam, with_H ? K : NULL)
                      : imp_law(&M, P, A->V, mu + 2 * i, lam, with_H ? K : NULL, ie + i);
     if (st == UNLOADED) continue;
-    near |= !P->imp && P->near;
+    near |= st == NEAR;
     if (st == STICKS) {
       sticks = 1;
       continue;
@@ -984,18 +978,28 @@ static void lu_solve(const double *A, const int *piv, int n, double *x)
   }
 }
 
-/* Points of the last evaluation (lam) that stick or came near it (T G_tt
- * above IMP_RATIO |v_t|) go to impulse form, from their impulse there or,
- * sticking, the one their contact holds (the warm start).  Returns how
- * many went. */
-static int switch_points(const ssData *d, const Setup *s, ssNewtonWork *w)
+/* Points at y that stick or come near it (point_law's STICKS, NEAR; the
+ * law run again on copies of the points, their memos kept) go to impulse
+ * form, from their impulse there or, sticking, the one their contact
+ * holds (the warm start).  Returns how many went. */
+static int switch_points(const ssModel *m, const ssData *d, const Setup *s, ssNewtonWork *w)
 {
-  int moved = 0;
+  int moved = 0, gprev = -1;
+  Mat M = {0};
+  for (int g = 0; g < s->ngroup; g++) to_group(w->grp + g, w->y + 6 * g, w->sum[g].V);
   for (int i = 0; i < s->first_row; i++) {
-    NPoint *P = w->pt + i;
-    if (P->imp || !(w->lam[3 * i] > 0) || !P->near) continue;
-    const double *m0 = P->near == 2 ? d->contact[i].lambda + 1 : w->lam + 3 * i + 1;
-    P->imp = 1;
+    NPoint P = w->pt[i];
+    int g = w->group_of[i];
+    if (P.imp || !(w->lam[3 * i] > 0)) continue;
+    if (g != gprev) {
+      gprev = g;
+      M = mat_of(w->grp[g].mat, m->opt.timestep);
+    }
+    double lam[3];
+    int st = point_law(&M, &P, w->sum[g].V, lam, NULL);
+    if (st != NEAR && st != STICKS) continue;
+    const double *m0 = st == STICKS ? d->contact[i].lambda + 1 : lam + 1;
+    w->pt[i].imp = 1;
     w->imp[w->ns++] = i;
     w->mu[2 * i] = m0[0];
     w->mu[2 * i + 1] = m0[1];
@@ -1215,7 +1219,7 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
   int st = have_H ? evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->q, w->lam, w->ie)
                   : evaluate_F(m, d, &s, w, w->y, w->mu, w->F, w->lam, w->ie);
   /* points that stick or nearly so at the start: impulse form */
-  if (st && switch_points(d, &s, w)) {
+  if (st && switch_points(m, d, &s, w)) {
     st = evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->q, w->lam, w->ie);
     have_H = 1;
   }
@@ -1320,7 +1324,7 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
     size = size_try;
     /* points that came near sticking: impulse form from here on (their
      * mu at the trial were their law's, so the swap above kept them) */
-    if ((fl & NEAR_STICK) && switch_points(d, &s, w)) {
+    if ((fl & NEAR_STICK) && switch_points(m, d, &s, w)) {
       if (evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->q, w->lam, w->ie) & STUCK) break;
       f = residual(&s, w, w->y, w->F, w->mu, w->ie, w->phi, &size);
       /* and a few more iterations to settle them */
