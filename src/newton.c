@@ -622,7 +622,7 @@ static void imp_step(const NPoint *P, const NImpEval *ie, const double dV[6], do
 static inline __attribute__((always_inline)) int
 evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWork *w,
             const double *y, const double *mu, double *F, double *H, double *q,
-            double *lam_out, NImpEval *ie, const int with_H)
+            double *lam_out, NImpEval *ie, const int with_H, const int with_imp)
 {
   const double dt = m->opt.timestep;
   memset(F, 0, (size_t)s->n * sizeof(double));
@@ -645,7 +645,7 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
       M = mat_of(w->grp[g].mat, dt);
     }
     double *lam = lam_out + 3 * i, K[6];
-    int st = !P->imp ? point_law(&M, P, A->V, lam, with_H ? K : NULL)
+    int st = !(with_imp && P->imp) ? point_law(&M, P, A->V, lam, with_H ? K : NULL)
                      : imp_law(&M, P, A->V, mu + 2 * i, lam, with_H ? K : NULL, ie + i);
     if (st == UNLOADED) continue;
     near |= st == NEAR;
@@ -662,7 +662,7 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
     A->F[4] += l1;
     A->F[5] += l2;
     if (!with_H) continue;
-    if (P->imp) imp_eliminate(P, ie + i, A);
+    if (with_imp && P->imp) imp_eliminate(P, ie + i, A);
     /* K = [[kn, 0, 0], [k1n, k11, k12], [k2n, k12, k22]] and the blocks of
      * J^T K J written out: K (-[r]x), [r]x K and [r]x K (-[r]x) */
     const double kn = K[0], k1n = K[1], k2n = K[2], k11 = K[3], k12 = K[4], k22 = K[5];
@@ -715,7 +715,7 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
         Hg[6 * (a + 3) + b] = A->vw[3 * a + b];
         Hg[6 * (a + 3) + 3 + b] = Kv[3 * a + b];
       }
-    if (w->ns) {
+    if (with_imp) {
       for (int k = 0; k < 36; k++) Hg[k] += A->Q[k];
       from_group(w->grp + g, A->q, NULL, q + 6 * g, NULL);
     }
@@ -739,20 +739,23 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
   return (sticks ? STUCK : 0) | (near ? NEAR_STICK : 0);
 }
 
-/* the two forms, each compiled for itself (without H, the Jacobian's work
- * is dropped at compile time) */
+/* the forms, each compiled for itself: without H, the Jacobian's work is
+ * dropped at compile time, and without impulse-form points (most steps)
+ * their tests and sums */
 static int evaluate(const ssModel *m, const ssData *d, const Setup *s,
                     const ssNewtonWork *w, const double *y, const double *mu, double *F,
                     double *H, double *q, double *lam_out, NImpEval *ie)
 {
-  return evaluate_at(m, d, s, w, y, mu, F, H, q, lam_out, ie, 1);
+  return w->ns ? evaluate_at(m, d, s, w, y, mu, F, H, q, lam_out, ie, 1, 1)
+               : evaluate_at(m, d, s, w, y, mu, F, H, q, lam_out, ie, 1, 0);
 }
 
 static int evaluate_F(const ssModel *m, const ssData *d, const Setup *s,
                       const ssNewtonWork *w, const double *y, const double *mu, double *F,
                       double *lam_out, NImpEval *ie)
 {
-  return evaluate_at(m, d, s, w, y, mu, F, NULL, NULL, lam_out, ie, 0);
+  return w->ns ? evaluate_at(m, d, s, w, y, mu, F, NULL, NULL, lam_out, ie, 0, 1)
+               : evaluate_at(m, d, s, w, y, mu, F, NULL, NULL, lam_out, ie, 0, 0);
 }
 
 /* check's measure at an impulse-form point: the change a visit of the
