@@ -112,48 +112,14 @@ static int identical(const ssModel *m, const ssData *a, const ssData *b)
 /* ---------------------------------------------------------------------- */
 /* worlds built in code                                                    */
 
-/* A 20 kg plate on an n x n soil bed of side size; with pull != 0, a
- * horizontal force pull (N) along x from t = 0.03 s: the dragged plate. */
+/* plate_world, its failure reported */
 static int build_plate_on(int n, double size, double slope, double pull,
                           const ssSoilMaterial *soil, ssModel **mout, ssData **dout)
 {
   ssError e;
-  ssModel *m = ss_model_new();
-  double *z = calloc((size_t)n * n, sizeof(double));
-  if (!m || !z) return 0;
-  for (int j = 0; j < n; j++)
-    for (int i = 0; i < n; i++) z[j * n + i] = slope * i / (n - 1);
-  ssHfieldDef hd = ss_hfield_def_default();
-  hd.name = "bed";
-  hd.nx = hd.ny = n;
-  hd.x_size = hd.y_size = size;
-  hd.height = z;
-  hd.soil = 1;
-  hd.soilmat = soil ? *soil : plate_soil();
-  int bed = ss_model_add_hfield(m, &hd, &e);
-  free(z);
-  ssBodyDef bd = ss_body_def_default();
-  bd.name = "plate";
-  bd.shape = SS_GEOM_BOX;
-  ss_v3_set(bd.size, 0.4, 0.6, 0.05);
-  bd.mass = 20;
-  ss_v3_set(bd.pos, 0.013, -0.007, 0.0265);
-  int body = ss_model_add_body(m, &bd, &e);
-  int ok = bed >= 0 && body >= 0;
-  if (ok && pull != 0) {
-    double f[3] = {pull, 0, 0}, t[3] = {0, 0, 0};
-    ok = ss_model_add_xforce(m, m->sys_bodyadr[body], f, t, 0.03, 1e9, &e) >= 0;
-  }
-  if (ok) ok = ss_model_validate(m, &e) == SS_OK;
-  ssData *d = ok ? ss_data_new(m) : NULL;
-  if (!d) {
-    diag("world build failed: %s", e.message);
-    ss_model_free(m);
-    return 0;
-  }
-  *mout = m;
-  *dout = d;
-  return 1;
+  if (plate_world(n, size, slope, pull, soil, mout, dout, &e)) return 1;
+  diag("world build failed: %s", e.message);
+  return 0;
 }
 
 /* on a gentle slope, so that the state is not symmetric */

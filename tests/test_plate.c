@@ -576,35 +576,15 @@ static void test_newton(void)
  * points in impulse form, solves each step. */
 static void test_resting_on_slope(void)
 {
-  const int n = 41;
   ssError e;
-  ssModel *m = ss_model_new();
-  double *z = calloc((size_t)n * n, sizeof(double));
-  if (!m || !z) {
-    ok(0, "tilted bed: memory");
+  ssModel *m;
+  ssData *d;
+  if (!plate_world(41, 1.6, 0.002, 0, NULL, &m, &d, &e)) {
+    ok(0, "tilted bed: %s", e.message);
     return;
   }
-  for (int j = 0; j < n; j++)
-    for (int i = 0; i < n; i++) z[j * n + i] = 0.002 * i / (n - 1);
-  ssHfieldDef hd = ss_hfield_def_default();
-  hd.name = "bed";
-  hd.nx = hd.ny = n;
-  hd.x_size = hd.y_size = 1.6;
-  hd.height = z;
-  hd.soil = 1;
-  hd.soilmat = plate_soil();
-  int bed = ss_model_add_hfield(m, &hd, &e);
-  free(z);
-  ssBodyDef bd = ss_body_def_default();
-  bd.name = "plate";
-  bd.shape = SS_GEOM_BOX;
-  ss_v3_set(bd.size, 0.4, 0.6, 0.05);
-  bd.mass = 20;
-  ss_v3_set(bd.pos, 0.013, -0.007, 0.0265);
-  int plate = ss_model_add_body(m, &bd, &e);
-  ssData *d = bed >= 0 && plate >= 0 && ss_model_validate(m, &e) == SS_OK ? ss_data_new(m) : NULL;
-  World w = {m, d, plate, bed};
-  int good = d && run(&w, 100), unconverged = 0, sweeps = 0, newton = 0, sticking = 0;
+  World w = {m, d, 0, 0};
+  int good = run(&w, 100), unconverged = 0, sweeps = 0, newton = 0, sticking = 0;
   for (int k = 0; k < 200 && good; k++) {
     good = run(&w, 1);
     unconverged += !d->stats.converged;
@@ -616,7 +596,7 @@ static void test_resting_on_slope(void)
      "plate coming to rest on a bed tilted 0.07 deg, steps 100-300: %d unconverged, %d sweeps, "
      "%d Newton iterations, %d steps with points in impulse form",
      unconverged, sweeps, newton, sticking);
-  if (d) ss_data_free(d);
+  ss_data_free(d);
   ss_model_free(m);
 }
 

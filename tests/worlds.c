@@ -84,11 +84,18 @@ ssSoilMaterial plate_soil(void)
   return s;
 }
 
-int add_bed(ssModel *m, double size, double h, ssSoilMaterial soil)
+/* an n x n soil bed "bed" of side size rising by slope (m) along x; its
+ * index, or -1 (why in *e) */
+static int add_sloped_bed(ssModel *m, int n, double size, double slope, ssSoilMaterial soil,
+                          ssError *e)
 {
-  ssError e;
-  int n = (int)lround(size / h) + 1;
   double *z = calloc((size_t)n * n, sizeof(double));
+  if (!z) {
+    snprintf(e->message, sizeof e->message, "out of memory");
+    return -1;
+  }
+  for (int j = 0; j < n; j++)
+    for (int i = 0; i < n; i++) z[j * n + i] = n > 1 ? slope * i / (n - 1) : 0;
   ssHfieldDef hd = ss_hfield_def_default();
   hd.name = "bed";
   hd.nx = hd.ny = n;
@@ -96,9 +103,15 @@ int add_bed(ssModel *m, double size, double h, ssSoilMaterial soil)
   hd.height = z;
   hd.soil = 1;
   hd.soilmat = soil;
-  int k = ss_model_add_hfield(m, &hd, &e);
+  int k = ss_model_add_hfield(m, &hd, e);
   free(z);
   return k;
+}
+
+int add_bed(ssModel *m, double size, double h, ssSoilMaterial soil)
+{
+  ssError e;
+  return add_sloped_bed(m, (int)lround(size / h) + 1, size, 0, soil, &e);
 }
 
 int add_soil_bed(ssModel *m, double size, double h)
@@ -279,4 +292,37 @@ done:
   free(buf);
   free(lam);
   return ok;
+}
+
+int plate_world(int n, double size, double slope, double pull, const ssSoilMaterial *soil,
+                ssModel **mout, ssData **dout, ssError *e)
+{
+  ssModel *m = ss_model_new();
+  if (!m) {
+    snprintf(e->message, sizeof e->message, "out of memory");
+    return 0;
+  }
+  int bed = add_sloped_bed(m, n, size, slope, soil ? *soil : plate_soil(), e);
+  ssBodyDef bd = ss_body_def_default();
+  bd.name = "plate";
+  bd.shape = SS_GEOM_BOX;
+  ss_v3_set(bd.size, 0.4, 0.6, 0.05);
+  bd.mass = 20;
+  ss_v3_set(bd.pos, 0.013, -0.007, 0.0265);
+  int body = bed >= 0 ? ss_model_add_body(m, &bd, e) : -1;
+  int ok = bed >= 0 && body >= 0;
+  if (ok && pull != 0) {
+    double f[3] = {pull, 0, 0}, t[3] = {0, 0, 0};
+    ok = ss_model_add_xforce(m, m->sys_bodyadr[body], f, t, 0.03, 1e9, e) >= 0;
+  }
+  if (ok) ok = ss_model_validate(m, e) == SS_OK;
+  ssData *d = ok ? ss_data_new(m) : NULL;
+  if (!d) {
+    if (ok) snprintf(e->message, sizeof e->message, "out of memory");
+    ss_model_free(m);
+    return 0;
+  }
+  *mout = m;
+  *dout = d;
+  return 1;
 }

@@ -24,6 +24,12 @@ ssSoilMaterial plate_soil(void);
 /* a flat size x size soil bed named "bed" at spacing h: of soil, or of
  * plate_soil() */
 int add_bed(ssModel *m, double size, double h, ssSoilMaterial soil);
+/* The 20 kg, 0.4 x 0.6 m plate of DESIGN 2.7 just above an n x n soil bed
+ * of side size (soil, or plate_soil() when NULL) that rises by slope (m)
+ * along x; with pull != 0, a horizontal force pull (N) along x from t =
+ * 0.03 s.  Validated, with a data; 0 on failure (why in *e). */
+int plate_world(int n, double size, double slope, double pull, const ssSoilMaterial *soil,
+                ssModel **m, ssData **d, ssError *e);
 int add_soil_bed(ssModel *m, double size, double h);
 /* a chain of nlinks sprung revolute joints standing on link `on` */
 int add_mast(ssUrdf *u, int on, int nlinks, double mass, const double at[3]);
