@@ -419,6 +419,17 @@ static Mat mat_of(const ssSoilMaterial *mat, double dt)
 enum { UNLOADED = 0, LOADED = 1, STICKS = 2, NEAR = 3 };
 enum { STUCK = 1, NEAR_STICK = 2 }; /* evaluate's flags */
 
+/* the velocity (v_n, v_t1, v_t2) of a point at r for its group's velocity
+ * V (frame about o): v = v_o + omega x r */
+static inline __attribute__((always_inline)) void point_velocity(const double r[3],
+                                                                 const double V[6],
+                                                                 double v[3])
+{
+  v[0] = V[3] + V[1] * r[2] - V[2] * r[1];
+  v[1] = V[4] + V[2] * r[0] - V[0] * r[2];
+  v[2] = V[5] + V[0] * r[1] - V[1] * r[0];
+}
+
 /* The normal law of point P at normal velocity vn: lambda_n, and its
  * derivative d lambda_n / d v_n in *kn; -1 when unloaded (no overlap) */
 static inline __attribute__((always_inline)) double point_normal(const Mat *M, NPoint *P,
@@ -458,7 +469,8 @@ static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint 
                             double lam[3], double *K)
 {
   const double *r = P->r;
-  /* v = v_o + omega x r */
+  /* v = v_o + omega x r (point_velocity, the tangential part formed only
+   * for a loaded point) */
   double vn = V[3] + V[1] * r[2] - V[2] * r[1], kn;
   double ln = point_normal(M, P, vn, &kn);
   if (ln < 0) {
@@ -547,12 +559,11 @@ static __attribute__((noinline)) int imp_law(const Mat *M, NPoint *P, const doub
                                              const double mu[2], double lam[3], double *K,
                                              NImpEval *ie)
 {
-  const double *r = P->r;
-  double vn = V[3] + V[1] * r[2] - V[2] * r[1], kn;
-  double ln = point_normal(M, P, vn, &kn);
+  double v[3], kn;
+  point_velocity(P->r, V, v);
+  double ln = point_normal(M, P, v[0], &kn);
   if (ln < 0) return STICKS;
-  double v[2] = {V[4] + V[2] * r[0] - V[0] * r[2], V[5] + V[0] * r[1] - V[1] * r[0]};
-  imp_map(M, P, v, ln, kn, mu, ie);
+  imp_map(M, P, v + 1, ln, kn, mu, ie);
   lam[0] = ln;
   lam[1] = mu[0];
   lam[2] = mu[1];
@@ -563,6 +574,18 @@ static __attribute__((noinline)) int imp_law(const Mat *M, NPoint *P, const doub
   return LOADED;
 }
 
+/* d phi / d mu + IMP_REG G_tt I of an impulse-form point, in A; returns
+ * its determinant */
+static double imp_regularized(const NPoint *P, const NImpEval *ie, double A[4])
+{
+  double reg = IMP_REG * P->gtt;
+  A[0] = ie->Dm[0] + reg;
+  A[1] = ie->Dm[1];
+  A[2] = ie->Dm[2];
+  A[3] = ie->Dm[3] + reg;
+  return A[0] * A[3] - A[1] * A[2];
+}
+
 /* An impulse-form point's elimination into its group's sums (frame about
  * o).  With W = (d phi / d mu + IMP_REG G_tt I)^-1 its Newton step is
  * dmu = -W (phi + D_v dv_t + e dv_n), dv = X dV' (X: its rows n, t1, t2),
@@ -571,10 +594,8 @@ static __attribute__((noinline)) int imp_law(const Mat *M, NPoint *P, const doub
 static __attribute__((noinline)) void imp_eliminate(const NPoint *P, const NImpEval *ie, NSum *A)
 {
   const double *r = P->r;
-  double reg = IMP_REG * P->gtt;
-  double a = ie->Dm[0] + reg, b = ie->Dm[1], c = ie->Dm[2], dd = ie->Dm[3] + reg;
-  double det = a * dd - b * c;
-  const double W[4] = {dd / det, -b / det, -c / det, a / det};
+  double A0[4], det = imp_regularized(P, ie, A0);
+  const double W[4] = {A0[3] / det, -A0[1] / det, -A0[2] / det, A0[0] / det};
   const double x[3][6] = {{0, r[2], -r[1], 1, 0, 0},
                           {-r[2], 0, r[0], 0, 1, 0},
                           {r[1], -r[0], 0, 0, 0, 1}};
@@ -599,17 +620,12 @@ static __attribute__((noinline)) void imp_eliminate(const NPoint *P, const NImpE
  * imp_eliminate) */
 static void imp_step(const NPoint *P, const NImpEval *ie, const double dV[6], double dmu[2])
 {
-  const double *r = P->r;
-  double reg = IMP_REG * P->gtt;
-  double a = ie->Dm[0] + reg, b = ie->Dm[1], c = ie->Dm[2], dd = ie->Dm[3] + reg;
-  double det = a * dd - b * c;
-  double dvn = dV[3] + dV[1] * r[2] - dV[2] * r[1];
-  double dv1 = dV[4] + dV[2] * r[0] - dV[0] * r[2];
-  double dv2 = dV[5] + dV[0] * r[1] - dV[1] * r[0];
-  double g0 = ie->phi[0] + ie->Dv[0] * dv1 + ie->Dv[1] * dv2 + ie->e[0] * dvn;
-  double g1 = ie->phi[1] + ie->Dv[2] * dv1 + ie->Dv[3] * dv2 + ie->e[1] * dvn;
-  dmu[0] = -(dd * g0 - b * g1) / det;
-  dmu[1] = -(a * g1 - c * g0) / det;
+  double A[4], det = imp_regularized(P, ie, A), dv[3];
+  point_velocity(P->r, dV, dv);
+  double g0 = ie->phi[0] + ie->Dv[0] * dv[1] + ie->Dv[1] * dv[2] + ie->e[0] * dv[0];
+  double g1 = ie->phi[1] + ie->Dv[2] * dv[1] + ie->Dv[3] * dv[2] + ie->e[1] * dv[0];
+  dmu[0] = -(A[3] * g0 - A[1] * g1) / det;
+  dmu[1] = -(A[0] * g1 - A[2] * g0) / det;
 }
 
 /* F(y, mu) and H(y) = dF/dy over all contacts, the soil points' impulses
@@ -769,12 +785,12 @@ static double imp_check(const Mat *M, NPoint *P, const NGroup *G, const double V
                         const double lam[3])
 {
   const double *r = P->r;
-  double vn = V[3] + V[1] * r[2] - V[2] * r[1], kn;
-  double ln = point_normal(M, P, vn, &kn);
+  double v[3], kn;
+  point_velocity(r, V, v);
+  double ln = point_normal(M, P, v[0], &kn);
   if (ln < 0) ln = kn = 0;
-  double v[2] = {V[4] + V[2] * r[0] - V[0] * r[2], V[5] + V[0] * r[1] - V[1] * r[0]};
   NImpEval ie;
-  imp_map(M, P, v, ln, kn, lam + 1, &ie);
+  imp_map(M, P, v + 1, ln, kn, lam + 1, &ie);
   const double x[2][6] = {{-r[2], 0, r[0], 0, 1, 0}, {r[1], -r[0], 0, 0, 0, 1}};
   double Gt[4], A[4];
   for (int a = 0; a < 2; a++)
