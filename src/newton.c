@@ -774,6 +774,28 @@ static int evaluate_F(const ssModel *m, const ssData *d, const Setup *s,
                : evaluate_at(m, d, s, w, y, mu, F, NULL, NULL, lam_out, ie, 0, 0);
 }
 
+/* The sweeps' measure of a solve: the largest change |law - lambda|_1 a
+ * contact's law would make over the largest |lambda|_1, INFINITY if a
+ * change is not finite (check and warm_check) */
+typedef struct Measure {
+  double dmax, lmax;
+  int finite;
+} Measure;
+
+static inline void measure_add(Measure *q, double dn, double ln)
+{
+  /* not fmax: a libm call here, and it would pass over a NaN */
+  q->finite &= isfinite(dn);
+  q->dmax = dn > q->dmax ? dn : q->dmax;
+  q->lmax = ln > q->lmax ? ln : q->lmax;
+}
+
+static double measure_value(const Measure *q)
+{
+  if (!q->finite) return INFINITY;
+  return q->lmax > 0 ? q->dmax / q->lmax : 0;
+}
+
 /* check's measure at an impulse-form point: the change a visit of the
  * sweeps would make to its impulse lam (held) at group velocity V, the
  * others held.  Normal: the law's impulse at v_n against the one held;
@@ -825,8 +847,7 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
     group_motion(m, d, G, d->qvel + m->sys_vadr[G->sys], V);
     to_group(G, V, w->sum[g].V);
   }
-  double dmax = 0, lmax = 0;
-  int finite = 1;
+  Measure q = {0, 0, 1};
   int gprev = -1;
   Mat M = {0};
   for (int i = 0; i < s->first_row; i++) {
@@ -847,11 +868,7 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
       if (point_law(&M, &P, w->sum[g].V, lam, NULL) == STICKS) return INFINITY;
       dn = fabs(lam[0] - c->lambda[0]) + fabs(lam[1] - c->lambda[1]) + fabs(lam[2] - c->lambda[2]);
     }
-    double ln = fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]);
-    /* not fmax: a libm call here, and it would pass over a NaN */
-    finite &= isfinite(dn);
-    dmax = dn > dmax ? dn : dmax;
-    lmax = ln > lmax ? ln : lmax;
+    measure_add(&q, dn, fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]));
   }
   for (int r = 0; r < s->nrow; r++) {
     const ssContact *c = d->contact + s->first_row + r;
@@ -859,13 +876,9 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
     double l = c->row_a - c->row_b * v;
     if (l > c->row_bound) l = c->row_bound;
     if (l < -c->row_bound) l = -c->row_bound;
-    double dr = fabs(l - c->lambda[0]), lr = fabs(c->lambda[0]);
-    finite &= isfinite(dr);
-    dmax = dr > dmax ? dr : dmax;
-    lmax = lr > lmax ? lr : lmax;
+    measure_add(&q, fabs(l - c->lambda[0]), fabs(c->lambda[0]));
   }
-  if (!finite) return INFINITY;
-  return lmax > 0 ? dmax / lmax : 0;
+  return measure_value(&q);
 }
 
 /* The check of the warm start itself (check's measure, without a pass of
@@ -876,25 +889,17 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
  * not finite. */
 static double warm_check(const ssData *d, const Setup *s, const ssNewtonWork *w)
 {
-  double dmax = 0, lmax = 0;
-  int finite = 1;
+  Measure q = {0, 0, 1};
   for (int i = 0; i < s->first_row; i++) {
     const double *l = d->contact[i].lambda, *law = w->lam + 3 * i;
-    double dn = fabs(law[0] - l[0]) + fabs(law[1] - l[1]) + fabs(law[2] - l[2]);
-    double ln = fabs(l[0]) + fabs(l[1]) + fabs(l[2]);
-    finite &= isfinite(dn);
-    dmax = dn > dmax ? dn : dmax;
-    lmax = ln > lmax ? ln : lmax;
+    measure_add(&q, fabs(law[0] - l[0]) + fabs(law[1] - l[1]) + fabs(law[2] - l[2]),
+                fabs(l[0]) + fabs(l[1]) + fabs(l[2]));
   }
   for (int r = 0; r < s->nrow; r++) {
     double l = d->contact[s->first_row + r].lambda[0];
-    double dr = fabs(w->F[6 * s->ngroup + r] - l), lr = fabs(l);
-    finite &= isfinite(dr);
-    dmax = dr > dmax ? dr : dmax;
-    lmax = lr > lmax ? lr : lmax;
+    measure_add(&q, fabs(w->F[6 * s->ngroup + r] - l), fabs(l));
   }
-  if (!finite) return INFINITY;
-  return lmax > 0 ? dmax / lmax : 0;
+  return measure_value(&q);
 }
 
 /* phi = y - yfree - Lam F.  Returns |phi|^2 and sets *size to |Lam F|^2,
