@@ -54,6 +54,8 @@
  * velocity form is no use: a trial that puts a velocity-form point there
  * is no descent, and at the start such a point goes to impulse form. */
 #define STICK_RATIO 1e3
+/* Newton iterations of a solve; twice as many once points are in impulse
+ * form (their kinks cost a few damped steps) */
 #define MAX_ITER 8
 /* A loaded point whose T/|v_t| passes this many times 1/G_tt at an
  * accepted iterate (or that sticks at the start) is solved in impulse form
@@ -65,6 +67,20 @@
  * d phi / d mu + IMP_REG G_tt, which moves the Newton step only along the
  * indeterminate directions (and by that fraction elsewhere). */
 #define IMP_REG 1e-6
+/* Close to the answer (|phi| below IMP_REG_NEAR of the contacts' effect,
+ * as residual weighs them) a line search that finds no descent with
+ * impulse-form points (their steps move far along the indeterminate
+ * directions, across the natural map's kinks) tries again from the same
+ * point with the regularization IMP_REG_UP times larger, up to
+ * IMP_REG_MAX (a Levenberg-Marquardt damping of their impulses); each
+ * later step relaxes it by IMP_REG_DOWN, back to IMP_REG.  Farther out
+ * (a creeping patch whose points cross the kinks in bulk) damped steps
+ * converge too slowly to pay for their evaluations; the sweeps do better
+ * there. */
+#define IMP_REG_NEAR 1e-5
+#define IMP_REG_UP 10
+#define IMP_REG_DOWN 0.5
+#define IMP_REG_MAX 1
 
 /* A soil point as the Newton phase sees it: its law's constants for this
  * step, its place in its group's frame, and the last values of its two
@@ -143,6 +159,8 @@ struct ssNewtonWork {
   int settled;        /* the last solve took no Newton step: the next one
                          forms its first H only if a step needs it */
   int ns;             /* impulse-form points of this solve */
+  double reg;         /* their regularization, times G_tt (IMP_REG, more
+                         after a line search without descent) */
   int *imp;           /* (ncontact) their indices */
   double *mu, *mutry, *dmu; /* (ncontact x 2) their mu at y, at the trial,
                          the step */
@@ -508,9 +526,16 @@ static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint 
 
 /* The friction law of an impulse-form point in natural-map form at slip
  * velocity v (2), normal impulse ln with d ln / d v_n = kn, tangential
- * impulse mu: phi and its derivatives (NImpEval) */
+ * impulse mu: phi and its derivatives (NImpEval).  With project, a mu
+ * outside the disc is first brought back onto its rim (radially): a
+ * Newton step that turns a point's impulse along the rim (to first order
+ * free there, the rim's tangent) leaves it outside by the rim's curvature,
+ * an error of second order in the step that the linearization does not
+ * see and that, summed over a patch, can take away all descent; no answer
+ * lies outside the disc, and the projection moves mu closer to every
+ * point of it. */
 static void imp_map(const Mat *M, const NPoint *P, const double v[2], double ln, double kn,
-                    const double mu[2], NImpEval *ie)
+                    double mu[2], int project, NImpEval *ie)
 {
   double rho = 1 / P->gtt, sigma = sqrt(v[0] * v[0] + v[1] * v[1]);
   double tf = P->tf0 + M->mu * ln, mob = 1, ex = 0;
@@ -520,6 +545,14 @@ static void imp_map(const Mat *M, const NPoint *P, const double v[2], double ln,
     ex = 1 - mob;
   }
   double T = tf * mob;
+  if (project) {
+    double mn = sqrt(mu[0] * mu[0] + mu[1] * mu[1]);
+    if (mn > T) {
+      double sc = T / mn;
+      mu[0] *= sc;
+      mu[1] *= sc;
+    }
+  }
   double z0 = mu[0] - rho * v[0], z1 = mu[1] - rho * v[1], zn = sqrt(z0 * z0 + z1 * z1);
   if (!(zn > T)) {
     /* inside the disc: phi = v_t (sticking, v_t = 0 at the answer) */
@@ -556,14 +589,14 @@ static void imp_map(const Mat *M, const NPoint *P, const double v[2], double ln,
  * *ie.  Returns LOADED, or STICKS where it has no answer there
  * (unloaded). */
 static __attribute__((noinline)) int imp_law(const Mat *M, NPoint *P, const double V[6],
-                                             const double mu[2], double lam[3], double *K,
+                                             double mu[2], double lam[3], double *K,
                                              NImpEval *ie)
 {
   double v[3], kn;
   point_velocity(P->r, V, v);
   double ln = point_normal(M, P, v[0], &kn);
   if (ln < 0) return STICKS;
-  imp_map(M, P, v + 1, ln, kn, mu, ie);
+  imp_map(M, P, v + 1, ln, kn, mu, 1, ie);
   lam[0] = ln;
   lam[1] = mu[0];
   lam[2] = mu[1];
@@ -574,11 +607,11 @@ static __attribute__((noinline)) int imp_law(const Mat *M, NPoint *P, const doub
   return LOADED;
 }
 
-/* d phi / d mu + IMP_REG G_tt I of an impulse-form point, in A; returns
- * its determinant */
-static double imp_regularized(const NPoint *P, const NImpEval *ie, double A[4])
+/* d phi / d mu + scale G_tt I of an impulse-form point (scale: the solve's
+ * regularization, IMP_REG or more), in A; returns its determinant */
+static double imp_regularized(const NPoint *P, const NImpEval *ie, double scale, double A[4])
 {
-  double reg = IMP_REG * P->gtt;
+  double reg = scale * P->gtt;
   A[0] = ie->Dm[0] + reg;
   A[1] = ie->Dm[1];
   A[2] = ie->Dm[2];
@@ -587,14 +620,15 @@ static double imp_regularized(const NPoint *P, const NImpEval *ie, double A[4])
 }
 
 /* An impulse-form point's elimination into its group's sums (frame about
- * o).  With W = (d phi / d mu + IMP_REG G_tt I)^-1 its Newton step is
+ * o).  With W = (d phi / d mu + scale G_tt I)^-1 its Newton step is
  * dmu = -W (phi + D_v dv_t + e dv_n), dv = X dV' (X: its rows n, t1, t2),
  * so it adds X_t^T (-W [e | D_v]) X to d F' / d V' (Q) and X_t^T (-W phi)
  * to F' at the step (q). */
-static __attribute__((noinline)) void imp_eliminate(const NPoint *P, const NImpEval *ie, NSum *A)
+static __attribute__((noinline)) void imp_eliminate(const NPoint *P, const NImpEval *ie,
+                                                   double scale, NSum *A)
 {
   const double *r = P->r;
-  double A0[4], det = imp_regularized(P, ie, A0);
+  double A0[4], det = imp_regularized(P, ie, scale, A0);
   const double W[4] = {A0[3] / det, -A0[1] / det, -A0[2] / det, A0[0] / det};
   const double x[3][6] = {{0, r[2], -r[1], 1, 0, 0},
                           {-r[2], 0, r[0], 0, 1, 0},
@@ -618,9 +652,10 @@ static __attribute__((noinline)) void imp_eliminate(const NPoint *P, const NImpE
 
 /* An impulse-form point's step dmu from its group's dV' (see
  * imp_eliminate) */
-static void imp_step(const NPoint *P, const NImpEval *ie, const double dV[6], double dmu[2])
+static void imp_step(const NPoint *P, const NImpEval *ie, double scale, const double dV[6],
+                     double dmu[2])
 {
-  double A[4], det = imp_regularized(P, ie, A), dv[3];
+  double A[4], det = imp_regularized(P, ie, scale, A), dv[3];
   point_velocity(P->r, dV, dv);
   double g0 = ie->phi[0] + ie->Dv[0] * dv[1] + ie->Dv[1] * dv[2] + ie->e[0] * dv[0];
   double g1 = ie->phi[1] + ie->Dv[2] * dv[1] + ie->Dv[3] * dv[2] + ie->e[1] * dv[0];
@@ -637,7 +672,7 @@ static void imp_step(const NPoint *P, const NImpEval *ie, const double dV[6], do
  * no good). */
 static inline __attribute__((always_inline)) int
 evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWork *w,
-            const double *y, const double *mu, double *F, double *H, double *q,
+            const double *y, double *mu, double *F, double *H, double *q,
             double *lam_out, NImpEval *ie, const int with_H, const int with_imp)
 {
   const double dt = m->opt.timestep;
@@ -678,7 +713,7 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
     A->F[4] += l1;
     A->F[5] += l2;
     if (!with_H) continue;
-    if (with_imp && P->imp) imp_eliminate(P, ie + i, A);
+    if (with_imp && P->imp) imp_eliminate(P, ie + i, w->reg, A);
     /* K = [[kn, 0, 0], [k1n, k11, k12], [k2n, k12, k22]] and the blocks of
      * J^T K J written out: K (-[r]x), [r]x K and [r]x K (-[r]x) */
     const double kn = K[0], k1n = K[1], k2n = K[2], k11 = K[3], k12 = K[4], k22 = K[5];
@@ -759,7 +794,7 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
  * dropped at compile time, and without impulse-form points (most steps)
  * their tests and sums */
 static int evaluate(const ssModel *m, const ssData *d, const Setup *s,
-                    const ssNewtonWork *w, const double *y, const double *mu, double *F,
+                    const ssNewtonWork *w, const double *y, double *mu, double *F,
                     double *H, double *q, double *lam_out, NImpEval *ie)
 {
   return w->ns ? evaluate_at(m, d, s, w, y, mu, F, H, q, lam_out, ie, 1, 1)
@@ -767,7 +802,7 @@ static int evaluate(const ssModel *m, const ssData *d, const Setup *s,
 }
 
 static int evaluate_F(const ssModel *m, const ssData *d, const Setup *s,
-                      const ssNewtonWork *w, const double *y, const double *mu, double *F,
+                      const ssNewtonWork *w, const double *y, double *mu, double *F,
                       double *lam_out, NImpEval *ie)
 {
   return w->ns ? evaluate_at(m, d, s, w, y, mu, F, NULL, NULL, lam_out, ie, 0, 1)
@@ -812,7 +847,8 @@ static double imp_check(const Mat *M, NPoint *P, const NGroup *G, const double V
   double ln = point_normal(M, P, v[0], &kn);
   if (ln < 0) ln = kn = 0;
   NImpEval ie;
-  imp_map(M, P, v + 1, ln, kn, lam + 1, &ie);
+  double mu[2] = {lam[1], lam[2]};
+  imp_map(M, P, v + 1, ln, kn, mu, 0, &ie);
   const double x[2][6] = {{-r[2], 0, r[0], 0, 1, 0}, {r[1], -r[0], 0, 0, 0, 1}};
   double Gt[4], A[4];
   for (int a = 0; a < 2; a++)
@@ -1240,6 +1276,7 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
   int have_H = !w->settled;
   w->settled = 0;
   w->ns = 0;
+  w->reg = IMP_REG;
   int st = have_H ? evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->q, w->lam, w->ie)
                   : evaluate_F(m, d, &s, w, w->y, w->mu, w->F, w->lam, w->ie);
   /* points that stick or nearly so at the start: impulse form */
@@ -1248,8 +1285,9 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
     have_H = 1;
   }
   if (st & STUCK) return 0;
+  int limit = w->ns ? 2 * MAX_ITER : MAX_ITER;
   double f = residual(&s, w, w->y, w->F, w->mu, w->ie, w->phi, &size);
-  int it = 0, stalled = 0, limit = MAX_ITER, rescued = 0;
+  int it = 0, stalled = 0, rescued = 0;
   for (;;) {
     if (f <= try2 * size || stalled || it >= limit) {
       /* stalled far from the answer (a patch near sticking, where the
@@ -1297,8 +1335,12 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
       int i = w->imp[k];
       double dV[6];
       to_group(w->grp + w->group_of[i], w->dy + 6 * w->group_of[i], dV);
-      imp_step(w->pt + i, w->ie + i, dV, w->dmu + 2 * i);
+      imp_step(w->pt + i, w->ie + i, w->reg, dV, w->dmu + 2 * i);
     }
+    /* the trials' eliminations (the next step's) relax the regularization
+     * again */
+    double reg_step = w->reg;
+    if (w->reg > IMP_REG) w->reg = fmax(IMP_REG, IMP_REG_DOWN * w->reg);
     double alpha = 1, ftry = f;
     int ok = 0, fl = 0;
     for (int ls = 0; ls < 8 && !ok; ls++, alpha *= 0.5) {
@@ -1324,8 +1366,16 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
       if (switch_all(w, &s) &&
           !(evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->q, w->lam, w->ie) & STUCK)) {
         f = residual(&s, w, w->y, w->F, w->mu, w->ie, w->phi, &size);
-        limit = it + MAX_ITER / 2 > limit ? it + MAX_ITER / 2 : limit;
-        if (limit > 2 * MAX_ITER) limit = 2 * MAX_ITER;
+        limit = 2 * MAX_ITER;
+        continue;
+      }
+    }
+    /* no descent in impulse form: the same point again with the
+     * impulse-form points damped more (IMP_REG_UP) */
+    if (!ok && w->ns && reg_step < IMP_REG_MAX && f <= IMP_REG_NEAR * IMP_REG_NEAR * size) {
+      w->reg = reg_step * IMP_REG_UP;
+      if (!(evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->q, w->lam, w->ie) & STUCK)) {
+        f = residual(&s, w, w->y, w->F, w->mu, w->ie, w->phi, &size);
         continue;
       }
     }
@@ -1351,9 +1401,8 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
     if ((fl & NEAR_STICK) && switch_points(m, d, &s, w)) {
       if (evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->q, w->lam, w->ie) & STUCK) break;
       f = residual(&s, w, w->y, w->F, w->mu, w->ie, w->phi, &size);
-      /* and a few more iterations to settle them */
-      limit = it + MAX_ITER / 2 > limit ? it + MAX_ITER / 2 : limit;
-      if (limit > 2 * MAX_ITER) limit = 2 * MAX_ITER;
+      /* and up to 2 MAX_ITER iterations in all to settle them */
+      limit = 2 * MAX_ITER;
     }
   }
   *iterations = it;

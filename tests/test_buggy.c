@@ -30,7 +30,15 @@ static int load(const char *rel, ssModel **m, ssData **d)
   return 1;
 }
 
-static int run(const ssModel *m, ssData *d, int n, double *closure)
+/* what a run watches: the largest loop-closure error, and the solver's
+ * sweeps (steps over 20 sweeps: the Newton phase did not finish them) */
+typedef struct Watch {
+  double closure;
+  long sweeps;
+  int slow, unconverged;
+} Watch;
+
+static int run(const ssModel *m, ssData *d, int n, Watch *w)
 {
   ssError e;
   for (int k = 0; k < n; k++) {
@@ -38,7 +46,11 @@ static int run(const ssModel *m, ssData *d, int n, double *closure)
       diag("step failed: %s", e.message);
       return 0;
     }
-    if (closure && d->closure_error > *closure) *closure = d->closure_error;
+    if (!w) continue;
+    if (d->closure_error > w->closure) w->closure = d->closure_error;
+    w->sweeps += d->stats.sweeps;
+    w->slow += d->stats.sweeps > 20;
+    w->unconverged += !d->stats.converged;
   }
   return 1;
 }
@@ -99,8 +111,9 @@ static void test_statics(void)
   }
   ok(fabs(total_mass(m) - 896) < 1e-9, "the buggy weighs 896 kg (%.6g)", total_mass(m));
   set_drive(m, d, 0);
-  double closure = 0;
-  run(m, d, 3000, &closure);
+  Watch w = {0};
+  run(m, d, 3000, &w);
+  double closure = w.closure;
   double sum = 0, load[4];
   char name[32];
   for (int k = 0; k < 4; k++) {
@@ -268,11 +281,12 @@ static void test_drive(void)
     return;
   }
   int chassis = body(m, "chassis"), wrl = body(m, "wheel_rl");
-  double x0 = d->body_xipos[3 * chassis], closure = 0, slip_sum = 0;
+  double x0 = d->body_xipos[3 * chassis], slip_sum = 0;
+  Watch watch = {0};
   int slip_n = 0;
   ssError e;
   for (int k = 0; k < 20000; k++) {
-    if (!run(m, d, 1, &closure)) break;
+    if (!run(m, d, 1, &watch)) break;
     if (k > 2000 && k % 100 == 0) {
       /* slip ratio of the rear wheel: 1 - v / (omega r) */
       double w = d->qvel[m->body_dofadr[wrl]], v = d->qvel[m->body_dofadr[chassis]];
@@ -284,7 +298,8 @@ static void test_drive(void)
   ok(speed > 0.5 && speed < 0.9, "on soil the chassis advances at %.3f m/s over 20 s (0.5-0.9)", speed);
   double slip = slip_sum / slip_n;
   ok(slip > 0.02 && slip < 0.5, "the driven rear wheels slip (mean slip ratio %.3f)", slip);
-  ok(closure < 1e-6, "loop closure error < 1e-6 m over the whole drive (max %.3g)", closure);
+  ok(watch.closure < 1e-6, "loop closure error < 1e-6 m over the whole drive (max %.3g)",
+     watch.closure);
 
   /* ruts: permanent sinkage under the wheel tracks, none away from them */
   int h = 0, nx = m->hfield_nx[h], ny = m->hfield_ny[h];
@@ -354,7 +369,13 @@ static void test_drive(void)
   ss_model_free(m);
 }
 
-/* steering: the rack held to the left turns the car to the left */
+/* steering: the rack held to the left turns the car to the left.  The
+ * turning wheels' patches have points near sticking in about a quarter of
+ * the steps; the Newton phase solves nearly all of them: 960 sweeps in
+ * the 6000 steps, 14 steps over 20 sweeps, none unconverged (with 8
+ * iterations and 4 more after each switch to impulse form, and without
+ * the projection onto the discs: 3882, 44 and 5; with 16 iterations but
+ * without the projection: 1122, 11 and 2). */
 static void test_steering(void)
 {
   ssModel *m;
@@ -364,13 +385,16 @@ static void test_steering(void)
     return;
   }
   int chassis = body(m, "chassis");
-  double closure = 0;
-  run(m, d, 6000, &closure);
+  Watch w = {0};
+  run(m, d, 6000, &w);
   const double *R = d->body_xmat + 9 * chassis;
   double yaw = atan2(R[3], R[0]);
   ok(yaw > 0.1, "a rack offset to the left turns the buggy left (yaw %.3f rad)", yaw);
   ok(d->body_xipos[3 * chassis + 1] > 0.05, "  and it drifts to +y (%.3f m)", d->body_xipos[3 * chassis + 1]);
-  ok(closure < 1e-6, "  the tie rods stay closed (max error %.3g m)", closure);
+  ok(w.closure < 1e-6, "  the tie rods stay closed (max error %.3g m)", w.closure);
+  ok(w.sweeps <= 2000 && w.slow <= 25 && w.unconverged <= 1,
+     "  the Newton phase solves the turning steps: %ld sweeps in 6000 steps, %d steps over 20 "
+     "sweeps, %d unconverged", w.sweeps, w.slow, w.unconverged);
   ss_data_free(d);
   ss_model_free(m);
 }

@@ -572,8 +572,10 @@ static void test_newton(void)
 /* A plate coming to rest on a bed tilted by 0.07 degrees: its points
  * creep at 1e-7 m/s and less, where the Janosi shear is nearly
  * set-valued.  The sweeps alone do not converge there in 200 sweeps (all
- * 200 steps below, before the impulse form); the Newton phase, its
- * points in impulse form, solves each step. */
+ * of steps 100-300, before the impulse form); the Newton phase, its
+ * points in impulse form, solves each step of 100-1200 (before impulses
+ * were brought back onto their discs, step 319 stopped unconverged, and
+ * with 16 iterations step 181: no descent at 3e-8, newton.c imp_map). */
 static void test_resting_on_slope(void)
 {
   ssError e;
@@ -585,7 +587,7 @@ static void test_resting_on_slope(void)
   }
   World w = {m, d, 0, 0};
   int good = run(&w, 100), unconverged = 0, sweeps = 0, newton = 0, sticking = 0;
-  for (int k = 0; k < 200 && good; k++) {
+  for (int k = 0; k < 1100 && good; k++) {
     good = run(&w, 1);
     unconverged += !d->stats.converged;
     sweeps += d->stats.sweeps;
@@ -593,7 +595,7 @@ static void test_resting_on_slope(void)
     sticking += d->stats.newton_sticking > 0;
   }
   ok(good && unconverged == 0 && sweeps <= 20 && sticking > 100,
-     "plate coming to rest on a bed tilted 0.07 deg, steps 100-300: %d unconverged, %d sweeps, "
+     "plate coming to rest on a bed tilted 0.07 deg, steps 100-1200: %d unconverged, %d sweeps, "
      "%d Newton iterations, %d steps with points in impulse form",
      unconverged, sweeps, newton, sticking);
   ss_data_free(d);
