@@ -801,7 +801,7 @@ static int evaluate(const ssModel *m, const ssData *d, const Setup *s,
                : evaluate_at(m, d, s, w, y, mu, F, H, q, lam_out, ie, 1, 0);
 }
 
-static int evaluate_F(const ssModel *m, const ssData *d, const Setup *s,
+static inline __attribute__((always_inline)) int evaluate_F(const ssModel *m, const ssData *d, const Setup *s,
                       const ssNewtonWork *w, const double *y, double *mu, double *F,
                       double *lam_out, NImpEval *ie)
 {
@@ -1288,6 +1288,7 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
   int limit = w->ns ? 2 * MAX_ITER : MAX_ITER;
   double f = residual(&s, w, w->y, w->F, w->mu, w->ie, w->phi, &size);
   int it = 0, stalled = 0, rescued = 0;
+  double rel_prev = 0;
   for (;;) {
     if (f <= try2 * size || stalled || it >= limit) {
       /* stalled far from the answer (a patch near sticking, where the
@@ -1341,6 +1342,14 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
      * again */
     double reg_step = w->reg;
     if (w->reg > IMP_REG) w->reg = fmax(IMP_REG, IMP_REG_DOWN * w->reg);
+    /* Newton's rate, rel' = C rel^2 (rel = sqrt(f / size); C from the
+     * last step, 1 before it): a step expected to end well within the
+     * convergence test forms no H at its trials (it would go unused); the
+     * loop's top forms it if a step follows after all */
+    double rel = sqrt(f / size);
+    double rate = rel_prev > 0 ? rel / (rel_prev * rel_prev) : 1;
+    int trial_H = !(rate * rel * rel <= tol);
+    rel_prev = rel;
     double alpha = 1, ftry = f;
     int ok = 0, fl = 0;
     for (int ls = 0; ls < 8 && !ok; ls++, alpha *= 0.5) {
@@ -1351,8 +1360,9 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
         w->mutry[2 * i + 1] = w->mu[2 * i + 1] + alpha * w->dmu[2 * i + 1];
       }
       /* a trial that makes a point stick is no descent either */
-      fl = evaluate(m, d, &s, w, w->ytry, w->mutry, w->Ftry, w->Htry, w->qtry, w->lamtry,
-                    w->ietry);
+      fl = trial_H ? evaluate(m, d, &s, w, w->ytry, w->mutry, w->Ftry, w->Htry, w->qtry,
+                              w->lamtry, w->ietry)
+                   : evaluate_F(m, d, &s, w, w->ytry, w->mutry, w->Ftry, w->lamtry, w->ietry);
       if (fl & STUCK) continue;
       ftry = residual(&s, w, w->ytry, w->Ftry, w->mutry, w->ietry, w->phitry, &size_try);
       ok = ftry <= (1 - 1e-4 * alpha) * f;
@@ -1365,6 +1375,7 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
       rescued = 1;
       if (switch_all(w, &s) &&
           !(evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->q, w->lam, w->ie) & STUCK)) {
+        have_H = 1;
         f = residual(&s, w, w->y, w->F, w->mu, w->ie, w->phi, &size);
         limit = 2 * MAX_ITER;
         continue;
@@ -1375,6 +1386,7 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
     if (!ok && w->ns && reg_step < IMP_REG_MAX && f <= IMP_REG_NEAR * IMP_REG_NEAR * size) {
       w->reg = reg_step * IMP_REG_UP;
       if (!(evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->q, w->lam, w->ie) & STUCK)) {
+        have_H = 1;
         f = residual(&s, w, w->y, w->F, w->mu, w->ie, w->phi, &size);
         continue;
       }
@@ -1396,10 +1408,12 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
     w->ietry = te;
     f = ftry;
     size = size_try;
+    have_H = trial_H;
     /* points that came near sticking: impulse form from here on (their
      * mu at the trial were their law's, so the swap above kept them) */
     if ((fl & NEAR_STICK) && switch_points(m, d, &s, w)) {
       if (evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->q, w->lam, w->ie) & STUCK) break;
+      have_H = 1;
       f = residual(&s, w, w->y, w->F, w->mu, w->ie, w->phi, &size);
       /* and up to 2 MAX_ITER iterations in all to settle them */
       limit = 2 * MAX_ITER;
