@@ -630,7 +630,8 @@ static void csv_name(FILE *fp, const char *name, const char *suffix)
 
 static void csv_header(FILE *fp, const ssModel *m)
 {
-  fputs("step,time,soil_contacts,soil_contact_area,soil_normal_force,sweeps",
+  fputs("step,time,soil_contacts,soil_contact_area,soil_normal_force,sweeps,newton,"
+        "residual,converged",
         fp);
   for (int s = 0; s < m->nsys; s++) {
     csv_name(fp, m->sys_name[s], ".x");
@@ -644,9 +645,9 @@ static void csv_header(FILE *fp, const ssModel *m)
 static void csv_row(FILE *fp, const ssModel *m, const ssData *d, long k)
 {
   const ssStepStats *st = &d->stats;
-  fprintf(fp, "%ld,%.17g,%d,%.17g,%.17g,%d", k, d->time,
+  fprintf(fp, "%ld,%.17g,%d,%.17g,%.17g,%d,%d,%.17g,%d", k, d->time,
           st->soil_contacts, st->soil_contact_area, st->soil_normal_force,
-          st->sweeps);
+          st->sweeps, st->newton, st->residual, st->converged);
   for (int s = 0; s < m->nsys; s++) {
     if (!d->sys_active[s] || m->sys_nbody[s] < 1) {
       fputs(",,,", fp);

@@ -200,7 +200,7 @@ check "cold start: 20 steps, export, reload, 10 more = 30 steps straight (articu
 
 head -n 1 "$tmp/a.csv" >"$tmp/header"
 check "CSV header: the statistics columns, then plate.x,plate.y,plate.z" \
-  '[ "$(cat "$tmp/header")" = "step,time,soil_contacts,soil_contact_area,soil_normal_force,sweeps,plate.x,plate.y,plate.z" ]'
+  '[ "$(cat "$tmp/header")" = "step,time,soil_contacts,soil_contact_area,soil_normal_force,sweeps,newton,residual,converged,plate.x,plate.y,plate.z" ]'
 check "CSV has one row per step ($N rows)" \
   '[ "$(sed 1d "$tmp/a.csv" | wc -l)" -eq $N ]'
 check "CSV rows are numbered 1..$N and have as many fields as the header" \
@@ -208,18 +208,21 @@ check "CSV rows are numbered 1..$N and have as many fields as the header" \
      NF != nf || \$1 != NR - 1 { bad = 1 }
      END { exit bad || NR != n + 1 }" "$tmp/a.csv"'
 check "CSV: the plate has sunk into the soil (z below 0.025 at the end)" \
-  'tail -n 1 "$tmp/a.csv" | awk -F, "{ exit !(\$9 < 0.025 && \$9 > 0) }"'
+  'tail -n 1 "$tmp/a.csv" | awk -F, "{ exit !(\$12 < 0.025 && \$12 > 0) }"'
+check "CSV: the solver columns (newton, residual, converged): every plate step converged" \
+  'awk -F, "NR == 1 { next } !(\$7 >= 0 && \$8 >= 0 && \$8 <= 1e-9 && \$9 == 1) { bad = 1 }
+     END { exit bad }" "$tmp/a.csv"'
 
 # A removed system keeps its columns, empty from the row after its step.
 run "$PLATE" --steps 20 --csv "$tmp/r.csv" --remove plate@10 --quiet
 check "--remove plate@10: exit 0; rows 1..10 have positions, 11..20 are empty" \
   'rc_is 0 && awk -F, "NR == 1 { next }
-     NR <= 11 && \$7 == \"\" { bad = 1 }
-     NR > 11 && (\$7 != \"\" || \$8 != \"\" || \$9 != \"\") { bad = 1 }
+     NR <= 11 && \$10 == \"\" { bad = 1 }
+     NR > 11 && (\$10 != \"\" || \$11 != \"\" || \$12 != \"\") { bad = 1 }
      END { exit bad || NR != 21 }" "$tmp/r.csv"'
 run "$PLATE" --steps 5 --csv "$tmp/r0.csv" --remove plate@0 --quiet
 check "--remove plate@0 applies before the first step" \
-  'rc_is 0 && awk -F, "NR > 1 && \$7 != \"\" { bad = 1 } END { exit bad }" "$tmp/r0.csv"'
+  'rc_is 0 && awk -F, "NR > 1 && \$10 != \"\" { bad = 1 } END { exit bad }" "$tmp/r0.csv"'
 
 run "$PLATE" --steps 0 --export "$tmp/zero.xml" --csv "$tmp/zero.csv" --quiet
 check "--steps 0: exit 0, export written, CSV has only its header" \
