@@ -449,6 +449,9 @@ typedef struct ssData {
   ssWarmEntry *warm;      /* (nwarm) warm-start cache */
   int cap_warm_next;
   ssWarmEntry *warm_next; /* the next cache while it is sorted (scratch) */
+  double *geom_patch;     /* (ngeom x 3) each collider's soil patch when the
+                             cache is stored: fastest loaded slip, sums of
+                             normal and of tangential impulses (scratch) */
   int solver_full;        /* 1: every contact updates the full velocity
                              (no packed link groups); the reference path of
                              the tests, equal to the default at round-off */

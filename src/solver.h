@@ -73,7 +73,9 @@ struct ssContact {
  * unconverged tractions is mostly solver error, and extrapolating it feeds
  * that error back step after step; a change within the tolerance (a
  * settled body's drift) is no trend either, and extrapolating it costs
- * the point solves an iteration. */
+ * the point solves an iteration.  Nor does a creeping collider keep rates
+ * (solver.c, CREEP_SLIP): its tractions follow slip directions that turn
+ * with velocities of 1e-5 m/s and less. */
 struct ssWarmEntry {
   int vertex;        /* absolute soil vertex (joint rows: see row_key) */
   int geom;

@@ -12,24 +12,6 @@
 #include <string.h>
 #include <unistd.h>
 
-static const char *top(void)
-{
-  const char *t = getenv("top_srcdir");
-  return t && *t ? t : ".";
-}
-
-static int load(const char *rel, ssModel **m, ssData **d)
-{
-  char path[1024];
-  ssError e;
-  snprintf(path, sizeof path, "%s/%s", top(), rel);
-  if (ss_scene_load(path, m, d, &e) != SS_OK) {
-    diag("%s:%d: %s", e.file, e.line, e.message);
-    return 0;
-  }
-  return 1;
-}
-
 /* what a run watches: the largest loop-closure error, and the solver's
  * sweeps (steps over 20 sweeps: the Newton phase did not finish them) */
 typedef struct Watch {
@@ -105,7 +87,7 @@ static void test_statics(void)
 {
   ssModel *m;
   ssData *d;
-  if (!load("scenes/buggy_rigid.xml", &m, &d)) {
+  if (!load_scene_file("scenes/buggy_rigid.xml", &m, &d)) {
     ok(0, "buggy_rigid.xml loads");
     return;
   }
@@ -186,7 +168,7 @@ static void test_packed_groups(void)
 {
   ssModel *m;
   ssData *d;
-  if (!load("scenes/buggy.xml", &m, &d)) {
+  if (!load_scene_file("scenes/buggy.xml", &m, &d)) {
     ok(0, "buggy.xml loads");
     return;
   }
@@ -212,7 +194,7 @@ static void test_newton_sticking(void)
 {
   ssModel *m;
   ssData *d;
-  if (!load("tests/data/buggy_turn_4cm.xml", &m, &d)) {
+  if (!load_scene_file("tests/data/buggy_turn_4cm.xml", &m, &d)) {
     ok(0, "buggy_turn_4cm.xml loads");
     return;
   }
@@ -247,7 +229,7 @@ static void test_newton(void)
 {
   ssModel *m;
   ssData *d;
-  if (!load("scenes/buggy.xml", &m, &d)) {
+  if (!load_scene_file("scenes/buggy.xml", &m, &d)) {
     ok(0, "buggy.xml loads");
     return;
   }
@@ -276,7 +258,7 @@ static void test_drive(void)
 {
   ssModel *m;
   ssData *d;
-  if (!load("tests/data/buggy_4cm.xml", &m, &d)) {
+  if (!load_scene_file("tests/data/buggy_4cm.xml", &m, &d)) {
     ok(0, "buggy_4cm.xml loads");
     return;
   }
@@ -380,7 +362,7 @@ static void test_steering(void)
 {
   ssModel *m;
   ssData *d;
-  if (!load("tests/data/buggy_turn_4cm.xml", &m, &d)) {
+  if (!load_scene_file("tests/data/buggy_turn_4cm.xml", &m, &d)) {
     ok(0, "buggy_turn_4cm.xml loads");
     return;
   }
@@ -407,7 +389,7 @@ static void test_determinism(void)
     ssModel *m;
     ssData *d;
     ssError e;
-    if (!load("tests/data/buggy_4cm.xml", &m, &d)) return;
+    if (!load_scene_file("tests/data/buggy_4cm.xml", &m, &d)) return;
     run(m, d, 300, NULL);
     snprintf(out[k], sizeof out[k], "/tmp/soilsim-buggy-%ld-%d.xml", (long)getpid(), k);
     ss_scene_export(m, d, out[k], &e);

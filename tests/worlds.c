@@ -2,6 +2,7 @@
  * program: a tiny in-memory URDF builder, the plate soil of DESIGN 2.7, and
  * the articulated benchmark bodies of DESIGN 8. */
 #include "worlds.h"
+#include "tap.h"
 #include "solver.h"
 #include "ss_math.h"
 
@@ -324,5 +325,18 @@ int plate_world(int n, double size, double slope, double pull, const ssSoilMater
   }
   *mout = m;
   *dout = d;
+  return 1;
+}
+
+int load_scene_file(const char *rel, ssModel **m, ssData **d)
+{
+  const char *top = getenv("top_srcdir");
+  char path[1024];
+  ssError e;
+  snprintf(path, sizeof path, "%s/%s", top && *top ? top : ".", rel);
+  if (ss_scene_load(path, m, d, &e) != SS_OK) {
+    diag("%s:%d: %s", e.file, e.line, e.message);
+    return 0;
+  }
   return 1;
 }

@@ -31,6 +31,9 @@ int add_bed(ssModel *m, double size, double h, ssSoilMaterial soil);
 int plate_world(int n, double size, double slope, double pull, const ssSoilMaterial *soil,
                 ssModel **m, ssData **d, ssError *e);
 int add_soil_bed(ssModel *m, double size, double h);
+/* the scene file rel (a path from $top_srcdir, default "."), loaded; 0
+ * with a TAP diagnostic when it does not load */
+int load_scene_file(const char *rel, ssModel **m, ssData **d);
 /* a chain of nlinks sprung revolute joints standing on link `on` */
 int add_mast(ssUrdf *u, int on, int nlinks, double mass, const double at[3]);
 /* the articulated bodies of DESIGN 8, each 20 kg on 0.24 m^2 */
