@@ -149,6 +149,97 @@ static void axis_side(const double a[3], double w[3])
   }
 }
 
+/* The hull of two copies of one convex polygon, p[0, n) and p[n, 2n) (the
+ * second the first moved by -2t, t = (tx, ty) != 0; points in the order of
+ * the circle table, counter-clockwise when ccw, else clockwise), without a
+ * sort: it is the polygon swept along t, the first copy's chain between
+ * its extreme points across t followed by the second copy's other chain.
+ * Collinear and repeated points are dropped with convex_hull's tolerance,
+ * and the result starts at its least point (x, then y) as convex_hull's
+ * does, so that where convex_hull keeps the same points the polygon is the
+ * same, bit for bit.  Returns 0 (out untouched) when the sweep is not
+ * cleanly convex; convex_hull then decides. */
+static int swept_hull(const pt2 *p, int n, int ccw, double tx, double ty, ssPoly2 *out)
+{
+  /* the points counter-clockwise, q[0, n) (first copy) and q[n, 2n);
+   * B, A: least and greatest extent along the normal (-ty, tx) */
+  pt2 q[HULL_IN_MAX];
+  for (int k = 0; k < n; k++) {
+    int i = ccw || k == 0 ? k : n - k;
+    q[k] = p[i];
+    q[n + k] = p[n + i];
+  }
+  int kb = 0, ka = 0;
+  double lo = INFINITY, hi = -INFINITY;
+  for (int k = 0; k < n; k++) {
+    double e = tx * q[k].y - ty * q[k].x;
+    if (e < lo) {
+      lo = e;
+      kb = k;
+    }
+    if (e > hi) {
+      hi = e;
+      ka = k;
+    }
+  }
+  pt2 h[HULL_IN_MAX + 2];
+  int m = 0;
+  /* B to A on the first copy (its edges face +t), A to B on the second */
+  for (int k = kb;; k = k + 1 == n ? 0 : k + 1) {
+    h[m++] = q[k];
+    if (k == ka) break;
+  }
+  for (int k = ka;; k = k + 1 == n ? 0 : k + 1) {
+    h[m++] = q[n + k];
+    if (k == kb) break;
+  }
+  double xlo = h[0].x, xhi = h[0].x, ylo = h[0].y, yhi = h[0].y;
+  for (int i = 1; i < m; i++) {
+    if (h[i].x < xlo) xlo = h[i].x;
+    if (h[i].x > xhi) xhi = h[i].x;
+    if (h[i].y < ylo) ylo = h[i].y;
+    if (h[i].y > yhi) yhi = h[i].y;
+  }
+  double ext = xhi - xlo > yhi - ylo ? xhi - xlo : yhi - ylo;
+  if (!(ext > 0)) return 0;
+  double tol = HULL_COLLINEAR_EPS * ext * ext;
+  /* left turns only, as convex_hull keeps them, around the cycle */
+  int k = 0;
+  for (int i = 0; i < m; i++) {
+    while (k >= 2 && cross3(&h[k - 2], &h[k - 1], &h[i]) <= tol) k--;
+    h[k++] = h[i];
+  }
+  int first = 0;
+  for (int changed = 1; changed && k - first >= 3;) {
+    changed = 0;
+    if (cross3(&h[k - 2], &h[k - 1], &h[first]) <= tol) {
+      k--;
+      changed = 1;
+    } else if (cross3(&h[k - 1], &h[first], &h[first + 1]) <= tol) {
+      first++;
+      changed = 1;
+    }
+  }
+  const pt2 *c = h + first;
+  int cnt = k - first;
+  if (cnt < 3) return 0;
+  /* a sweep whose turns are not all left is no convex polygon: leave it to
+   * convex_hull */
+  for (int i = 0; i < cnt; i++) {
+    int i1 = i + 1 < cnt ? i + 1 : i + 1 - cnt, i2 = i + 2 < cnt ? i + 2 : i + 2 - cnt;
+    if (!(cross3(c + i, c + i1, c + i2) > tol)) return 0;
+  }
+  int start = 0;
+  for (int i = 1; i < cnt; i++)
+    if (pt_less(c + i, c + start)) start = i;
+  out->n = cnt;
+  for (int i = 0, j = start; i < cnt; i++, j = j + 1 == cnt ? 0 : j + 1) {
+    out->x[i] = c[j].x;
+    out->y[i] = c[j].y;
+  }
+  return 1;
+}
+
 void ss_shape_footprint(const ssShape *s, ssPoly2 *out)
 {
   pt2 p[HULL_IN_MAX];
@@ -196,6 +287,15 @@ void ss_shape_footprint(const ssShape *s, ssPoly2 *out)
     }
     np = put_ellipse(p, np, ct, st, c[0] + hl * a[0], c[1] + hl * a[1], u, v);
     np = put_ellipse(p, np, ct, st, c[0] - hl * a[0], c[1] - hl * a[1], u, v);
+    /* two copies of one convex polygon: swept, no sort (a wheel's
+     * footprint in half the instructions), unless the caps are (nearly)
+     * edge-on or the axis (nearly) vertical, where the copies' points
+     * nearly coincide and only the sort tells them apart */
+    double det = u[0] * v[1] - u[1] * v[0], tx = hl * a[0], ty = hl * a[1];
+    double lu = hypot(u[0], u[1]), lv = hypot(v[0], v[1]);
+    if (fabs(det) > 1e-9 * lu * lv && hypot(tx, ty) > 1e-6 * fmax(lu, lv) &&
+        swept_hull(p, SS_FOOTPRINT_SEGMENTS, det > 0, tx, ty, out))
+      return;
     break;
   }
   default:

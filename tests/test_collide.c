@@ -282,6 +282,24 @@ static void test_round_footprints(void)
   ok(small, "tilted cylinders: convex CCW footprints, <= SS_POLY_MAX vertices");
   ok(worst <= 1e-12, "tilted cylinders: area = pi r^2 |cos| + 2 r L sin (worst rel %.3g)", worst);
 
+  /* nearly lying (a wheel's camber, 1e-2 to 1e-7 rad): thin caps, the
+   * footprint swept along the axle (collide.c, swept_hull) */
+  worst = 0;
+  small = 1;
+  for (int trial = 0; trial < 60; trial++) {
+    double eps = pow(10, -2 - 5 * urand(0, 1)) * (trial % 2 ? 1 : -1);
+    double phi = 0.5 * PI + eps, psi = urand(-PI, PI);
+    rot_tilt(R, phi, psi);
+    s = make_shape(SS_GEOM_CYLINDER, r, L, 0, urand(-2, 2), urand(-2, 2), r, R);
+    ss_shape_footprint(&s, &p);
+    if (p.n > SS_POLY_MAX || !poly_ccw_convex(&p)) small = 0;
+    worst = fmax(worst, rel(ss_poly_area(&p),
+                            PI * r * r * fabs(cos(phi)) + 2 * r * L * sin(phi)));
+  }
+  ok(small && worst <= 1e-12,
+     "nearly lying cylinders: convex CCW footprints, area = pi r^2 |cos| + 2 r L sin "
+     "(worst rel %.3g)", worst);
+
   /* capsules */
   rot_wheel(R, 0.3, 1.1);
   s = make_shape(SS_GEOM_CAPSULE, r, L, 0, 0.2, 0.1, r, R);
