@@ -189,14 +189,21 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
   const double *sp = d->soil_plastic + adr, *jj = d->soil_shear + adr;
   double tiny = 1e-12 * dx * dy;
 
+  /* the chord at the last row's upper boundary, which is (to round-off)
+   * this row's lower one */
+  double b0 = 0, b1 = 0;
+  int b_ok = 0;
   for (int j = j0; j <= j1; j++) {
     double y = y0 + j * dy;
     double cy0 = j == 0 ? y : y - 0.5 * dy, cy1 = j == ny - 1 ? y : y + 0.5 * dy;
     /* cells whose x range lies inside both chords of the row's band lie
      * inside the (convex) footprint: fully covered, no clipping; a margin
-     * of 1e-9 dx leaves the cells on the footprint's edge to the clipping */
-    double in0 = INFINITY, in1 = -INFINITY, a0, a1, b0, b1;
-    if (ss_poly_chord(&fp, cy0, &a0, &a1) && ss_poly_chord(&fp, cy1, &b0, &b1)) {
+     * of 1e-9 dx leaves the cells on the footprint's edge to the clipping
+     * (and covers the round-off between the two rows' shared boundary) */
+    double in0 = INFINITY, in1 = -INFINITY, a0 = b0, a1 = b1;
+    int a_ok = j > j0 ? b_ok : ss_poly_chord(&fp, cy0, &a0, &a1);
+    b_ok = ss_poly_chord(&fp, cy1, &b0, &b1);
+    if (a_ok && b_ok) {
       in0 = fmax(a0, b0) + 1e-9 * dx;
       in1 = fmin(a1, b1) - 1e-9 * dx;
     }
