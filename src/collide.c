@@ -521,7 +521,7 @@ static int clip_slab(const double *ic, const double *io, int n, const int *rg,
   return m;
 }
 
-int ss_poly_xchains(const ssPoly2 *p, int ends[2])
+int ss_poly_xchains(const ssPoly2 *p, ssPolyChains *c)
 {
   int n = p->n, l = 0, r = 0;
   if (n < 3) return 0;
@@ -541,38 +541,75 @@ int ss_poly_xchains(const ssPoly2 *p, int ends[2])
     if (p->x[k] > p->x[i]) return 0;
     i = k;
   }
-  ends[0] = l;
-  ends[1] = r;
+  c->l = l;
+  c->r = r;
+  for (int k = 0; k < 4; k++) c->hint[k] = -1;
   return 1;
 }
 
 /* first k in [0, cnt) where sgn (x[start + k] - v) >= 0 (> 0 when
  * strict), indices modulo n; cnt when none.  sgn x is non-decreasing
  * along the chain. */
-static int chain_search(const double *x, int n, int start, int cnt, double v,
-                        double sgn, int strict)
+static inline int chain_pred(const double *x, int n, int start, int k, double v,
+                             double sgn, int strict)
 {
-  int a = 0, b = cnt;
+  int i = start + k;
+  if (i >= n) i -= n;
+  double dv = sgn * (x[i] - v);
+  return strict ? dv > 0 : dv >= 0;
+}
+
+/* (the predicate is monotone along the chain, so the answer is unique:
+ * galloping from *hint to bracket it, then bisecting, finds the one
+ * bisection alone finds; *hint receives it) */
+static int chain_search(const double *x, int n, int start, int cnt, double v,
+                        double sgn, int strict, int *hint)
+{
+  int a = 0, b = cnt, h = *hint;
+  if (h >= 0 && h < cnt) {
+    if (chain_pred(x, n, start, h, v, sgn, strict)) {
+      b = h;
+      for (int step = 1;; step *= 2) {
+        int k = b - step;
+        if (k < 0) break;
+        if (!chain_pred(x, n, start, k, v, sgn, strict)) {
+          a = k + 1;
+          break;
+        }
+        b = k;
+      }
+    } else {
+      a = h + 1;
+      for (int step = 1;; step *= 2) {
+        int k = a - 1 + step;
+        if (k >= cnt) break;
+        if (chain_pred(x, n, start, k, v, sgn, strict)) {
+          b = k;
+          break;
+        }
+        a = k + 1;
+      }
+    }
+  }
   while (a < b) {
-    int mid = (a + b) / 2, i = start + mid;
-    if (i >= n) i -= n;
-    double dv = sgn * (x[i] - v);
-    if (strict ? dv > 0 : dv >= 0) b = mid;
+    int mid = (a + b) / 2;
+    if (chain_pred(x, n, start, mid, v, sgn, strict)) b = mid;
     else a = mid + 1;
   }
+  *hint = a;
   return a;
 }
 
 /* the edges (index of their end vertex) of chain start -> start + cnt whose
  * x range meets [x0, x1], as up to two ascending index ranges */
 static int chain_edges(const ssPoly2 *p, int start, int cnt, double sgn,
-                       double x0, double x1, int *rg)
+                       double x0, double x1, int hint[2], int *rg)
 {
   int n = p->n, s1 = start + 1 < n ? start + 1 : 0;
   /* sgn = 1: x rises along the chain; edge k runs from vertex k to k + 1 */
   double enter = sgn > 0 ? x0 : x1, leave = sgn > 0 ? x1 : x0;
-  int k0 = chain_search(p->x, n, s1, cnt, enter, sgn, 0);
-  int k1 = chain_search(p->x, n, start, cnt, leave, sgn, 1);
+  int k0 = chain_search(p->x, n, s1, cnt, enter, sgn, 0, hint);
+  int k1 = chain_search(p->x, n, start, cnt, leave, sgn, 1, hint + 1);
   if (k1 <= k0) return 0;
   int a = s1 + k0;
   if (a >= n) a -= n;
@@ -632,19 +669,18 @@ double ss_poly_rect_area(const ssPoly2 *p, double x0, double x1, double y0,
   return rect_area(p, NULL, -1, x0, x1, y0, y1, cx, cy);
 }
 
-double ss_poly_rect_area_x(const ssPoly2 *p, const int ends[2], double x0,
-                           double x1, double y0, double y1, double *cx,
-                           double *cy)
+double ss_poly_rect_area_x(const ssPoly2 *p, ssPolyChains *c, double x0, double x1,
+                           double y0, double y1, double *cx, double *cy)
 {
   if (p->n < 3 || !(x1 > x0) || !(y1 > y0)) return 0;
   /* the edges whose x range meets the slab widened far beyond round-off:
    * every edge the clip would take something from (it compares x - mx
    * with x0 - mx) */
-  int n = p->n, l = ends[0], r = ends[1], rg[8], nr = 0;
+  int n = p->n, l = c->l, r = c->r, rg[8], nr = 0;
   double tol = 1e-9 * (fabs(x0) + fabs(x1));
   double lo = x0 - tol, hi = x1 + tol;
-  nr += chain_edges(p, l, (r - l + n) % n, 1, lo, hi, rg);
-  nr += chain_edges(p, r, (l - r + n) % n, -1, lo, hi, rg + 2 * nr);
+  nr += chain_edges(p, l, (r - l + n) % n, 1, lo, hi, c->hint, rg);
+  nr += chain_edges(p, r, (l - r + n) % n, -1, lo, hi, c->hint + 2, rg + 2 * nr);
   if (nr == 0) return 0;
   /* ascending, as the clip visits them */
   for (int i = 1; i < nr; i++)

@@ -48,17 +48,23 @@ double ss_poly_area(const ssPoly2 *p);
  * area is > 0 and cx, cy are not NULL they receive its centroid. */
 double ss_poly_rect_area(const ssPoly2 *p, double x0, double x1, double y0,
                          double y1, double *cx, double *cy);
-/* A vertex of least x (ends[0]) and one of greatest x (ends[1]) of a
- * polygon along which it splits into two chains monotone in x; 0 (ends
- * untouched) when it has none (fewer than 3 vertices, zero width, not
- * convex). */
-int ss_poly_xchains(const ssPoly2 *p, int ends[2]);
-/* ss_poly_rect_area, bit for bit, given ss_poly_xchains' ends: visits only
- * the edges near [x0, x1] (found by bisection on the chains), so its cost
- * hardly grows with the polygon's vertex count. */
-double ss_poly_rect_area_x(const ssPoly2 *p, const int ends[2], double x0,
-                           double x1, double y0, double y1, double *cx,
-                           double *cy);
+/* A polygon's split into two chains monotone in x: a vertex of least x
+ * (l) and one of greatest x (r), and where the last searches along the
+ * chains ended (hint: ss_poly_rect_area_x starts its next searches there,
+ * so that cells visited in order cost a step or two each). */
+typedef struct ssPolyChains {
+  int l, r;
+  int hint[4];
+} ssPolyChains;
+/* The chains of p (hints cleared); 0 (c untouched) when it has none (fewer
+ * than 3 vertices, zero width, not convex). */
+int ss_poly_xchains(const ssPoly2 *p, ssPolyChains *c);
+/* ss_poly_rect_area, bit for bit, given ss_poly_xchains' chains: visits
+ * only the edges near [x0, x1] (found by galloping from the hints, then
+ * bisection, on the chains), so its cost hardly grows with the polygon's
+ * vertex count.  Updates c's hints. */
+double ss_poly_rect_area_x(const ssPoly2 *p, ssPolyChains *c, double x0, double x1,
+                           double y0, double y1, double *cx, double *cy);
 /* The chord [*x0, *x1] of a convex polygon on the line at height y;
  * 0 when the line misses it. */
 int ss_poly_chord(const ssPoly2 *p, double y, double *x0, double *x1);

@@ -179,7 +179,8 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
 
   ssPoly2 fp;
   ss_shape_footprint(&s, &fp);
-  int ends[2], mono = ss_poly_xchains(&fp, ends);
+  ssPolyChains chains;
+  int mono = ss_poly_xchains(&fp, &chains);
   double up[3] = {0, 0, 1};
   double width = ss_shape_width(&s, up);
   double frame[9];
@@ -212,7 +213,7 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       double cx0 = i == 0 ? x : x - 0.5 * dx, cx1 = i == nx - 1 ? x : x + 0.5 * dx;
       double qx = x, qy = y, full = (cx1 - cx0) * (cy1 - cy0), area = full;
       if (!(cx0 > in0 && cx1 < in1)) {
-        area = mono ? ss_poly_rect_area_x(&fp, ends, cx0, cx1, cy0, cy1, &qx, &qy)
+        area = mono ? ss_poly_rect_area_x(&fp, &chains, cx0, cx1, cy0, cy1, &qx, &qy)
                     : ss_poly_rect_area(&fp, cx0, cx1, cy0, cy1, &qx, &qy);
         if (!(area > tiny)) continue;
         /* the point represents the covered part of the cell: the vertex

@@ -388,9 +388,9 @@ static void test_poly_clip_chains(void)
     if (t % 3 == 0) rot_wheel(R, urand(0, PI), urand(0, PI));
     ssShape s = make_shape(type, 0.3, 0.5, 0.2, urand(-1, 1), urand(-1, 1), 0.2, R);
     ssPoly2 p;
-    int ends[2];
+    ssPolyChains ch;
     ss_shape_footprint(&s, &p);
-    if (!ss_poly_xchains(&p, ends)) continue;
+    if (!ss_poly_xchains(&p, &ch)) continue;
     mono++;
     double lo[3], hi[3], dx = urand(0.005, 0.05), dy = urand(0.005, 0.05);
     ss_shape_aabb(&s, lo, hi);
@@ -398,7 +398,7 @@ static void test_poly_clip_chains(void)
       for (double x = lo[0] - dx; x < hi[0] + dx; x += dx) {
         double ax = 7, ay = 7, bx = 7, by = 7;
         double a = ss_poly_rect_area(&p, x, x + dx, y, y + dy, &ax, &ay);
-        double b = ss_poly_rect_area_x(&p, ends, x, x + dx, y, y + dy, &bx, &by);
+        double b = ss_poly_rect_area_x(&p, &ch, x, x + dx, y, y + dy, &bx, &by);
         cells++;
         hits += a > 0;
         if (memcmp(&a, &b, sizeof a) || memcmp(&ax, &bx, sizeof ax) ||
@@ -411,9 +411,9 @@ static void test_poly_clip_chains(void)
      "footprints split)", differ, cells, hits, mono);
   ssPoly2 sq = {4, {0, 1, 1, 0}, {0, 0, 1, 1}}, cw = {4, {0, 0, 1, 1}, {0, 1, 1, 0}};
   ssPoly2 bow = {4, {0, 1, 0, 1}, {0, 0, 1, 1}};
-  int e[2] = {-1, -1};
-  ok(ss_poly_xchains(&sq, e) && e[0] == 0 && e[1] == 1 && ss_poly_xchains(&cw, e) &&
-     !ss_poly_xchains(&bow, e), "x chains of a square either way round, none "
+  ssPolyChains e = {-1, -1, {0, 0, 0, 0}};
+  ok(ss_poly_xchains(&sq, &e) && e.l == 0 && e.r == 1 && ss_poly_xchains(&cw, &e) &&
+     !ss_poly_xchains(&bow, &e), "x chains of a square either way round, none "
      "for a bow tie");
 }
 
