@@ -223,8 +223,8 @@ static int swept_hull(const pt2 *p, int n, int ccw, double tx, double ty, ssPoly
   const pt2 *c = h + first;
   int cnt = k - first;
   if (cnt < 3) return 0;
-  /* a sweep whose turns are not all left is no convex polygon: leave it to
-   * convex_hull */
+  /* every turn left (the filter's stack makes them so, unless a point is
+   * not finite): else leave it to convex_hull */
   for (int i = 0; i < cnt; i++) {
     int i1 = i + 1 < cnt ? i + 1 : i + 1 - cnt, i2 = i + 2 < cnt ? i + 2 : i + 2 - cnt;
     if (!(cross3(c + i, c + i1, c + i2) > tol)) return 0;
@@ -547,9 +547,8 @@ int ss_poly_xchains(const ssPoly2 *p, ssPolyChains *c)
   return 1;
 }
 
-/* first k in [0, cnt) where sgn (x[start + k] - v) >= 0 (> 0 when
- * strict), indices modulo n; cnt when none.  sgn x is non-decreasing
- * along the chain. */
+/* whether sgn (x[start + k] - v) >= 0 (> 0 when strict), indices modulo
+ * n */
 static inline int chain_pred(const double *x, int n, int start, int k, double v,
                              double sgn, int strict)
 {
@@ -559,9 +558,10 @@ static inline int chain_pred(const double *x, int n, int start, int k, double v,
   return strict ? dv > 0 : dv >= 0;
 }
 
-/* (the predicate is monotone along the chain, so the answer is unique:
- * galloping from *hint to bracket it, then bisecting, finds the one
- * bisection alone finds; *hint receives it) */
+/* first k in [0, cnt) where chain_pred holds; cnt when none.  sgn x is
+ * non-decreasing along the chain, so the predicate is monotone and the
+ * answer unique: galloping from *hint to bracket it, then bisecting, finds
+ * the one bisection alone finds; *hint receives it. */
 static int chain_search(const double *x, int n, int start, int cnt, double v,
                         double sgn, int strict, int *hint)
 {

@@ -968,6 +968,17 @@ static double residual(const Setup *s, const ssNewtonWork *w, const double *y,
   return sum;
 }
 
+/* F, H and the residual formed again at the iterate (w->y, w->mu), after
+ * points went to impulse form or the regularization changed; 0 when a
+ * point sticks there (the evaluation is no good) */
+static int reevaluate(const ssModel *m, const ssData *d, const Setup *s, ssNewtonWork *w,
+                      double *f, double *size)
+{
+  if (evaluate(m, d, s, w, w->y, w->mu, w->F, w->H, w->q, w->lam, w->ie) & STUCK) return 0;
+  *f = residual(s, w, w->y, w->F, w->mu, w->ie, w->phi, size);
+  return 1;
+}
+
 /* A = I - Lam H (the impulse-form points eliminated into H) */
 static void newton_matrix(const Setup *s, ssNewtonWork *w, const double *H)
 {
@@ -1373,10 +1384,8 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
      * the velocity form even below IMP_RATIO) and Newton tries again. */
     if (!ok && !rescued) {
       rescued = 1;
-      if (switch_all(w, &s) &&
-          !(evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->q, w->lam, w->ie) & STUCK)) {
+      if (switch_all(w, &s) && reevaluate(m, d, &s, w, &f, &size)) {
         have_H = 1;
-        f = residual(&s, w, w->y, w->F, w->mu, w->ie, w->phi, &size);
         limit = 2 * MAX_ITER;
         continue;
       }
@@ -1385,9 +1394,8 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
      * impulse-form points damped more (IMP_REG_UP) */
     if (!ok && w->ns && reg_step < IMP_REG_MAX && f <= IMP_REG_NEAR * IMP_REG_NEAR * size) {
       w->reg = reg_step * IMP_REG_UP;
-      if (!(evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->q, w->lam, w->ie) & STUCK)) {
+      if (reevaluate(m, d, &s, w, &f, &size)) {
         have_H = 1;
-        f = residual(&s, w, w->y, w->F, w->mu, w->ie, w->phi, &size);
         continue;
       }
     }
@@ -1412,9 +1420,8 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
     /* points that came near sticking: impulse form from here on (their
      * mu at the trial were their law's, so the swap above kept them) */
     if ((fl & NEAR_STICK) && switch_points(m, d, &s, w)) {
-      if (evaluate(m, d, &s, w, w->y, w->mu, w->F, w->H, w->q, w->lam, w->ie) & STUCK) break;
+      if (!reevaluate(m, d, &s, w, &f, &size)) break;
       have_H = 1;
-      f = residual(&s, w, w->y, w->F, w->mu, w->ie, w->phi, &size);
       /* and up to 2 MAX_ITER iterations in all to settle them */
       limit = 2 * MAX_ITER;
     }
