@@ -27,6 +27,7 @@ ssData *ss_data_new(const ssModel *m)
   d->geom_xpos = calloc(ng * 3, sizeof(double));
   d->geom_xmat = calloc(ng * 9, sizeof(double));
   d->geom_patch = calloc(ng * 3, sizeof(double));
+  d->hfield_pow = calloc(nh, sizeof(ssPowTable));
   d->body_iinv = calloc(nb * 9, sizeof(double));
   d->body_xipos = calloc(nb * 3, sizeof(double));
   d->pd_target = calloc((size_t)(m->npd ? m->npd : 1) * 2, sizeof(double));
@@ -38,7 +39,8 @@ ssData *ss_data_new(const ssModel *m)
   d->soil_shear = calloc(nhd, sizeof(double));
   if (!d->qpos || !d->qvel || !d->qvel_free || !d->sys_active ||
       !d->body_xpos || !d->body_xquat || !d->body_xmat || !d->geom_xpos ||
-      !d->geom_xmat || !d->geom_patch || !d->body_iinv || !d->body_xipos || !d->pd_target ||
+      !d->geom_xmat || !d->geom_patch || !d->hfield_pow || !d->body_iinv ||
+      !d->body_xipos || !d->pd_target ||
       !d->art || !d->hfield_pos || !d->hfield_quat || !d->soil_sinkage ||
       !d->soil_plastic || !d->soil_shear) {
     ss_data_free(d);
@@ -59,6 +61,7 @@ void ss_data_free(ssData *d)
   free(d->qpos); free(d->qvel); free(d->qvel_free); free(d->sys_active);
   free(d->body_xpos); free(d->body_xquat); free(d->body_xmat);
   free(d->geom_xpos); free(d->geom_xmat); free(d->geom_patch); free(d->body_iinv);
+  free(d->hfield_pow);
   free(d->body_xipos); free(d->pd_target);
   if (d->art)
     for (int s = 0; s < d->model->nsys; s++) ss_art_work_free(d->art[s]);

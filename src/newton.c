@@ -124,6 +124,7 @@ typedef struct NGroup {
   double gq[12];      /* the points' G_11, G_22 as quadratics in r
                          (slip_quadratics of Lg) */
   const ssSoilMaterial *mat;
+  const ssPowTable *pt; /* its bed's table of s^(n-1), or NULL */
   double R[9];        /* contact frame rows n, t1, t2 (world) */
   double o[3];        /* origin of the points' r (world) */
 } NGroup;
@@ -424,13 +425,17 @@ typedef struct Mat {
   ssPowSeries pser;            /* of s^(n-1), when not linear */
 } Mat;
 
-static Mat mat_of(const ssSoilMaterial *mat, double dt)
+static Mat mat_of(const NGroup *G, double dt)
 {
+  const ssSoilMaterial *mat = G->mat;
   Mat M = {dt, mat->sinkage_exponent,
            mat->elastic_stiffness, mat->damping, mat->friction_coefficient,
            mat->shear_displacement > 0 ? dt / mat->shear_displacement : 0,
-           mat->sinkage_exponent == 1.0, {0, {0}, 0}};
-  if (!M.linear) M.pser = ss_pow_series(M.n - 1);
+           mat->sinkage_exponent == 1.0, {0, {0}, 0, NULL}};
+  if (!M.linear) {
+    M.pser = ss_pow_series(M.n - 1);
+    M.pser.tab = G->pt;
+  }
   return M;
 }
 
@@ -693,7 +698,7 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
     NSum *A = w->sum + g;
     if (g != gprev) {
       gprev = g;
-      M = mat_of(w->grp[g].mat, dt);
+      M = mat_of(w->grp + g, dt);
     }
     double *lam = lam_out + 3 * i, K[6];
     int st = !(with_imp && P->imp) ? point_law(&M, P, A->V, lam, with_H ? K : NULL)
@@ -891,7 +896,7 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
     int g = w->group_of[i];
     if (g != gprev) {
       gprev = g;
-      M = mat_of(w->grp[g].mat, dt);
+      M = mat_of(w->grp + g, dt);
     }
     /* on a copy: the points' memos stay at the last evaluation's y, so
      * that H formed there later (ss_newton_solve) is what the evaluation
@@ -1064,7 +1069,7 @@ static int switch_points(const ssModel *m, const ssData *d, const Setup *s, ssNe
     if (P.imp || !(w->lam[3 * i] > 0)) continue;
     if (g != gprev) {
       gprev = g;
-      M = mat_of(w->grp[g].mat, m->opt.timestep);
+      M = mat_of(w->grp + g, m->opt.timestep);
     }
     double lam[3];
     int st = point_law(&M, &P, w->sum[g].V, lam, NULL);
@@ -1232,6 +1237,7 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
       G->sys = c->sys;
       G->body = c->link >= 0 ? c->link : m->geom_body[c->geom];
       G->mat = &m->hfield_soilmat[c->hfield];
+      G->pt = ss_solver_pow_table(m, d, c->hfield);
       memcpy(G->R, c->frame, sizeof G->R);
       memcpy(G->o, c->pos, sizeof G->o);
       if (c->link < 0) body_block(m, d, G->body, G->Yb);

@@ -632,15 +632,19 @@ int ss_point_soil(ssContact *c, const double v0[3], double tol)
 /* The point's law from the contact and its material (ssPointCache): the
  * constants always, the reused power and mobilisation kept while what they
  * were made from is unchanged. */
-void ss_point_setup(const ssSoilMaterial *mat, double dt, ssContact *c)
+void ss_point_setup(const ssSoilMaterial *mat, const ssPowTable *tab, double dt,
+                    ssContact *c)
 {
   ssPointCache *k = &c->cache;
   Law L = {c->area * dt, dt, c->g0, c->sp,
            (c->width > 0 && mat->bekker_kc != 0 ? mat->bekker_kc / c->width : 0) +
                mat->bekker_kphi,
            mat->sinkage_exponent, mat->sinkage_exponent - 1,
-           mat->elastic_stiffness, mat->damping, mat->sinkage_exponent == 1.0, {0, {0}, 0}, {0, 0, 0}};
-  if (!L.linear) L.pser = ss_pow_series(L.m1);
+           mat->elastic_stiffness, mat->damping, mat->sinkage_exponent == 1.0, {0, {0}, 0, NULL}, {0, 0, 0}};
+  if (!L.linear) {
+    L.pser = ss_pow_series(L.m1);
+    L.pser.tab = tab;
+  }
   if (k->law.pw.s > 0 && k->law.m1 == L.m1) L.pw = k->law.pw;
   k->law = L;
   Mobil J;
@@ -655,7 +659,7 @@ void ss_point_setup(const ssSoilMaterial *mat, double dt, ssContact *c)
 int ss_solver_soil_point(const ssSoilMaterial *mat, double dt, ssContact *c,
                          const double v0[3], double tol)
 {
-  ss_point_setup(mat, dt, c);
+  ss_point_setup(mat, NULL, dt, c);
   return ss_point_soil(c, v0, tol);
 }
 

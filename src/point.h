@@ -58,8 +58,10 @@ typedef struct ssPointCache {
 
 /* Set up the law of soil contact c for this step from its material
  * (c->cache): the constants always, the reused power and mobilisation only
- * while what they were made from is unchanged. */
-void ss_point_setup(const ssSoilMaterial *mat, double dt, ssContact *c);
+ * while what they were made from is unchanged.  tab: the bed's table of
+ * s^(n-1) for the first power (ss_solver_pow_table), or NULL: libm. */
+void ss_point_setup(const ssSoilMaterial *mat, const ssPowTable *tab, double dt,
+                    ssContact *c);
 /* New impulse c->lambda of a soil contact set up by ss_point_setup, given
  * the velocity v0 it would have without its own impulse (others held);
  * c->lambda is the first guess.  Returns the number of inner iterations. */

@@ -1,5 +1,6 @@
 /* soil.c -- the soil constitutive law of DESIGN 2.3-2.5 as pure functions. */
 #include "soilsim.h"
+#include "terrain.h"
 
 #include <math.h>
 #include <string.h>
@@ -78,14 +79,27 @@ double ss_soil_pressure(const ssSoilMaterial *s, double b, double z, double z_p)
   return pe < py ? pe : py;
 }
 
+/* the update on the envelope value py at z > z_p */
+static double plastic_update(const ssSoilMaterial *s, double z, double z_p, double py)
+{
+  double pe = ss_soil_elastic(s, z, z_p), p = pe < py ? pe : py;
+  double zp = z - p / s->elastic_stiffness;
+  /* on the elastic branch z - p/K_e reproduces z_p up to round-off */
+  return zp > z_p ? zp : z_p;
+}
+
 double ss_soil_plastic_update(const ssSoilMaterial *s, double b, double z,
                               double z_p)
 {
   if (!(z > z_p)) return z_p;
-  double p = ss_soil_pressure(s, b, z, z_p);
-  double zp = z - p / s->elastic_stiffness;
-  /* on the elastic branch z - p/K_e reproduces z_p up to round-off */
-  return zp > z_p ? zp : z_p;
+  return plastic_update(s, z, z_p, ss_soil_envelope(s, b, z));
+}
+
+double ss_soil_plastic_update_pow(const ssSoilMaterial *s, double b, double z,
+                                  double z_p, double zn1)
+{
+  if (!(z > z_p)) return z_p;
+  return plastic_update(s, z, z_p, modulus(s, b) * (z * zn1));
 }
 
 double ss_soil_viscous(const ssSoilMaterial *s, double sdot)

@@ -452,6 +452,10 @@ typedef struct ssData {
   double *geom_patch;     /* (ngeom x 3) each collider's soil patch when the
                              cache is stored: fastest loaded slip, sums of
                              normal and of tangential impulses (scratch) */
+  struct ssPowTable *hfield_pow; /* (nhfield) each soil bed's s^(n-1) by
+                             table (ss_math.h), formed for the exponent its
+                             material holds before each step's contacts
+                             (internal) */
   int solver_full;        /* 1: every contact updates the full velocity
                              (no packed link groups); the reference path of
                              the tests, equal to the default at round-off */

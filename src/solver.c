@@ -375,6 +375,23 @@ SS_SORT_RUNS(sort_runs, ssWarmEntry, warm_less)
 #define CREEP_SLIP 1e-4
 #define CREEP_SHEAR 1e-6
 
+void ss_solver_pow_tables(const ssModel *m, ssData *d)
+{
+  for (int h = 0; h < m->nhfield; h++) {
+    double a = m->hfield_soilmat[h].sinkage_exponent - 1;
+    ssPowTable *t = d->hfield_pow + h;
+    if (m->hfield_soil[h] && a != 0 && t->ser.a != a)
+      ss_pow_table_init(t, a);
+  }
+}
+
+const ssPowTable *ss_solver_pow_table(const ssModel *m, const ssData *d, int h)
+{
+  const ssPowTable *t = d->hfield_pow + h;
+  double a = m->hfield_soilmat[h].sinkage_exponent - 1;
+  return t->ok && t->ser.a == a ? t : NULL;
+}
+
 /* keep this step's converged tractions (soil) and impulse rates (joint
  * rows) for the next one */
 ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
@@ -562,7 +579,8 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
       ss_dyn_contact_jacobian(d, b, c->pos, c->frame, J);
       ss_dyn_contact_response(m, d, b, J, J + 3 * c->nv, c->G);
     }
-    if (c->type == SS_CONTACT_SOIL) ss_point_setup(&m->hfield_soilmat[c->hfield], dt, c);
+    if (c->type == SS_CONTACT_SOIL)
+      ss_point_setup(&m->hfield_soilmat[c->hfield], ss_solver_pow_table(m, d, c->hfield), dt, c);
   }
   Group g = {NULL, NULL, NULL, {0}, {0}};
   for (int sweep = 0; sweep < sweeps; sweep++) {

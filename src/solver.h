@@ -113,6 +113,16 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
                     int *sticking, double *residual);
 void ss_newton_work_free(ssNewtonWork *w);
 
+/* Each soil bed's table of s^(n-1) (ss_math.h's ssPowTable in
+ * d->hfield_pow), formed again wherever its material's exponent is not
+ * the one it was formed for; before each step's contacts (step.c).  The
+ * first power of every loaded point in a step (the Newton phase's first
+ * evaluation, the sweeps' first visit, the soil update) comes from it
+ * instead of libm's pow. */
+void ss_solver_pow_tables(const ssModel *m, ssData *d);
+/* bed h's table, NULL where none holds (n = 1 or beyond the series) */
+const ssPowTable *ss_solver_pow_table(const ssModel *m, const ssData *d, int h);
+
 /* The per-point soil solve (exposed for tests and benchmarks): given the
  * contact's state and the velocity v0 it would have with lambda = 0 from
  * this contact (others held), find lambda.  Returns the number of inner

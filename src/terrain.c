@@ -388,7 +388,8 @@ void ss_terrain_update(const ssModel *m, ssData *d)
     d->soil_sinkage[v] = d->soil_plastic[v];
     d->soil_shear[v] = 0;
   }
-  int nload = 0;
+  int nload = 0, pt_bed = -1;
+  const ssPowTable *pt = NULL; /* the table of bed pt_bed */
   for (int i = 0; i < d->ncontact; i++) {
     ssContact *c = d->contact + i;
     if (c->type != SS_CONTACT_SOIL) {
@@ -398,9 +399,12 @@ void ss_terrain_update(const ssModel *m, ssData *d)
     st->soil_contacts++;
     if (!c->loaded) continue;
     const ssSoilMaterial *mat = &m->hfield_soilmat[c->hfield];
+    if (c->hfield != pt_bed) pt = ss_solver_pow_table(m, d, pt_bed = c->hfield);
     double delta = -(c->g0 + dt * c->v[0]);
     double s = c->sp + delta;
-    double spn = ss_soil_plastic_update(mat, c->width, s, c->sp);
+    double spn = pt && s > c->sp
+                     ? ss_soil_plastic_update_pow(mat, c->width, s, c->sp, ss_pow_tab(pt, s))
+                     : ss_soil_plastic_update(mat, c->width, s, c->sp);
     double jn = c->j + dt * sqrt(c->v[1] * c->v[1] + c->v[2] * c->v[2]);
     int v = c->vertex;
     /* two colliders on one vertex: the deeper imprint wins */

@@ -650,6 +650,51 @@ static void test_creeping_plate(void)
   ss_model_free(m);
 }
 
+/* The first power of each point's step comes from its bed's table of
+ * s^(n-1) (solver.h, ss_solver_pow_tables), formed for the exponent the
+ * material holds: a material changed between steps (n 0.9 -> 1.1, the
+ * envelope below 1 m drops and the plate yields again) gets a
+ * table of its own before the next step's contacts, and the soil update
+ * with it leaves every loaded vertex's rut where the public law puts it. */
+static void test_power_table(void)
+{
+  ssError e;
+  ssModel *m;
+  ssData *d;
+  ssSoilMaterial soil = plate_soil();
+  soil.sinkage_exponent = 0.9;
+  if (!plate_world(41, 1.6, 0, 0, &soil, &m, &d, &e)) {
+    ok(0, "plate on n = 0.9: %s", e.message);
+    return;
+  }
+  World w = {m, d, 0, 0};
+  int good = run(&w, 200);
+  const ssPowTable *t = ss_solver_pow_table(m, d, 0);
+  int before = t && t->ser.a == 0.9 - 1;
+  ssSoilMaterial *mat = &m->hfield_soilmat[0];
+  mat->sinkage_exponent = 1.1;
+  good = good && run(&w, 1);
+  t = ss_solver_pow_table(m, d, 0);
+  int after = t && t->ser.a == 1.1 - 1;
+  double worst = 0;
+  int loaded = 0, yielding = 0;
+  for (int i = 0; i < d->ncontact; i++) {
+    const ssContact *c = d->contact + i;
+    if (c->type != SS_CONTACT_SOIL || !c->loaded) continue;
+    double z = c->sp - (c->g0 + m->opt.timestep * c->v[0]);
+    double want = ss_soil_plastic_update(mat, c->width, z, c->sp);
+    worst = fmax(worst, fabs(d->soil_plastic[c->vertex] - want) / z);
+    loaded++;
+    yielding += want > c->sp;
+  }
+  ok(good && before && after && yielding > 100 && worst <= 1e-14,
+     "power tables follow the material's exponent (n 0.9, then 1.1: %d, %d); %d ruts of %d "
+     "loaded points deepened, as the public law deepens them to %.2g",
+     before, after, yielding, loaded, worst);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 int main(void)
 {
   test_analytic_plate();
@@ -662,5 +707,6 @@ int main(void)
   test_newton();
   test_resting_on_slope();
   test_creeping_plate();
+  test_power_table();
   return done_testing();
 }
