@@ -124,9 +124,9 @@ typedef struct NGroup {
   double gq[12];      /* the points' G_11, G_22 as quadratics in r
                          (slip_quadratics of Lg) */
   const ssSoilMaterial *mat;
-  const ssPowTable *pt; /* its bed's table of s^(n-1), or NULL */
   double R[9];        /* contact frame rows n, t1, t2 (world) */
   double o[3];        /* origin of the points' r (world) */
+  const ssPowTable *pt; /* its bed's table of s^(n-1), or NULL */
 } NGroup;
 
 /* One evaluation's sums over a group's points, in its frame about o */

@@ -239,6 +239,13 @@ typedef struct ssPowMemo {
   double s, v, is;
 } ssPowMemo;
 
+/* s^a from p's table, or libm's pow where it has none (out of line: the
+ * callers' loops stay as small as with pow alone) */
+static __attribute__((noinline, unused)) double ss_pow_far(const ssPowSeries *p, double s)
+{
+  return p->tab ? ss_pow_tab(p->tab, s) : pow(s, p->a);
+}
+
 /* s^a, moved by the series p (exponent a) from the memo when s is within
  * SS_POW_SERIES_MAX of it, else from p's table (or libm); the memo moves
  * to s */
@@ -246,7 +253,7 @@ static inline double ss_pow_moved(ssPowMemo *c, double s, const ssPowSeries *p)
 {
   double u = c->s > 0 ? (s - c->s) * c->is : INFINITY, v;
   if (fabs(u) <= SS_POW_SERIES_MAX && p->ok) v = c->v + c->v * ss_pow1p_m1(p, u);
-  else v = p->tab ? ss_pow_tab(p->tab, s) : pow(s, p->a);
+  else v = ss_pow_far(p, s);
   c->s = s;
   c->v = v;
   c->is = 1 / s;

@@ -388,8 +388,12 @@ void ss_terrain_update(const ssModel *m, ssData *d)
     d->soil_sinkage[v] = d->soil_plastic[v];
     d->soil_shear[v] = 0;
   }
-  int nload = 0, pt_bed = -1;
-  const ssPowTable *pt = NULL; /* the table of bed pt_bed */
+  /* the material of bed `bed` and s^(n-1) for it: 1 where n = 1, else
+   * by its table (solver.h), else libm, as the law forms it */
+  int nload = 0, bed = -1;
+  const ssSoilMaterial *mat = NULL;
+  const ssPowTable *pt = NULL;
+  double n1 = 0;
   for (int i = 0; i < d->ncontact; i++) {
     ssContact *c = d->contact + i;
     if (c->type != SS_CONTACT_SOIL) {
@@ -398,13 +402,16 @@ void ss_terrain_update(const ssModel *m, ssData *d)
     }
     st->soil_contacts++;
     if (!c->loaded) continue;
-    const ssSoilMaterial *mat = &m->hfield_soilmat[c->hfield];
-    if (c->hfield != pt_bed) pt = ss_solver_pow_table(m, d, pt_bed = c->hfield);
+    if (c->hfield != bed) {
+      bed = c->hfield;
+      mat = &m->hfield_soilmat[bed];
+      pt = ss_solver_pow_table(m, d, bed);
+      n1 = mat->sinkage_exponent - 1;
+    }
     double delta = -(c->g0 + dt * c->v[0]);
     double s = c->sp + delta;
-    double spn = pt && s > c->sp
-                     ? ss_soil_plastic_update_pow(mat, c->width, s, c->sp, ss_pow_tab(pt, s))
-                     : ss_soil_plastic_update(mat, c->width, s, c->sp);
+    double spn = ss_soil_plastic_update_pow(mat, c->width, s, c->sp,
+                                            n1 == 0 ? 1 : pt ? ss_pow_tab(pt, s) : pow(s, n1));
     double jn = c->j + dt * sqrt(c->v[1] * c->v[1] + c->v[2] * c->v[2]);
     int v = c->vertex;
     /* two colliders on one vertex: the deeper imprint wins */
