@@ -9,13 +9,14 @@
  * written.  It does not hold the model: it is restored into a data made for
  * the same world, which a fingerprint of the model checks.
  *
- * Format, version 2 (version 1, before the warm-start cache kept its rates,
- * is refused: its cache cannot replay this build's steps).  Every integer is little-endian; every double is its
+ * Format, version 3 (versions 1, before the warm-start cache kept its
+ * rates, and 2, before its entries said whether their collider crept, are
+ * refused: their caches cannot replay this build's steps).  Every integer is little-endian; every double is its
  * IEEE-754 bit pattern as a little-endian 64-bit integer (bit-exact).
  *
  *   header (32 bytes; the same layout in every version)
  *     0   8  magic "SOILCKPT"
- *     8   4  u32 format version (2)
+ *     8   4  u32 format version (3)
  *    12   4  u32 header size (32)
  *    16   8  u64 file size in bytes, trailer included
  *    24   4  u32 number of sections
@@ -37,8 +38,9 @@
  *     PDTG  npd x 2 f64     HPOS  nhfield x 3 f64 HQUA  nhfield x 4 f64
  *     SINK, PLAS, SHEA      nhfielddata f64 each (sinkage, plastic, shear)
  *     LOAD  nsoil_loaded i32, strictly ascending vertex indices
- *     WARM  nwarm entries of 56 bytes: vertex (i32), geom (i32), traction
- *           (3 f64), rate (3 f64), in the solver's sort order
+ *     WARM  nwarm entries of 60 bytes: vertex (i32), geom (i32), creep
+ *           (i32: 0 or 1, only for soil entries), traction (3 f64), rate
+ *           (3 f64), in the solver's sort order
  *     STAT  soil_contacts, soil_loaded (i32), soil_contact_area,
  *           soil_normal_force (f64), rigid_contacts, sweeps (i32), residual
  *           (f64), converged (i32); the stage wall times are not saved, so
@@ -68,11 +70,11 @@
 #include <sys/stat.h>
 
 #define CKPT_MAGIC "SOILCKPT"
-#define CKPT_VERSION 2u
+#define CKPT_VERSION 3u
 #define CKPT_HEADER 32u
 #define CKPT_SECTION_HEAD 16u
 #define CKPT_TRAILER 8u
-#define CKPT_WARM_BYTES 56u
+#define CKPT_WARM_BYTES 60u
 #define CKPT_SOURCE_MAX 4096u
 
 /* ---------------------------------------------------------------------- */
@@ -472,6 +474,7 @@ ssStatus ss_checkpoint_save_buffer(const ssModel *m, const ssData *d,
     const ssWarmEntry *e = d->warm + k;
     w_i32(&w, e->vertex);
     w_i32(&w, e->geom);
+    w_i32(&w, e->creep);
     w_f64s(&w, e->traction, 3);
     w_f64s(&w, e->rate, 3);
   }
@@ -1049,6 +1052,7 @@ static ssStatus parse_state(const ssModel *m, const Parsed *f, const char *path,
     ssWarmEntry *e = s->warm + k;
     e->vertex = r_i32(&r);
     e->geom = r_i32(&r);
+    e->creep = r_i32(&r);
     r_f64s(&r, e->traction, 3);
     r_f64s(&r, e->rate, 3);
     int key_ok = e->geom >= 0
@@ -1056,6 +1060,7 @@ static ssStatus parse_state(const ssModel *m, const Parsed *f, const char *path,
                            e->geom < m->ngeom && soil_vertex(m, e->vertex)
                      : (e->geom == -2 || e->geom == -3) && e->vertex >= 0 &&
                            (size_t)e->vertex < 2 * nv;
+    key_ok = key_ok && (e->creep == 0 || (e->creep == 1 && e->geom >= 0));
     if (!key_ok || !isfinite(e->traction[0]) || !isfinite(e->traction[1]) ||
         !isfinite(e->traction[2]) || !isfinite(e->rate[0]) || !isfinite(e->rate[1]) ||
         !isfinite(e->rate[2]) || (k && cmp_key(e - 1, e) > 0))

@@ -268,9 +268,13 @@ static void body_run_close(const ssModel *m, ssData *d, BodyRun *r)
  * (ssWarmEntry), scaled by the current area and time step and projected
  * into the current bounds; joint rows start from last step's impulse
  * rate.  converged: the cached tractions are a converged solve's (the
- * previous step's stats), so this step may form their rate. */
-static void warm_start(const ssModel *m, ssData *d, int converged)
+ * previous step's stats), so this step may form their rate.  A creeping
+ * collider's entries (creep) are extrapolated only with creep_rates.  On
+ * entry d->qvel is the free velocity; returns how many matched entries'
+ * rates were left out. */
+static int warm_start(const ssModel *m, ssData *d, int converged, int creep_rates)
 {
+  int left = 0;
   const double dt = m->opt.timestep;
   Group g = {NULL, NULL, NULL, {0}, {0}};
   BodyRun br = {-1, {0}};
@@ -280,7 +284,7 @@ static void warm_start(const ssModel *m, ssData *d, int converged)
     c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
     if (!m->opt.terrain_warm_start || c->type == SS_CONTACT_RIGID || !d->nwarm)
       continue;
-    ssWarmEntry key = {c->vertex, c->geom, {0, 0, 0}, {0, 0, 0}};
+    ssWarmEntry key = {c->vertex, c->geom, 0, {0, 0, 0}, {0, 0, 0}};
     if (c->type != SS_CONTACT_SOIL) row_key(d, c, &key);
     const ssWarmEntry *e = find_warm(d, &key, &cursor);
     if (!e) continue;
@@ -291,7 +295,9 @@ static void warm_start(const ssModel *m, ssData *d, int converged)
       c->lambda[0] = e->traction[0] > 0 ? e->traction[0] * dt : 0;
     } else {
       double scale = c->area * dt, t[3];
-      for (int k = 0; k < 3; k++) t[k] = e->traction[k] + e->rate[k];
+      int rate = !e->creep || creep_rates;
+      left += !rate && (e->rate[0] != 0 || e->rate[1] != 0 || e->rate[2] != 0);
+      for (int k = 0; k < 3; k++) t[k] = e->traction[k] + (rate ? e->rate[k] : 0);
       memcpy(c->warm_t, e->traction, sizeof c->warm_t);
       c->warm_trend = converged;
       double ln = t[0] > 0 ? t[0] * scale : 0;
@@ -346,6 +352,7 @@ static void warm_start(const ssModel *m, ssData *d, int converged)
   }
   group_close(d, &g);
   body_run_close(m, d, &br);
+  return left;
 }
 
 static int cached(const ssContact *c)
@@ -365,13 +372,19 @@ SS_SORT_RUNS(sort_runs, ssWarmEntry, warm_less)
 /* A collider whose loaded soil points all slip slower than CREEP_SLIP
  * (m/s) while its patch carries shear (tangential impulses above
  * CREEP_SHEAR of the normal ones, both summed) creeps: its slip directions
- * are set by velocities so small that a traction's next value is no
- * extrapolation of its last two, and an extrapolated warm start (rates in
- * ssWarmEntry) is further from the answer than the last tractions
- * themselves.  Its points keep no rates.  (plate_arm.xml, whose plate
- * creeps at 1e-7 to 1e-5 m/s under the lift's pull: 27 -> 4.7 sweeps per
- * step, no step left at the sweep cap.)  A sinking body carries no shear
- * and keeps its rates; a rolling wheel's patch slips far faster. */
+ * are set by velocities so small that a traction's next value is mostly
+ * no extrapolation of its last two, and an extrapolated warm start (rates
+ * in ssWarmEntry) is further from the answer than the last tractions
+ * themselves.  Its cache entries are marked (creep): the warm start leaves
+ * their rates out, and only where the Newton phase then fails does it
+ * start again from the extrapolation.  (plate_arm.xml, whose plate creeps
+ * at 1e-7 to 1e-5 m/s under the lift's pull: with the rates always, 27
+ * sweeps per step; without them, 4.7, nearly all in steps 201-500 where
+ * the plate also sinks at 1e-3 m/s and its trend is real; with them where
+ * Newton fails without, 0.4, and no step over 20 sweeps in 301-1000.)  A
+ * sinking body carries no shear and keeps its rates; a rolling wheel's
+ * patch slips far faster.  Which start suits is not known before: the
+ * first residuals of both are about 1e-3 there, whichever converges. */
 #define CREEP_SLIP 1e-4
 #define CREEP_SHEAR 1e-6
 
@@ -460,9 +473,8 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
     p[0] = p[1] > 0 && p[0] < CREEP_SLIP * CREEP_SLIP && p[2] > CREEP_SHEAR * p[1];
     creeping |= p[0] != 0;
   }
-  for (int k = 0; k < n && creeping; k++)
-    if (next[k].geom >= 0 && patch[3 * next[k].geom] != 0)
-      next[k].rate[0] = next[k].rate[1] = next[k].rate[2] = 0;
+  for (int k = 0; k < n; k++)
+    next[k].creep = creeping && next[k].geom >= 0 && patch[3 * next[k].geom] != 0;
   if (sort_runs(next, d->warm, n) == next) {
     /* sorted in warm_next: the buffers change places (and capacities) */
     int cap = d->cap_warm;
@@ -533,7 +545,7 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   st->newton = 0;
   st->newton_sticking = 0;
   if (m->nv) memcpy(d->qvel_free, d->qvel, (size_t)m->nv * sizeof(double));
-  warm_start(m, d, converged);
+  int left = warm_start(m, d, converged, 0);
 
   /* joint rows (PD, limits) are few, stiff and coupled to everything:
    * they are revisited after every piece of a link run (PIECE) and every
@@ -559,8 +571,19 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   int sweeps = d->ncontact ? m->opt.solver_max_sweeps : 0;
   if (!d->solver_gs_only) {
     double res;
-    if (ss_newton_solve(m, d, first_row, &st->newton, &st->newton_sticking, &res) &&
-        res <= tol) {
+    int ok = ss_newton_solve(m, d, first_row, &st->newton, &st->newton_sticking, &res) &&
+             res <= tol;
+    if (!ok && left) {
+      /* failed from the creeping colliders' last tractions: again from
+       * their extrapolation (CREEP_SLIP) */
+      int it = st->newton;
+      if (m->nv) memcpy(d->qvel, d->qvel_free, (size_t)m->nv * sizeof(double));
+      warm_start(m, d, converged, 1);
+      ok = ss_newton_solve(m, d, first_row, &st->newton, &st->newton_sticking, &res) &&
+           res <= tol;
+      st->newton += it;
+    }
+    if (ok) {
       st->residual = res;
       sweeps = 0;
     }

@@ -73,12 +73,16 @@ struct ssContact {
  * unconverged tractions is mostly solver error, and extrapolating it feeds
  * that error back step after step; a change within the tolerance (a
  * settled body's drift) is no trend either, and extrapolating it costs
- * the point solves an iteration.  Nor does a creeping collider keep rates
- * (solver.c, CREEP_SLIP): its tractions follow slip directions that turn
- * with velocities of 1e-5 m/s and less. */
+ * the point solves an iteration.  A creeping collider's entries keep their
+ * rates but are marked (creep; solver.c, CREEP_SLIP): its tractions follow
+ * slip directions that turn with velocities of 1e-5 m/s and less, and the
+ * warm start extrapolates them only where the Newton phase fails without. */
 struct ssWarmEntry {
   int vertex;        /* absolute soil vertex (joint rows: see row_key) */
   int geom;
+  int creep;         /* 1: its collider crept (solver.c, CREEP_SLIP): the
+                        warm start leaves its rate out, unless the Newton
+                        phase fails without */
   double traction[3];/* impulse / (area dt), contact frame (Pa); joint
                         rows: impulse / dt in traction[0] */
   double rate[3];    /* traction change over the last step (Pa); 0 for rows */

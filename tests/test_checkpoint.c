@@ -464,10 +464,10 @@ static void damage_tests(const char *what, const ssModel *m, const ssData *src,
     ok(0, "%s: checkpoint", what);
     return;
   }
-  ok(!memcmp(good, "SOILCKPT", 8) && le(good + 8, 4) == 2 && le(good + 16, 8) == n &&
+  ok(!memcmp(good, "SOILCKPT", 8) && le(good + 8, 4) == 3 && le(good + 16, 8) == n &&
      le(good + 28, 4) == crc32_ref(good, 28) && !memcmp(good + n - 8, "CRC ", 4) &&
      le(good + n - 4, 4) == crc32_ref(good, n - 4),
-     "%s: layout: signature, version 2, size and CRC-32 in the header, CRC-32 "
+     "%s: layout: signature, version 3, size and CRC-32 in the header, CRC-32 "
      "trailer (%zu bytes)", what, n);
 
   /* the victim: a data in another state that must survive every attack */
@@ -544,8 +544,8 @@ static void damage_tests(const char *what, const ssModel *m, const ssData *src,
     int width;
     uint64_t value;
   } forge[] = {
-    {"version 1 (an older build's)", NULL, 8, 4, 1},
-    {"version 3", NULL, 8, 4, 3},
+    {"version 2 (an older build's)", NULL, 8, 4, 2},
+    {"version 4", NULL, 8, 4, 4},
     {"header size", NULL, 12, 4, 64},
     {"section count too high", NULL, 24, 4, 17},
     {"section count too low", NULL, 24, 4, 14},
@@ -556,7 +556,7 @@ static void damage_tests(const char *what, const ssModel *m, const ssData *src,
     {"QPOS size huge", "QPOS", 8, 8, UINT64_C(1) << 62},
     {"SINK size off by 8", "SINK", 8, 8, 0},
     {"LOAD size not a multiple of 4", "LOAD", 8, 8, 0},
-    {"WARM size not a multiple of 56", "WARM", 8, 8, 0},
+    {"WARM size not a multiple of 60", "WARM", 8, 8, 0},
     {"unknown section tag", "CLCK", 0, 4, 0x58585858u},
     {"section reserved word", "OPTS", 4, 4, 7},
     {"count of nq in the model section", "MODL", 16 + 4, 4, 99},
@@ -573,7 +573,8 @@ static void damage_tests(const char *what, const ssModel *m, const ssData *src,
     {"loaded vertex negative", "LOAD", 16, 4, 0xFFFFFFFFu},
     {"warm entry collider out of range", "WARM", 16 + 4, 4, 0x10000},
     {"warm entry vertex negative", "WARM", 16, 4, 0xFFFFFFF0u},
-    {"warm entry rate NaN", "WARM", 16 + 8 + 24, 8, UINT64_C(0x7ff8000000000000)},
+    {"warm entry rate NaN", "WARM", 16 + 12 + 24, 8, UINT64_C(0x7ff8000000000000)},
+    {"warm entry creep flag 2", "WARM", 16 + 8, 4, 2},
   };
   int nforge = (int)(sizeof forge / sizeof forge[0]), fail = 0;
   for (int k = 0; k < nforge; k++) {
@@ -598,7 +599,7 @@ static void damage_tests(const char *what, const ssModel *m, const ssData *src,
         le(p + at + 8, 8) < 4)
       continue; /* no loaded vertex to damage */
     if (forge[k].tag && !strcmp(forge[k].tag, "WARM") && forge[k].off >= 16 &&
-        le(p + at + 8, 8) < 56)
+        le(p + at + 8, 8) < 60)
       continue;
     put(p + at + forge[k].off, value, forge[k].width);
     reseal(p, n);
@@ -703,10 +704,10 @@ static void test_foreign_and_mismatch(void)
   /* info without a model */
   ssCheckpointInfo info;
   ok(ss_checkpoint_save(m, d, path, &e) == SS_OK && ss_checkpoint_info(path, &info, &e) == SS_OK &&
-     info.version == 2 && info.step == 20 && info.time == d->time &&
+     info.version == 3 && info.step == 20 && info.time == d->time &&
      info.bytes == n && strstr(info.source, "plate.xml") &&
      info.opt.solver_max_sweeps == m->opt.solver_max_sweeps,
-     "ss_checkpoint_info: version 2, step 20, time, size, source '%s'", info.source);
+     "ss_checkpoint_info: version 3, step 20, time, size, source '%s'", info.source);
 
   /* another world */
   ssModel *ml;
