@@ -930,10 +930,13 @@ static ssStatus read_doubles(const Parsed *f, int s, size_t n, double *out,
   return SS_OK;
 }
 
+/* the solver's cache order (solver.c cmp_warm): collider, then vertex,
+ * the joint rows (geom < 0, as unsigned) last */
 static int cmp_key(const ssWarmEntry *a, const ssWarmEntry *b)
 {
-  if (a->vertex != b->vertex) return (a->vertex > b->vertex) - (a->vertex < b->vertex);
-  return (a->geom > b->geom) - (a->geom < b->geom);
+  unsigned ga = (unsigned)a->geom, gb = (unsigned)b->geom;
+  if (ga != gb) return (ga > gb) - (ga < gb);
+  return (a->vertex > b->vertex) - (a->vertex < b->vertex);
 }
 
 /* Everything read from a file before it is put into the data. */

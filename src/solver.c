@@ -210,11 +210,17 @@ static void group_close(ssData *d, Group *g)
   g->first = NULL;
 }
 
+/* The cache's order: by collider, then vertex; the joint rows (geom < 0,
+ * taken as unsigned) after every collider.  Each collider's points come
+ * in vertex order and the colliders in order, so a step's entries arrive
+ * sorted or in a few runs (one per bed), and the warm start's look-ups
+ * walk the cache forwards without skipping other colliders' entries. */
 static int cmp_warm(const void *a, const void *b)
 {
   const ssWarmEntry *x = a, *y = b;
-  if (x->vertex != y->vertex) return (x->vertex > y->vertex) - (x->vertex < y->vertex);
-  return (x->geom > y->geom) - (x->geom < y->geom);
+  unsigned gx = (unsigned)x->geom, gy = (unsigned)y->geom;
+  if (gx != gy) return (gx > gy) - (gx < gy);
+  return (x->vertex > y->vertex) - (x->vertex < y->vertex);
 }
 
 /* cache key of a joint row: its dof and kind (PD, or the limit's side) */
@@ -226,9 +232,11 @@ static void row_key(const ssData *d, const ssContact *c, ssWarmEntry *k)
 }
 
 /* The cache entry of key, or NULL.  Contacts come in runs of ascending
- * keys (one collider's points in vertex order), so the search walks on
- * from the previous hit (*cursor) while the keys ascend, a few entries at
- * most, and falls back to bisection when they do not. */
+ * keys (one collider's points in vertex order, the colliders in order),
+ * so the search walks on from the previous hit (*cursor) while the keys
+ * ascend, a few entries at most, and falls back to bisection when they do
+ * not (a new bed, the joint rows, a gap of more than 8 entries no longer
+ * loaded). */
 static const ssWarmEntry *find_warm(const ssData *d, const ssWarmEntry *key,
                                     int *cursor)
 {
@@ -363,9 +371,9 @@ static int cached(const ssContact *c)
 
 /* Sort the n cache entries of a by key (cmp_warm), b being as large;
  * returns whichever of a and b ends holding them.  The contacts come in a
- * few ascending runs (one per collider and bed, then the joint rows), so
- * neighbouring runs are merged pairwise until one is left: a few passes,
- * no general sort. */
+ * few ascending runs (one per bed, then the joint rows), so neighbouring
+ * runs are merged pairwise until one is left: a few passes, no general
+ * sort, none where the entries came sorted. */
 static int warm_less(const ssWarmEntry *a, const ssWarmEntry *b) { return cmp_warm(a, b) < 0; }
 SS_SORT_RUNS(sort_runs, ssWarmEntry, warm_less)
 

@@ -282,6 +282,18 @@ static void test_drive(void)
   ok(slip > 0.02 && slip < 0.5, "the driven rear wheels slip (mean slip ratio %.3f)", slip);
   ok(watch.closure < 1e-6, "loop closure error < 1e-6 m over the whole drive (max %.3g)",
      watch.closure);
+  /* the warm-start cache in the order a step's points arrive (solver.c
+   * cmp_warm): by collider, then vertex, the joint rows last */
+  int wheels = d->nwarm > 0 && d->warm[0].geom >= 0, rows = 0, ordered = 1;
+  for (int k = 1; k < d->nwarm; k++) {
+    const ssWarmEntry *a = d->warm + k, *b = a - 1;
+    wheels += a->geom >= 0 && b->geom != a->geom;
+    rows += a->geom < 0;
+    ordered &= b->geom == a->geom ? b->vertex < a->vertex
+                                  : (unsigned)b->geom < (unsigned)a->geom;
+  }
+  ok(ordered && wheels == 4 && rows > 0, "warm-start cache: %d entries, of 4 wheels by "
+     "collider, then vertex, and %d joint rows last", d->nwarm, rows);
 
   /* ruts: permanent sinkage under the wheel tracks, none away from them */
   int h = 0, nx = m->hfield_nx[h], ny = m->hfield_ny[h];
