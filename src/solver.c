@@ -214,36 +214,40 @@ static void group_close(ssData *d, Group *g)
  * taken as unsigned) after every collider.  Each collider's points come
  * in vertex order and the colliders in order, so a step's entries arrive
  * sorted or in a few runs (one per bed), and the warm start's look-ups
- * walk the cache forwards without skipping other colliders' entries. */
-static int cmp_warm(const void *a, const void *b)
+ * walk the cache forwards without skipping other colliders' entries.
+ * Entry e against the key (geom, vertex): <0, 0, >0. */
+static inline int cmp_key(const ssWarmEntry *e, int geom, int vertex)
 {
-  const ssWarmEntry *x = a, *y = b;
-  unsigned gx = (unsigned)x->geom, gy = (unsigned)y->geom;
-  if (gx != gy) return (gx > gy) - (gx < gy);
-  return (x->vertex > y->vertex) - (x->vertex < y->vertex);
+  unsigned ge = (unsigned)e->geom, g = (unsigned)geom;
+  if (ge != g) return (ge > g) - (ge < g);
+  return (e->vertex > vertex) - (e->vertex < vertex);
+}
+
+static int cmp_warm(const ssWarmEntry *a, const ssWarmEntry *b)
+{
+  return cmp_key(a, b->geom, b->vertex);
 }
 
 /* cache key of a joint row: its dof and kind (PD, or the limit's side) */
-static void row_key(const ssData *d, const ssContact *c, ssWarmEntry *k)
+static void row_key(const ssData *d, const ssContact *c, int *geom, int *vertex)
 {
   int upper = c->type == SS_CONTACT_LIMIT && d->jac[c->jadr + (c->dof - c->vadr)] < 0;
-  k->vertex = 2 * c->dof + upper;
-  k->geom = c->type == SS_CONTACT_PD ? -2 : -3;
+  *vertex = 2 * c->dof + upper;
+  *geom = c->type == SS_CONTACT_PD ? -2 : -3;
 }
 
-/* The cache entry of key, or NULL.  Contacts come in runs of ascending
- * keys (one collider's points in vertex order, the colliders in order),
- * so the search walks on from the previous hit (*cursor) while the keys
- * ascend, a few entries at most, and falls back to bisection when they do
- * not (a new bed, the joint rows, a gap of more than 8 entries no longer
- * loaded). */
-static const ssWarmEntry *find_warm(const ssData *d, const ssWarmEntry *key,
-                                    int *cursor)
+/* The cache entry of key (geom, vertex), or NULL.  Contacts come in runs
+ * of ascending keys (one collider's points in vertex order, the colliders
+ * in order), so the search walks on from the previous hit (*cursor) while
+ * the keys ascend, a few entries at most, and falls back to bisection
+ * when they do not (a new bed, the joint rows, a gap of more than 8
+ * entries no longer loaded). */
+static const ssWarmEntry *find_warm(const ssData *d, int geom, int vertex, int *cursor)
 {
   int p = *cursor, n = d->nwarm;
-  if (p < n && cmp_warm(d->warm + p, key) <= 0) {
+  if (p < n && cmp_key(d->warm + p, geom, vertex) <= 0) {
     for (int k = 0; k < 8 && p < n; k++, p++) {
-      int c = cmp_warm(d->warm + p, key);
+      int c = cmp_key(d->warm + p, geom, vertex);
       if (c == 0) {
         *cursor = p + 1;
         return d->warm + p;
@@ -251,9 +255,16 @@ static const ssWarmEntry *find_warm(const ssData *d, const ssWarmEntry *key,
       if (c > 0) return NULL; /* passed it: not cached */
     }
   }
-  const ssWarmEntry *e = bsearch(key, d->warm, (size_t)n, sizeof *key, cmp_warm);
-  if (e) *cursor = (int)(e - d->warm) + 1;
-  return e;
+  /* the first entry not below the key */
+  int a = 0, b = n;
+  while (a < b) {
+    int mid = a + (b - a) / 2;
+    if (cmp_key(d->warm + mid, geom, vertex) < 0) a = mid + 1;
+    else b = mid;
+  }
+  if (a == n || cmp_key(d->warm + a, geom, vertex) != 0) return NULL;
+  *cursor = a + 1;
+  return d->warm + a;
 }
 
 /* A rigid body's run of contacts in the warm start: the sum of their
@@ -292,9 +303,9 @@ static int warm_start(const ssModel *m, ssData *d, int converged, int creep_rate
     c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
     if (!m->opt.terrain_warm_start || c->type == SS_CONTACT_RIGID || !d->nwarm)
       continue;
-    ssWarmEntry key = {c->vertex, c->geom, 0, {0, 0, 0}, {0, 0, 0}};
-    if (c->type != SS_CONTACT_SOIL) row_key(d, c, &key);
-    const ssWarmEntry *e = find_warm(d, &key, &cursor);
+    int geom = c->geom, vertex = c->vertex;
+    if (c->type != SS_CONTACT_SOIL) row_key(d, c, &geom, &vertex);
+    const ssWarmEntry *e = find_warm(d, geom, vertex, &cursor);
     if (!e) continue;
     if (c->type == SS_CONTACT_PD) {
       double l = e->traction[0] * dt;
@@ -303,9 +314,13 @@ static int warm_start(const ssModel *m, ssData *d, int converged, int creep_rate
       c->lambda[0] = e->traction[0] > 0 ? e->traction[0] * dt : 0;
     } else {
       double scale = c->area * dt, t[3];
-      int rate = !e->creep || creep_rates;
-      left += !rate && (e->rate[0] != 0 || e->rate[1] != 0 || e->rate[2] != 0);
-      for (int k = 0; k < 3; k++) t[k] = e->traction[k] + (rate ? e->rate[k] : 0);
+      static const double none[3] = {0, 0, 0};
+      const double *rate = e->rate;
+      if (e->creep && !creep_rates) {
+        rate = none;
+        left++;
+      }
+      for (int k = 0; k < 3; k++) t[k] = e->traction[k] + rate[k];
       memcpy(c->warm_t, e->traction, sizeof c->warm_t);
       c->warm_trend = converged;
       double ln = t[0] > 0 ? t[0] * scale : 0;
@@ -445,6 +460,7 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
     const ssContact *c = d->contact + i;
     if (!cached(c)) continue;
     ssWarmEntry *e = next + n++;
+    e->creep = 0;
     if (c->type == SS_CONTACT_SOIL) {
       double inv = 1.0 / (c->area * dt);
       int trend = c->warm_trend && d->stats.converged;
@@ -468,7 +484,7 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
         g[2] += fabs(c->lambda[1]) + fabs(c->lambda[2]);
       }
     } else {
-      row_key(d, c, e);
+      row_key(d, c, &e->geom, &e->vertex);
       e->traction[0] = c->lambda[0] / dt;
       e->traction[1] = e->traction[2] = 0;
       e->rate[0] = e->rate[1] = e->rate[2] = 0;
@@ -481,8 +497,11 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
     p[0] = p[1] > 0 && p[0] < CREEP_SLIP * CREEP_SLIP && p[2] > CREEP_SHEAR * p[1];
     creeping |= p[0] != 0;
   }
-  for (int k = 0; k < n; k++)
-    next[k].creep = creeping && next[k].geom >= 0 && patch[3 * next[k].geom] != 0;
+  for (int k = 0; k < n && creeping; k++) {
+    ssWarmEntry *e = next + k;
+    e->creep = e->geom >= 0 && patch[3 * e->geom] != 0 &&
+               (e->rate[0] != 0 || e->rate[1] != 0 || e->rate[2] != 0);
+  }
   if (sort_runs(next, d->warm, n) == next) {
     /* sorted in warm_next: the buffers change places (and capacities) */
     int cap = d->cap_warm;

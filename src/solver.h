@@ -80,9 +80,9 @@ struct ssContact {
 struct ssWarmEntry {
   int vertex;        /* absolute soil vertex (joint rows: see row_key) */
   int geom;
-  int creep;         /* 1: its collider crept (solver.c, CREEP_SLIP): the
-                        warm start leaves its rate out, unless the Newton
-                        phase fails without */
+  int creep;         /* 1: its collider crept (solver.c, CREEP_SLIP) and
+                        its rate is not 0: the warm start leaves the rate
+                        out, unless the Newton phase fails without */
   double traction[3];/* impulse / (area dt), contact frame (Pa); joint
                         rows: impulse / dt in traction[0] */
   double rate[3];    /* traction change over the last step (Pa); 0 for rows */
