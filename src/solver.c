@@ -411,23 +411,6 @@ SS_SORT_RUNS(sort_runs, ssWarmEntry, warm_less)
 #define CREEP_SLIP 1e-4
 #define CREEP_SHEAR 1e-6
 
-void ss_solver_pow_tables(const ssModel *m, ssData *d)
-{
-  for (int h = 0; h < m->nhfield; h++) {
-    double a = m->hfield_soilmat[h].sinkage_exponent - 1;
-    ssPowTable *t = d->hfield_pow + h;
-    if (m->hfield_soil[h] && a != 0 && t->ser.a != a)
-      ss_pow_table_init(t, a);
-  }
-}
-
-const ssPowTable *ss_solver_pow_table(const ssModel *m, const ssData *d, int h)
-{
-  const ssPowTable *t = d->hfield_pow + h;
-  double a = m->hfield_soilmat[h].sinkage_exponent - 1;
-  return t->ok && t->ser.a == a ? t : NULL;
-}
-
 /* keep this step's converged tractions (soil) and impulse rates (joint
  * rows) for the next one */
 ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
@@ -701,4 +684,22 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
       c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
   }
   return SS_OK;
+}
+
+/* the soil beds' tables of powers (solver.h) */
+void ss_solver_pow_tables(const ssModel *m, ssData *d)
+{
+  for (int h = 0; h < m->nhfield; h++) {
+    double a = m->hfield_soilmat[h].sinkage_exponent - 1;
+    ssPowTable *t = d->hfield_pow + h;
+    if (m->hfield_soil[h] && a != 0 && t->ser.a != a)
+      ss_pow_table_init(t, a);
+  }
+}
+
+const ssPowTable *ss_solver_pow_table(const ssModel *m, const ssData *d, int h)
+{
+  const ssPowTable *t = d->hfield_pow + h;
+  double a = m->hfield_soilmat[h].sinkage_exponent - 1;
+  return t->ok && t->ser.a == a ? t : NULL;
 }
