@@ -581,16 +581,17 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   int sweeps = d->ncontact ? m->opt.solver_max_sweeps : 0;
   if (!d->solver_gs_only) {
     double res;
-    int ok = ss_newton_solve(m, d, first_row, &st->newton, &st->newton_sticking, &res) &&
-             res <= tol;
-    if (!ok && left) {
-      /* failed from the creeping colliders' last tractions: again from
-       * their extrapolation (CREEP_SLIP) */
+    int done = ss_newton_solve(m, d, first_row, &st->newton, &st->newton_sticking, &res);
+    int ok = done && res <= tol;
+    if (!done && left) {
+      /* declined from the creeping colliders' last tractions: again from
+       * their extrapolation (CREEP_SLIP).  (An answer that only missed
+       * the check is kept: the sweeps finish it.) */
       int it = st->newton;
       if (m->nv) memcpy(d->qvel, d->qvel_free, (size_t)m->nv * sizeof(double));
       warm_start(m, d, converged, 1);
-      ok = ss_newton_solve(m, d, first_row, &st->newton, &st->newton_sticking, &res) &&
-           res <= tol;
+      done = ss_newton_solve(m, d, first_row, &st->newton, &st->newton_sticking, &res);
+      ok = done && res <= tol;
       st->newton += it;
     }
     if (ok) {
