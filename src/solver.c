@@ -399,7 +399,7 @@ SS_SORT_RUNS(sort_runs, ssWarmEntry, warm_less)
  * no extrapolation of its last two, and an extrapolated warm start (rates
  * in ssWarmEntry) is further from the answer than the last tractions
  * themselves.  Its cache entries are marked (creep): the warm start leaves
- * their rates out, and only where the Newton phase then fails does it
+ * their rates out, and only where the Newton phase then declines does it
  * start again from the extrapolation.  (plate_arm.xml, whose plate creeps
  * at 1e-7 to 1e-5 m/s under the lift's pull: with the rates always, 27
  * sweeps per step; without them, 4.7, nearly all in steps 201-500 where
