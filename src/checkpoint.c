@@ -930,15 +930,6 @@ static ssStatus read_doubles(const Parsed *f, int s, size_t n, double *out,
   return SS_OK;
 }
 
-/* the solver's cache order (solver.c cmp_warm): collider, then vertex,
- * the joint rows (geom < 0, as unsigned) last */
-static int cmp_key(const ssWarmEntry *a, const ssWarmEntry *b)
-{
-  unsigned ga = (unsigned)a->geom, gb = (unsigned)b->geom;
-  if (ga != gb) return (ga > gb) - (ga < gb);
-  return (a->vertex > b->vertex) - (a->vertex < b->vertex);
-}
-
 /* Everything read from a file before it is put into the data. */
 typedef struct State {
   double time, closure;
@@ -1066,7 +1057,7 @@ static ssStatus parse_state(const ssModel *m, const Parsed *f, const char *path,
     key_ok = key_ok && (e->creep == 0 || (e->creep == 1 && e->geom >= 0));
     if (!key_ok || !isfinite(e->traction[0]) || !isfinite(e->traction[1]) ||
         !isfinite(e->traction[2]) || !isfinite(e->rate[0]) || !isfinite(e->rate[1]) ||
-        !isfinite(e->rate[2]) || (k && cmp_key(e - 1, e) > 0))
+        !isfinite(e->rate[2]) || (k && ss_solver_warm_cmp(e - 1, e) > 0))
       return corrupt(err, path, "bad warm-start cache");
   }
 

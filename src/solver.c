@@ -228,6 +228,11 @@ static int cmp_warm(const ssWarmEntry *a, const ssWarmEntry *b)
   return cmp_key(a, b->geom, b->vertex);
 }
 
+int ss_solver_warm_cmp(const ssWarmEntry *a, const ssWarmEntry *b)
+{
+  return cmp_warm(a, b);
+}
+
 /* cache key of a joint row: its dof and kind (PD, or the limit's side) */
 static void row_key(const ssData *d, const ssContact *c, int *geom, int *vertex)
 {

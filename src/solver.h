@@ -88,6 +88,11 @@ struct ssWarmEntry {
   double rate[3];    /* traction change over the last step (Pa); 0 for rows */
 };
 
+/* The warm-start cache's order (<0, 0, >0): by collider, then vertex,
+ * the joint rows last; checkpoints hold the cache in it (checkpoint.c
+ * checks a file's entries with it). */
+int ss_solver_warm_cmp(const ssWarmEntry *a, const ssWarmEntry *b);
+
 /* Room for one more contact (zeroed, its point cache empty, link = -1)
  * with njac doubles of Jacobian storage in d->jac (6 nv for J and W, 36
  * for a link contact's X and LX); NULL when out of memory. */
