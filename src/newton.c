@@ -806,9 +806,9 @@ static int evaluate(const ssModel *m, const ssData *d, const Setup *s,
                : evaluate_at(m, d, s, w, y, mu, F, H, q, lam_out, ie, 1, 0);
 }
 
-static inline __attribute__((always_inline)) int evaluate_F(const ssModel *m, const ssData *d, const Setup *s,
-                      const ssNewtonWork *w, const double *y, double *mu, double *F,
-                      double *lam_out, NImpEval *ie)
+static inline __attribute__((always_inline)) int
+evaluate_F(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWork *w,
+           const double *y, double *mu, double *F, double *lam_out, NImpEval *ie)
 {
   return w->ns ? evaluate_at(m, d, s, w, y, mu, F, NULL, NULL, lam_out, ie, 0, 1)
                : evaluate_at(m, d, s, w, y, mu, F, NULL, NULL, lam_out, ie, 0, 0);
