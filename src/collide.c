@@ -17,7 +17,7 @@ _Static_assert(SS_FOOTPRINT_SEGMENTS % 4 == 0, "SS_FOOTPRINT_SEGMENTS must be a 
 #define HULL_IN_MAX (2 * SS_FOOTPRINT_SEGMENTS)
 
 /* room for a convex polygon clipped by four half-planes, plus slack */
-#define CLIP_MAX (SS_POLY_MAX + 8)
+#define CLIP_MAX SS_POLY_CLIP_MAX
 
 /* relative tolerance (of the squared extent) below which three hull points
  * count as collinear: removes duplicated and near-duplicated corners */
@@ -521,30 +521,36 @@ static int clip_slab(const double *ic, const double *io, int n, const int *rg,
   return m;
 }
 
-int ss_poly_xchains(const ssPoly2 *p, ssPolyChains *c)
+/* the two chains of the polygon (co, n) monotone in the coordinate co */
+static int mono_chains(const double *co, int n, ssPolyChains *c)
 {
-  int n = p->n, l = 0, r = 0;
+  int l = 0, r = 0;
   if (n < 3) return 0;
   for (int i = 1; i < n; i++) {
-    if (p->x[i] < p->x[l]) l = i;
-    if (p->x[i] > p->x[r]) r = i;
+    if (co[i] < co[l]) l = i;
+    if (co[i] > co[r]) r = i;
   }
   if (l == r) return 0;
-  /* x must not fall from l to r, nor rise from r back to l */
+  /* co must not fall from l to r, nor rise from r back to l */
   for (int i = l; i != r;) {
     int k = i + 1 < n ? i + 1 : 0;
-    if (p->x[k] < p->x[i]) return 0;
+    if (co[k] < co[i]) return 0;
     i = k;
   }
   for (int i = r; i != l;) {
     int k = i + 1 < n ? i + 1 : 0;
-    if (p->x[k] > p->x[i]) return 0;
+    if (co[k] > co[i]) return 0;
     i = k;
   }
   c->l = l;
   c->r = r;
   for (int k = 0; k < 4; k++) c->hint[k] = -1;
   return 1;
+}
+
+int ss_poly_ychains(const ssPoly2 *p, ssPolyChains *c)
+{
+  return mono_chains(p->y, p->n, c);
 }
 
 /* whether sgn (x[start + k] - v) >= 0 (> 0 when strict), indices modulo
@@ -600,16 +606,17 @@ static int chain_search(const double *x, int n, int start, int cnt, double v,
   return a;
 }
 
-/* the edges (index of their end vertex) of chain start -> start + cnt whose
- * x range meets [x0, x1], as up to two ascending index ranges */
-static int chain_edges(const ssPoly2 *p, int start, int cnt, double sgn,
+/* the edges (index of their end vertex) of chain start -> start + cnt of
+ * the polygon (co, n) whose range in the coordinate co meets [x0, x1], as
+ * up to two ascending index ranges */
+static int chain_edges(const double *co, int n, int start, int cnt, double sgn,
                        double x0, double x1, int hint[2], int *rg)
 {
-  int n = p->n, s1 = start + 1 < n ? start + 1 : 0;
-  /* sgn = 1: x rises along the chain; edge k runs from vertex k to k + 1 */
+  int s1 = start + 1 < n ? start + 1 : 0;
+  /* sgn = 1: co rises along the chain; edge k runs from vertex k to k + 1 */
   double enter = sgn > 0 ? x0 : x1, leave = sgn > 0 ? x1 : x0;
-  int k0 = chain_search(p->x, n, s1, cnt, enter, sgn, 0, hint);
-  int k1 = chain_search(p->x, n, start, cnt, leave, sgn, 1, hint + 1);
+  int k0 = chain_search(co, n, s1, cnt, enter, sgn, 0, hint);
+  int k1 = chain_search(co, n, start, cnt, leave, sgn, 1, hint + 1);
   if (k1 <= k0) return 0;
   int a = s1 + k0;
   if (a >= n) a -= n;
@@ -626,33 +633,17 @@ static int chain_edges(const ssPoly2 *p, int start, int cnt, double sgn,
   return 2;
 }
 
-/* area and centroid of p clipped to the rectangle: x first, visiting the
- * edge ranges rg (or all edges when nr < 0), then y */
-static double rect_area(const ssPoly2 *p, const int *rg, int nr, double x0,
-                        double x1, double y0, double y1, double *cx, double *cy)
+/* area of the polygon (x, y) (n > 2, kept about (mx, my)) and, when cx
+ * and cy are not NULL and the area is not 0, its centroid */
+static double shoelace(const double *x, const double *y, int n, double mx, double my,
+                       double *cx, double *cy)
 {
-  double ax[CLIP_MAX], ay[CLIP_MAX], bx[CLIP_MAX], by[CLIP_MAX];
-  int all[2] = {0, p->n};
-  if (nr < 0) {
-    rg = all;
-    nr = 1;
-  }
-
-  /* work about the rectangle's centre: small numbers, exact corners */
-  double mx = 0.5 * (x0 + x1), my = 0.5 * (y0 + y1);
-  int n = clip_slab(p->x, p->y, p->n, rg, nr, mx, my, ax, ay, x0 - mx, x1 - mx);
-  if (n < 3) return 0;
-  all[1] = n;
-  n = clip_slab(ay, ax, n, all, 1, 0, 0, by, bx, y0 - my, y1 - my);
-  if (n < 3) return 0;
-
-  /* shoelace area and centroid */
   double a2 = 0, sx = 0, sy = 0;
   for (int i = 0, j = n - 1; i < n; j = i++) {
-    double cr = bx[j] * by[i] - bx[i] * by[j];
+    double cr = x[j] * y[i] - x[i] * y[j];
     a2 += cr;
-    sx += (bx[j] + bx[i]) * cr;
-    sy += (by[j] + by[i]) * cr;
+    sx += (x[j] + x[i]) * cr;
+    sy += (y[j] + y[i]) * cr;
   }
   if (a2 == 0) return 0;
   if (cx && cy) {
@@ -662,26 +653,20 @@ static double rect_area(const ssPoly2 *p, const int *rg, int nr, double x0,
   return fabs(0.5 * a2);
 }
 
-double ss_poly_rect_area(const ssPoly2 *p, double x0, double x1, double y0,
-                         double y1, double *cx, double *cy)
+/* The edges of the polygon (co, n) whose range in co meets the slab
+ * [c0, c1] widened far beyond round-off (every edge a clip against the
+ * slab would take something from: it compares co - m with c0 - m), as
+ * ascending index ranges in rg (room for 4), found along its chains c
+ * monotone in co (ss_poly_ychains).  Returns their
+ * count. */
+static int slab_edges(const double *co, int n, ssPolyChains *c, double c0, double c1,
+                      int rg[8])
 {
-  if (p->n < 3 || !(x1 > x0) || !(y1 > y0)) return 0;
-  return rect_area(p, NULL, -1, x0, x1, y0, y1, cx, cy);
-}
-
-double ss_poly_rect_area_x(const ssPoly2 *p, ssPolyChains *c, double x0, double x1,
-                           double y0, double y1, double *cx, double *cy)
-{
-  if (p->n < 3 || !(x1 > x0) || !(y1 > y0)) return 0;
-  /* the edges whose x range meets the slab widened far beyond round-off:
-   * every edge the clip would take something from (it compares x - mx
-   * with x0 - mx) */
-  int n = p->n, l = c->l, r = c->r, rg[8], nr = 0;
-  double tol = 1e-9 * (fabs(x0) + fabs(x1));
-  double lo = x0 - tol, hi = x1 + tol;
-  nr += chain_edges(p, l, (r - l + n) % n, 1, lo, hi, c->hint, rg);
-  nr += chain_edges(p, r, (l - r + n) % n, -1, lo, hi, c->hint + 2, rg + 2 * nr);
-  if (nr == 0) return 0;
+  int l = c->l, r = c->r, nr = 0;
+  double tol = 1e-9 * (fabs(c0) + fabs(c1));
+  double lo = c0 - tol, hi = c1 + tol;
+  nr += chain_edges(co, n, l, (r - l + n) % n, 1, lo, hi, c->hint, rg);
+  nr += chain_edges(co, n, r, (l - r + n) % n, -1, lo, hi, c->hint + 2, rg + 2 * nr);
   /* ascending, as the clip visits them */
   for (int i = 1; i < nr; i++)
     for (int k = i; k > 0 && rg[2 * k - 2] > rg[2 * k]; k--) {
@@ -691,7 +676,118 @@ double ss_poly_rect_area_x(const ssPoly2 *p, ssPolyChains *c, double x0, double 
       rg[2 * k] = a;
       rg[2 * k + 1] = b;
     }
-  return rect_area(p, rg, nr, x0, x1, y0, y1, cx, cy);
+  return nr;
+}
+
+double ss_poly_rect_area(const ssPoly2 *p, double x0, double x1, double y0,
+                         double y1, double *cx, double *cy)
+{
+  if (p->n < 3 || !(x1 > x0) || !(y1 > y0)) return 0;
+  double ax[CLIP_MAX], ay[CLIP_MAX], bx[CLIP_MAX], by[CLIP_MAX];
+  int all[2] = {0, p->n};
+  /* x first, then y, about the rectangle's centre: small numbers, exact
+   * corners */
+  double mx = 0.5 * (x0 + x1), my = 0.5 * (y0 + y1);
+  int n = clip_slab(p->x, p->y, p->n, all, 1, mx, my, ax, ay, x0 - mx, x1 - mx);
+  if (n < 3) return 0;
+  all[1] = n;
+  n = clip_slab(ay, ax, n, all, 1, 0, 0, by, bx, y0 - my, y1 - my);
+  if (n < 3) return 0;
+  return shoelace(bx, by, n, mx, my, cx, cy);
+}
+
+/* one chain of a band: m vertices in x order (within round-off) */
+typedef struct BandChain {
+  int m, k;
+  const double *x, *y;
+} BandChain;
+
+/* The integrals of y, x y and y^2 dx along chain c from x = a to x = b
+ * (in its x order), x taken about sh: each edge piece is linear, so the
+ * trapezoid rule is exact for y and Simpson's for x y and y^2.  c->k, the
+ * first edge that may reach past a, moves on as the cells do. */
+static void chain_integrals(BandChain *c, double a, double b, double sh, double I[3])
+{
+  const double *x = c->x, *y = c->y;
+  int k = c->k;
+  if (k > 0 && x[k] > a) k = 0;
+  while (k < c->m - 2 && x[k + 1] <= a) k++;
+  c->k = k;
+  I[0] = I[1] = I[2] = 0;
+  for (; k < c->m - 1 && x[k] < b; k++) {
+    double xa = x[k], xb = x[k + 1];
+    if (!(xb > xa)) continue; /* an edge along y adds nothing */
+    double s = xa > a ? xa : a, t = xb < b ? xb : b, w = t - s;
+    if (!(w > 0)) continue;
+    double slope = (y[k + 1] - y[k]) / (xb - xa);
+    double ys = s == xa ? y[k] : y[k] + (s - xa) * slope;
+    double yt = t == xb ? y[k + 1] : y[k] + (t - xa) * slope;
+    double su = s - sh, tu = t - sh;
+    I[0] += 0.5 * w * (ys + yt);
+    I[1] += w * (su * (2 * ys + yt) + tu * (ys + 2 * yt)) / 6;
+    I[2] += w * (ys * ys + ys * yt + yt * yt) / 3;
+  }
+}
+
+int ss_poly_band(const ssPoly2 *p, ssPolyChains *yc, double y0, double y1, double ox,
+                 ssPolyBand *b)
+{
+  b->n = b->l = 0;
+  b->ox = ox;
+  b->oy = 0.5 * (y0 + y1);
+  if (p->n < 3 || !(y1 > y0)) return 1;
+  /* the edges near the band; all of a small polygon (a box's), which
+   * cost less than their search */
+  int rg[8] = {0, p->n}, nr = p->n <= 16 ? 1 : slab_edges(p->y, p->n, yc, y0, y1, rg);
+  if (nr == 0) return 1;
+  double x[SS_POLY_CLIP_MAX], y[SS_POLY_CLIP_MAX];
+  int n = clip_slab(p->y, p->x, p->n, rg, nr, b->oy, ox, y, x, y0 - b->oy, y1 - b->oy);
+  if (n < 3) return 1;
+  /* its two chains monotone in x, both from the least x to the greatest:
+   * the one the polygon runs along (x, y) from l to r, and the one it
+   * runs back along, reversed */
+  ssPolyChains c;
+  if (!mono_chains(x, n, &c)) return 0;
+  int m = 0;
+  for (int i = c.l;; i = i + 1 < n ? i + 1 : 0) {
+    b->x[m] = x[i];
+    b->y[m++] = y[i];
+    if (i == c.r) break;
+  }
+  b->l = m;
+  for (int i = c.l;; i = i > 0 ? i - 1 : n - 1) {
+    b->x[m] = x[i];
+    b->y[m++] = y[i];
+    if (i == c.r) break;
+  }
+  b->n = m;
+  b->k[0] = b->k[1] = 0;
+  return 1;
+}
+
+double ss_poly_band_area(ssPolyBand *b, double x0, double x1, double *cx, double *cy)
+{
+  if (b->n == 0 || !(x1 > x0)) return 0;
+  /* Green's theorem: area, int x dA and int y dA of the cell's part are
+   * -(closed) integrals of y, x y and y^2 / 2 dx along its boundary, whose
+   * parts along the cell's sides (dx = 0) add nothing: the chain the
+   * polygon runs forwards (lower, when counter-clockwise) counts
+   * negatively, the other (run backwards here) positively */
+  double mx = 0.5 * (x0 + x1), sh = mx - b->ox, a = x0 - b->ox, e = x1 - b->ox;
+  BandChain f = {b->l, b->k[0], b->x, b->y};
+  BandChain r = {b->n - b->l, b->k[1], b->x + b->l, b->y + b->l};
+  double If[3], Ir[3];
+  chain_integrals(&f, a, e, sh, If);
+  chain_integrals(&r, a, e, sh, Ir);
+  b->k[0] = f.k;
+  b->k[1] = r.k;
+  double A = Ir[0] - If[0];
+  if (A == 0) return 0;
+  if (cx && cy) {
+    *cx = mx + (Ir[1] - If[1]) / A;
+    *cy = b->oy + 0.5 * (Ir[2] - If[2]) / A;
+  }
+  return fabs(A);
 }
 
 int ss_poly_chord(const ssPoly2 *p, double y, double *x0, double *x1)

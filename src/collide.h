@@ -48,23 +48,43 @@ double ss_poly_area(const ssPoly2 *p);
  * area is > 0 and cx, cy are not NULL they receive its centroid. */
 double ss_poly_rect_area(const ssPoly2 *p, double x0, double x1, double y0,
                          double y1, double *cx, double *cy);
-/* A polygon's split into two chains monotone in x: a vertex of least x
- * (l) and one of greatest x (r), and where the last searches along the
- * chains ended (hint: ss_poly_rect_area_x starts its next searches there,
- * so that cells visited in order cost a step or two each). */
+/* A polygon's split into two chains monotone in y: a vertex of least y
+ * (l) and one of greatest y (r), and where the last searches along the
+ * chains ended (hint: ss_poly_band starts its next searches there, so that
+ * rows visited in order cost a step or two each). */
 typedef struct ssPolyChains {
   int l, r;
   int hint[4];
 } ssPolyChains;
 /* The chains of p (hints cleared); 0 (c untouched) when it has none (fewer
- * than 3 vertices, zero width, not convex). */
-int ss_poly_xchains(const ssPoly2 *p, ssPolyChains *c);
-/* ss_poly_rect_area, bit for bit, given ss_poly_xchains' chains: visits
- * only the edges near [x0, x1] (found by galloping from the hints, then
- * bisection, on the chains), so its cost hardly grows with the polygon's
- * vertex count.  Updates c's hints. */
-double ss_poly_rect_area_x(const ssPoly2 *p, ssPolyChains *c, double x0, double x1,
-                           double y0, double y1, double *cx, double *cy);
+ * than 3 vertices, zero height, not convex). */
+int ss_poly_ychains(const ssPoly2 *p, ssPolyChains *c);
+
+/* A row band of a convex polygon: its part in y0 <= y <= y1, as its two
+ * chains monotone in x, whose cells [x0, x1] x [y0, y1] then cost a few
+ * edge integrals each (ss_poly_band_area) instead of ss_poly_rect_area's
+ * two clips.  Kept about (ox, oy), oy the band's middle and ox the
+ * caller's, near the cells (digits: the coordinates stay small). */
+#define SS_POLY_CLIP_MAX (SS_POLY_MAX + 8)
+typedef struct ssPolyBand {
+  int n, l;        /* vertices; the first chain's count (x[0..l-1]) */
+  int k[2];        /* each chain's edge the last cell began at */
+  double ox, oy;
+  double x[2 * SS_POLY_CLIP_MAX], y[2 * SS_POLY_CLIP_MAX];
+} ssPolyBand;
+/* The band of p between y0 and y1 about (ox, (y0 + y1) / 2), visiting
+ * only the edges near it along p's y chains yc (ss_poly_ychains; their
+ * hints are updated).  Returns 0 when the band's chains are not monotone
+ * in x (round-off on a polygon too thin to tell): then use
+ * ss_poly_rect_area.  An empty band (n = 0) gives 0 for every cell. */
+int ss_poly_band(const ssPoly2 *p, ssPolyChains *yc, double y0, double y1, double ox,
+                 ssPolyBand *b);
+/* ss_poly_rect_area of the band's polygon for the cell [x0, x1] x [y0, y1]
+ * of its rows: the same area and centroid to round-off (integrated along
+ * the chains, not clipped).  Cheapest with the cells visited in order of
+ * x (the chains' places are kept in b). */
+double ss_poly_band_area(ssPolyBand *b, double x0, double x1, double *cx, double *cy);
+
 /* The chord [*x0, *x1] of a convex polygon on the line at height y;
  * 0 when the line misses it. */
 int ss_poly_chord(const ssPoly2 *p, double y, double *x0, double *x1);

@@ -179,8 +179,11 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
 
   ssPoly2 fp;
   ss_shape_footprint(&s, &fp);
-  ssPolyChains chains;
-  int mono = ss_poly_xchains(&fp, &chains);
+  /* a row's cells on the footprint's edge are clipped in x alone, in the
+   * row's band of the footprint (formed at the row's first such cell) */
+  ssPolyChains ych;
+  ssPolyBand band;
+  int banded = ss_poly_ychains(&fp, &ych);
   double up[3] = {0, 0, 1};
   double width = ss_shape_width(&s, up);
   double frame[9];
@@ -208,13 +211,17 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       in0 = fmax(a0, b0) + 1e-9 * dx;
       in1 = fmin(a1, b1) - 1e-9 * dx;
     }
+    int band_ready = 0;
     for (int i = i0; i <= i1; i++) {
       double x = x0 + i * dx;
       double cx0 = i == 0 ? x : x - 0.5 * dx, cx1 = i == nx - 1 ? x : x + 0.5 * dx;
       double qx = x, qy = y, full = (cx1 - cx0) * (cy1 - cy0), area = full;
       if (!(cx0 > in0 && cx1 < in1)) {
-        area = mono ? ss_poly_rect_area_x(&fp, &chains, cx0, cx1, cy0, cy1, &qx, &qy)
-                    : ss_poly_rect_area(&fp, cx0, cx1, cy0, cy1, &qx, &qy);
+        if (!band_ready) {
+          band_ready = banded && ss_poly_band(&fp, &ych, cy0, cy1, x, &band) ? 1 : -1;
+        }
+        area = band_ready > 0 ? ss_poly_band_area(&band, cx0, cx1, &qx, &qy)
+                              : ss_poly_rect_area(&fp, cx0, cx1, cy0, cy1, &qx, &qy);
         if (!(area > tiny)) continue;
         /* the point represents the covered part of the cell: the vertex
          * when the cell is fully covered, else the covered part's centroid
