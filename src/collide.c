@@ -16,6 +16,10 @@ _Static_assert(SS_FOOTPRINT_SEGMENTS % 4 == 0, "SS_FOOTPRINT_SEGMENTS must be a 
 /* points fed to the hull: two caps of SS_FOOTPRINT_SEGMENTS each at most */
 #define HULL_IN_MAX (2 * SS_FOOTPRINT_SEGMENTS)
 
+/* polygons of at most this many vertices (a box's footprint) visit all
+ * their edges: cheaper than searching the chains for the few near a row */
+#define SMALL_POLY 16
+
 /* room for a convex polygon clipped by four half-planes, plus slack */
 #define CLIP_MAX SS_POLY_CLIP_MAX
 
@@ -736,9 +740,7 @@ int ss_poly_band(const ssPoly2 *p, ssPolyChains *yc, double y0, double y1, doubl
   b->ox = ox;
   b->oy = 0.5 * (y0 + y1);
   if (p->n < 3 || !(y1 > y0)) return 1;
-  /* the edges near the band; all of a small polygon (a box's), which
-   * cost less than their search */
-  int rg[8] = {0, p->n}, nr = p->n <= 16 ? 1 : slab_edges(p->y, p->n, yc, y0, y1, rg);
+  int rg[8] = {0, p->n}, nr = p->n <= SMALL_POLY ? 1 : slab_edges(p->y, p->n, yc, y0, y1, rg);
   if (nr == 0) return 1;
   double x[SS_POLY_CLIP_MAX], y[SS_POLY_CLIP_MAX];
   int n = clip_slab(p->y, p->x, p->n, rg, nr, b->oy, ox, y, x, y0 - b->oy, y1 - b->oy);
@@ -790,27 +792,45 @@ double ss_poly_band_area(ssPolyBand *b, double x0, double x1, double *cx, double
   return fabs(A);
 }
 
-int ss_poly_chord(const ssPoly2 *p, double y, double *x0, double *x1)
+/* the chord at height y over the edges in the ascending ranges rg (edge
+ * i ends at vertex i); the others must not reach y */
+static int chord_of(const ssPoly2 *p, const int *rg, int nr, double y, double *x0,
+                    double *x1)
 {
   double lo = INFINITY, hi = -INFINITY;
-  for (int i = 0, j = p->n - 1; i < p->n; j = i++) {
-    double ya = p->y[j], yb = p->y[i];
-    if ((ya > y && yb > y) || (ya < y && yb < y)) continue;
-    double x;
-    if (ya == yb) {
-      /* an edge along the line: both ends */
-      lo = fmin(lo, fmin(p->x[i], p->x[j]));
-      hi = fmax(hi, fmax(p->x[i], p->x[j]));
-      continue;
+  for (int r = 0; r < nr; r++)
+    for (int i = rg[2 * r]; i < rg[2 * r + 1]; i++) {
+      int j = i > 0 ? i - 1 : p->n - 1;
+      double ya = p->y[j], yb = p->y[i];
+      if ((ya > y && yb > y) || (ya < y && yb < y)) continue;
+      double x;
+      if (ya == yb) {
+        /* an edge along the line: both ends */
+        lo = fmin(lo, fmin(p->x[i], p->x[j]));
+        hi = fmax(hi, fmax(p->x[i], p->x[j]));
+        continue;
+      }
+      x = p->x[j] + (y - ya) / (yb - ya) * (p->x[i] - p->x[j]);
+      lo = fmin(lo, x);
+      hi = fmax(hi, x);
     }
-    x = p->x[j] + (y - ya) / (yb - ya) * (p->x[i] - p->x[j]);
-    lo = fmin(lo, x);
-    hi = fmax(hi, x);
-  }
   if (!(hi >= lo)) return 0;
   *x0 = lo;
   *x1 = hi;
   return 1;
+}
+
+int ss_poly_chord(const ssPoly2 *p, double y, double *x0, double *x1)
+{
+  int all[2] = {0, p->n};
+  return chord_of(p, all, 1, y, x0, x1);
+}
+
+int ss_poly_chord_y(const ssPoly2 *p, ssPolyChains *yc, double y, double *x0, double *x1)
+{
+  if (!yc || p->n <= SMALL_POLY) return ss_poly_chord(p, y, x0, x1);
+  int rg[8], nr = slab_edges(p->y, p->n, yc, y, y, rg);
+  return chord_of(p, rg, nr, y, x0, x1);
 }
 
 int ss_poly_contains(const ssPoly2 *p, double x, double y)

@@ -88,6 +88,9 @@ double ss_poly_band_area(ssPolyBand *b, double x0, double x1, double *cx, double
 /* The chord [*x0, *x1] of a convex polygon on the line at height y;
  * 0 when the line misses it. */
 int ss_poly_chord(const ssPoly2 *p, double y, double *x0, double *x1);
+/* ss_poly_chord, bit for bit, visiting only the edges near y along p's y
+ * chains yc (ss_poly_ychains; their hints are updated); yc NULL: all. */
+int ss_poly_chord_y(const ssPoly2 *p, ssPolyChains *yc, double y, double *x0, double *x1);
 /* 1 if (x, y) lies inside or on the polygon. */
 int ss_poly_contains(const ssPoly2 *p, double x, double y);
 /* Lowest point of the shape's surface on the vertical line through (x, y):

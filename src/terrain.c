@@ -205,8 +205,9 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
      * of 1e-9 dx leaves the cells on the footprint's edge to the clipping
      * (and covers the round-off between the two rows' shared boundary) */
     double in0 = INFINITY, in1 = -INFINITY, a0 = b0, a1 = b1;
-    int a_ok = j > j0 ? b_ok : ss_poly_chord(&fp, cy0, &a0, &a1);
-    b_ok = ss_poly_chord(&fp, cy1, &b0, &b1);
+    ssPolyChains *yc = banded ? &ych : NULL;
+    int a_ok = j > j0 ? b_ok : ss_poly_chord_y(&fp, yc, cy0, &a0, &a1);
+    b_ok = ss_poly_chord_y(&fp, yc, cy1, &b0, &b1);
     if (a_ok && b_ok) {
       in0 = fmax(a0, b0) + 1e-9 * dx;
       in1 = fmin(a1, b1) - 1e-9 * dx;

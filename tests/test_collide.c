@@ -388,7 +388,7 @@ static void test_poly_band(void)
 {
   double R[9];
   int bad_area = 0, bad_centre = 0, differ = 0, cells = 0, hits = 0, split = 0, whole = 0,
-      thin = 0;
+      thin = 0, chords = 0, chords_differ = 0;
   double worst_a = 0, worst_c = 0;
   for (int t = 0; t < 60; t++) {
     int type = t % 4;
@@ -402,6 +402,19 @@ static void test_poly_band(void)
     split++;
     double lo[3], hi[3], dx = urand(0.005, 0.05), dy = urand(0.005, 0.05);
     ss_shape_aabb(&s, lo, hi);
+    /* chords along the chains: at every vertex's height, between, and
+     * beyond the polygon */
+    for (int v = 0; v < p.n; v++) {
+      double a0 = 7, a1 = 7, b0 = 7, b1 = 7;
+      for (int k = 0; k < 3; k++) {
+        double y = k == 0 ? p.y[v] : k == 1 ? 0.5 * (p.y[v] + p.y[(v + 1) % p.n])
+                                            : p.y[v] + (v % 2 ? 1 : -1) * 0.3;
+        int ra = ss_poly_chord(&p, y, &a0, &a1), rb = ss_poly_chord_y(&p, &yc, y, &b0, &b1);
+        chords++;
+        if (ra != rb || (ra && (memcmp(&a0, &b0, sizeof a0) || memcmp(&a1, &b1, sizeof a1))))
+          chords_differ++;
+      }
+    }
     for (double y = lo[1] - dy; y < hi[1] + dy; y += dy) {
       ssPolyBand b;
       double xs = lo[0] - dx;
@@ -448,6 +461,8 @@ static void test_poly_band(void)
      "off in area, worst %.2g of the cell; %d off in centroid, worst %.2g of its size; "
      "%d covered; %d of 60 footprints split, %d bands, %d not)", bad_area, cells, worst_a,
      bad_centre, worst_c, hits, split, whole, thin);
+  ok(chords_differ == 0 && chords > 5000, "chords along the y chains: the full scan's "
+     "bit for bit (%d of %d differ)", chords_differ, chords);
   ok(differ == 0, "row bands: cells visited backwards give the same values bit for bit "
      "(%d differ)", differ);
 
