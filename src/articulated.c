@@ -321,19 +321,19 @@ static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
     if (r == m) continue;
     for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) {
       double h = H[i * n + j], *xj = X + (size_t)m * j;
-      for (r = 0; r < m; r++) xj[r] -= h * xi[r];
+      ss_row_sub_scaled(xj, h, xi, m);
     }
   }
   for (int i = 0; i < n; i++) {
     double h = H[i * n + i], *xi = X + (size_t)m * i;
-    for (int r = 0; r < m; r++) xi[r] /= h;
+    ss_row_div(xi, h, m);
   }
   for (int i = 0; i < n; i++) {
     double *xi = X + (size_t)m * i;
     for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) {
       double h = H[i * n + j];
       const double *xj = X + (size_t)m * j;
-      for (int r = 0; r < m; r++) xi[r] -= h * xj[r];
+      ss_row_sub_scaled(xi, h, xj, m);
     }
   }
 }
@@ -473,9 +473,9 @@ static inline void closure_solve(const ssArtWork *w, double *Z, int m)
     }
     for (int k = 0; k < i; k++) {
       double a = A[i * nr + k];
-      for (int r = 0; r < m; r++) zi[r] -= a * Z[(size_t)m * k + r];
+      ss_row_sub_scaled(zi, a, Z + (size_t)m * k, m);
     }
-    for (int r = 0; r < m; r++) zi[r] /= A[i * nr + i];
+    ss_row_div(zi, A[i * nr + i], m);
   }
   for (int i = nr - 1; i >= 0; i--) {
     double *zi = Z + (size_t)m * i;
@@ -485,9 +485,9 @@ static inline void closure_solve(const ssArtWork *w, double *Z, int m)
     }
     for (int k = i + 1; k < nr; k++) {
       double a = A[k * nr + i];
-      for (int r = 0; r < m; r++) zi[r] -= a * Z[(size_t)m * k + r];
+      ss_row_sub_scaled(zi, a, Z + (size_t)m * k, m);
     }
-    for (int r = 0; r < m; r++) zi[r] /= A[i * nr + i];
+    ss_row_div(zi, A[i * nr + i], m);
   }
 }
 
@@ -716,16 +716,14 @@ static void body_response(const ssModel *m, ssArtWork *w, int lb)
       int k0 = m->body_dofadr[a] - w->v0;
       for (int k = k0; k < k0 + nd; k++) {
         const double *Sk = w->S + 6 * k, *Mk = w->MiKT + (size_t)k * nr;
-        for (int i = 0; i < nr; i++)
-          for (int r = 0; r < 6; r++) Z[6 * i + r] += Sk[r] * Mk[i];
+        for (int i = 0; i < nr; i++) ss_row_add_scaled(Z + 6 * i, Mk[i], Sk, 6);
       }
     }
     closure_solve(w, Z, 6);
     for (int k = 0; k < n; k++) {
       const double *Mk = w->MiKT + (size_t)k * nr;
       double t[6] = {0, 0, 0, 0, 0, 0};
-      for (int i = 0; i < nr; i++)
-        for (int r = 0; r < 6; r++) t[r] += Mk[i] * Z[6 * i + r];
+      for (int i = 0; i < nr; i++) ss_row_add_scaled(t, Mk[i], Z + 6 * i, 6);
       for (int r = 0; r < 6; r++) Y[6 * k + r] -= t[r];
     }
   }
@@ -736,8 +734,7 @@ static void body_response(const ssModel *m, ssArtWork *w, int lb)
     if (!nd) continue;
     int k0 = m->body_dofadr[a] - w->v0;
     for (int k = k0; k < k0 + nd; k++)
-      for (int r = 0; r < 6; r++)
-        for (int c = 0; c < 6; c++) Lam[6 * r + c] += w->S[6 * k + r] * Y[6 * k + c];
+      for (int r = 0; r < 6; r++) ss_row_add_scaled(Lam + 6 * r, w->S[6 * k + r], Y + 6 * k, 6);
   }
   w->Yok[lb] = 1;
 }

@@ -16,6 +16,55 @@
 static inline double ss_max(double a, double b) { return a > b ? a : b; }
 static inline double ss_min(double a, double b) { return a < b ? a : b; }
 
+/* y[0..m) -= a x[0..m) for rows that do not overlap, two lanes at a time
+ * (GCC's vector extension: SSE2 on x86-64, plain pairs elsewhere), the
+ * same products and differences, element by element, as the scalar loop
+ * (no reassociation: the results are bit for bit).  The compiler leaves
+ * the short row loops of the articulated solves scalar otherwise. */
+typedef double ssV2 __attribute__((vector_size(16)));
+static inline void ss_row_sub_scaled(double *y, double a, const double *x, int m)
+{
+  ssV2 av = {a, a};
+  int r = 0;
+  for (; r + 2 <= m; r += 2) {
+    ssV2 xv, yv;
+    memcpy(&xv, x + r, sizeof xv);
+    memcpy(&yv, y + r, sizeof yv);
+    yv -= av * xv;
+    memcpy(y + r, &yv, sizeof yv);
+  }
+  for (; r < m; r++) y[r] -= a * x[r];
+}
+
+/* y[0..m) += a x[0..m), likewise */
+static inline void ss_row_add_scaled(double *y, double a, const double *x, int m)
+{
+  ssV2 av = {a, a};
+  int r = 0;
+  for (; r + 2 <= m; r += 2) {
+    ssV2 xv, yv;
+    memcpy(&xv, x + r, sizeof xv);
+    memcpy(&yv, y + r, sizeof yv);
+    yv += av * xv;
+    memcpy(y + r, &yv, sizeof yv);
+  }
+  for (; r < m; r++) y[r] += a * x[r];
+}
+
+/* y[0..m) /= a, likewise */
+static inline void ss_row_div(double *y, double a, int m)
+{
+  ssV2 av = {a, a};
+  int r = 0;
+  for (; r + 2 <= m; r += 2) {
+    ssV2 yv;
+    memcpy(&yv, y + r, sizeof yv);
+    yv /= av;
+    memcpy(y + r, &yv, sizeof yv);
+  }
+  for (; r < m; r++) y[r] /= a;
+}
+
 static inline void ss_v3_set(double r[3], double x, double y, double z) { r[0] = x; r[1] = y; r[2] = z; }
 static inline void ss_v3_copy(double r[3], const double a[3]) { r[0] = a[0]; r[1] = a[1]; r[2] = a[2]; }
 static inline void ss_v3_add(double r[3], const double a[3], const double b[3]) { r[0] = a[0] + b[0]; r[1] = a[1] + b[1]; r[2] = a[2] + b[2]; }
