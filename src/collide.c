@@ -1,9 +1,11 @@
 /* collide.c -- footprints, exact vertical ray casts, contact candidates and
  * effective widths of box, sphere, cylinder and capsule colliders
- * (DESIGN 2.4, 2.6).  Pure functions: no allocation, no printing. */
+ * (DESIGN 2.4, 2.6).  Pure functions: no allocation, no printing (one
+ * constant table, the footprints' circle, is formed at first use). */
 #include "collide.h"
 
 #include <math.h>
+#include <threads.h>
 
 #include "sort_runs.h"
 #include "ss_math.h"
@@ -110,8 +112,11 @@ static void convex_hull(pt2 *p, int n, ssPoly2 *out)
  * polygons translated along y is then exactly 2 wide, so a lying wheel's
  * footprint is 2r x L and a capsule's is pi r^2 + 2 r L.  Quarter symmetry
  * keeps the four quadrants identical. */
-static void circle_table(double c[SS_FOOTPRINT_SEGMENTS], double s[SS_FOOTPRINT_SEGMENTS])
+static double circle_c[SS_FOOTPRINT_SEGMENTS], circle_s[SS_FOOTPRINT_SEGMENTS];
+
+static void circle_table(void)
 {
+  double *c = circle_c, *s = circle_s;
   const int n = SS_FOOTPRINT_SEGMENTS, q = SS_FOOTPRINT_SEGMENTS / 4;
   double step = 2 * SS_PI / n;
   double k = sqrt(2 * SS_PI / (n * sin(step)));
@@ -124,6 +129,11 @@ static void circle_table(double c[SS_FOOTPRINT_SEGMENTS], double s[SS_FOOTPRINT_
     c[i + 3 * q] = si;  s[i + 3 * q] = -ci;
   }
 }
+
+/* the table, formed once per process (33 libm calls: a wheel's footprint
+ * formed them at every step); call_once makes the first use safe from
+ * any number of threads */
+static once_flag circle_once = ONCE_FLAG_INIT;
 
 /* the affine image centre + u c_i + v s_i of the circle table */
 static int put_ellipse(pt2 *p, int np, const double c[], const double s[],
@@ -266,18 +276,16 @@ void ss_shape_footprint(const ssShape *s, ssPoly2 *out)
     break;
   }
   case SS_GEOM_SPHERE: {
-    double ct[SS_FOOTPRINT_SEGMENTS], st[SS_FOOTPRINT_SEGMENTS];
     double r = s->size[0], u[2] = {r, 0}, v[2] = {0, r};
-    circle_table(ct, st);
-    np = put_ellipse(p, np, ct, st, c[0], c[1], u, v);
+    call_once(&circle_once, circle_table);
+    np = put_ellipse(p, np, circle_c, circle_s, c[0], c[1], u, v);
     break;
   }
   case SS_GEOM_CYLINDER:
   case SS_GEOM_CAPSULE: {
-    double ct[SS_FOOTPRINT_SEGMENTS], st[SS_FOOTPRINT_SEGMENTS];
     double a[3] = {R[2], R[5], R[8]}, w[3], b[3], u[2], v[2];
     double r = s->size[0], hl = 0.5 * s->size[1];
-    circle_table(ct, st);
+    call_once(&circle_once, circle_table);
     axis_side(a, w);
     if (s->type == SS_GEOM_CYLINDER) {
       /* cap discs: in-plane axes w and a x w, projected to xy */
@@ -289,8 +297,8 @@ void ss_shape_footprint(const ssShape *s, ssPoly2 *out)
       u[0] = r * w[0];  u[1] = r * w[1];
       v[0] = -r * w[1]; v[1] = r * w[0];
     }
-    np = put_ellipse(p, np, ct, st, c[0] + hl * a[0], c[1] + hl * a[1], u, v);
-    np = put_ellipse(p, np, ct, st, c[0] - hl * a[0], c[1] - hl * a[1], u, v);
+    np = put_ellipse(p, np, circle_c, circle_s, c[0] + hl * a[0], c[1] + hl * a[1], u, v);
+    np = put_ellipse(p, np, circle_c, circle_s, c[0] - hl * a[0], c[1] - hl * a[1], u, v);
     /* two copies of one convex polygon: swept, no sort (a wheel's
      * footprint in half the instructions), unless the caps are (nearly)
      * edge-on or the axis (nearly) vertical, where the copies' points
