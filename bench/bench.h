@@ -9,4 +9,8 @@ int bench_render(int argc, char **argv);
 /* `benchmarks --bench deformable_terrain -- [options]` (DESIGN 8). */
 int bench_terrain(int argc, char **argv);
 
+/* s as a whole decimal integer within [lo, hi] into *v; 0 (v untouched)
+ * when it is not one */
+int bench_parse_long(const char *s, long lo, long hi, long *v);
+
 #endif

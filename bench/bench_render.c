@@ -108,16 +108,6 @@ static int find_default_scene(char *out, size_t len)
   return found;
 }
 
-static int parse_int(const char *s, long lo, long hi, long *v)
-{
-  char *end;
-  errno = 0;
-  long x = strtol(s, &end, 10);
-  if (errno || end == s || *end || x < lo || x > hi) return 0;
-  *v = x;
-  return 1;
-}
-
 static int parse_size(const char *s, int *w, int *h)
 {
   const char *x = strchr(s, 'x');
@@ -128,8 +118,8 @@ static int parse_size(const char *s, int *w, int *h)
   memcpy(a, s, n);
   a[n] = 0;
   long lw, lh;
-  if (!parse_int(a, 1, SS_RENDER_MAX_SIDE, &lw) ||
-      !parse_int(x + 1, 1, SS_RENDER_MAX_SIDE, &lh))
+  if (!bench_parse_long(a, 1, SS_RENDER_MAX_SIDE, &lw) ||
+      !bench_parse_long(x + 1, 1, SS_RENDER_MAX_SIDE, &lh))
     return 0;
   *w = (int)lw;
   *h = (int)lh;
@@ -180,11 +170,11 @@ int bench_render(int argc, char **argv)
         return 2;
       }
     } else if (!strcmp(name, "--frames")) {
-      if (!parse_int(val, 1, 100000, &frames)) {
+      if (!bench_parse_long(val, 1, 100000, &frames)) {
         fprintf(stderr, "benchmarks: render: invalid --frames '%s' (1 to 100000)\n", val);
         return 2;
       }
-    } else if (!parse_int(val, 0, 100000000, &steps)) {
+    } else if (!bench_parse_long(val, 0, 100000000, &steps)) {
       fprintf(stderr, "benchmarks: render: invalid --steps '%s'\n", val);
       return 2;
     }

@@ -11,10 +11,17 @@
 #include "ss_math.h"
 #include "worlds.h"
 
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+
+/* the options' ranges: a step count that ends within days; a bed up to
+ * 40^2 times the default area (2401^2 vertices, about 0.3 GB) */
+#define MAX_STEPS 100000000L
+#define MAX_REPEATS 10000L
+#define MAX_BED_SCALE 40L
 
 typedef struct Opt {
   const char *body;     /* rigid, articulated, pinned, multilink, buggy */
@@ -48,16 +55,19 @@ static double median(double *v, int n)
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-static void csv_row(const Opt *o, const char *kind, double ms, double ns_point,
-                    double sweeps, double newton, double err)
+/* one CSV row (with --csv); 0 and a message when it cannot be written */
+static int csv_row(const Opt *o, const char *kind, double ms, double ns_point,
+                   double sweeps, double newton, double err)
 {
-  if (!o->csv) return;
+  if (!o->csv) return 1;
   FILE *f = fopen(o->csv, "a");
-  if (!f) return;
-  fprintf(f, "%s,%s,%s,%s,%d,%d,%.6g,%.6g,%.6g,%.6g,%.6g\n", kind, o->body,
-          o->warm ? "warm" : "cold", o->linear ? "linear" : "nonlinear", o->steps,
-          o->repeats, ms, ns_point, sweeps, err, newton);
-  fclose(f);
+  int bad = !f || fprintf(f, "%s,%s,%s,%s,%d,%d,%.6g,%.6g,%.6g,%.6g,%.6g\n", kind, o->body,
+                          o->warm ? "warm" : "cold", o->linear ? "linear" : "nonlinear",
+                          o->steps, o->repeats, ms, ns_point, sweeps, err, newton) < 0;
+  if (f && fclose(f)) bad = 1;
+  if (bad)
+    fprintf(stderr, "benchmarks: deformable_terrain: cannot write --csv file '%s'\n", o->csv);
+  return !bad;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -73,16 +83,22 @@ static int build(const Opt *o, ssModel **mout, ssData **dout, char *why, size_t 
 {
   ssError e;
   if (!strcmp(o->body, "buggy")) {
-    const char *tries[] = {o->scene, "scenes/buggy.xml", "../scenes/buggy.xml", NULL};
+    /* a scene given is that scene or an error, never the default */
+    if (o->scene) {
+      if (ss_scene_load(o->scene, mout, dout, &e) == SS_OK) return 1;
+      snprintf(why, cap, "cannot load --scene '%s': %s", o->scene, e.message);
+      return 0;
+    }
+    /* else the project's buggy, from the build or source tree */
     char path[1024];
     const char *top = getenv("top_srcdir");
-    for (int k = 0; k < 4; k++) {
-      const char *t = k < 3 ? tries[k] : NULL;
-      if (k == 3 && top) {
+    for (int k = 0; k < 3; k++) {
+      const char *t = k == 0 ? "scenes/buggy.xml" : k == 1 ? "../scenes/buggy.xml" : NULL;
+      if (k == 2) {
+        if (!top) break;
         snprintf(path, sizeof path, "%s/scenes/buggy.xml", top);
         t = path;
       }
-      if (!t) continue;
       if (ss_scene_load(t, mout, dout, &e) == SS_OK) return 1;
     }
     snprintf(why, cap, "cannot load the buggy scene (give --scene=FILE): %s", e.message);
@@ -216,8 +232,9 @@ static int bench_bodies(const Opt *o)
     printf("  real-time factor %.3f\n", last.dt / (1e-3 * med));
   else
     printf("  sinkage %.4f mm (analytic 8.175, error %+.3f %%)\n", last.sinkage * 1e3, 100 * err);
-  csv_row(o, o->sweeps_only ? "body_sweeps_only" : "body", med, ns_point, last.sweeps,
-          last.newton, err);
+  if (!csv_row(o, o->sweeps_only ? "body_sweeps_only" : "body", med, ns_point, last.sweeps,
+               last.newton, err))
+    return 1;
   if (o->verify && !buggy) {
     /* warm and cold starts reach the same converged answer */
     Opt other = *o;
@@ -346,57 +363,153 @@ static int bench_contact_law(const Opt *o)
   printf("checks: normal pressure %s, shear within tau_max %s, shear opposes slip %s, "
          "never adds energy %s\n", bad_p ? "FAILED" : "ok", bad_bound ? "FAILED" : "ok",
          bad_align ? "FAILED" : "ok", bad_power ? "FAILED" : "ok");
-  csv_row(o, "contact_law", 0, med, 0, 0, good ? 0 : 1);
+  if (!csv_row(o, "contact_law", 0, med, 0, 0, good ? 0 : 1)) return 1;
   return good ? 0 : 1;
+}
+
+static void terrain_usage(FILE *f)
+{
+  fprintf(f, "usage: benchmarks --bench deformable_terrain -- [options]\n"
+             "  --body=rigid|articulated|pinned|multilink|buggy  (default rigid)\n"
+             "  --start=warm|cold  --steps=N (1..%ld)  --repeats=R (1..%ld)\n"
+             "  --warmup=N (0..%ld)  --bed-scale=K (1..%ld)  --csv=FILE  --verify\n"
+             "  --solver=newton|sweeps  --scene=FILE (--body=buggy only)\n"
+             "  --contact-law [--material=linear|nonlinear]\n"
+             "Options take their value as --option=VALUE or --option VALUE; an\n"
+             "engine flag such as --raisim is accepted and ignored.\n",
+          MAX_STEPS, MAX_REPEATS, MAX_STEPS, MAX_BED_SCALE);
+}
+
+/* one of the words (NULL-terminated) or -1 */
+static int word_of(const char *v, const char *const *words)
+{
+  for (int k = 0; words[k]; k++)
+    if (!strcmp(v, words[k])) return k;
+  return -1;
 }
 
 int bench_terrain(int argc, char **argv)
 {
   Opt o = {"rigid", 1, 0, 0, 0, 5, 0, 1, NULL, NULL, 0, 0};
+  static const char *const bodies[] = {"rigid", "articulated", "pinned", "multilink",
+                                       "buggy", NULL};
+  static const char *const starts[] = {"cold", "warm", NULL};
+  static const char *const materials[] = {"nonlinear", "linear", NULL};
+  static const char *const solvers[] = {"newton", "sweeps", NULL};
+  static const char *const valued[] = {"--body", "--start", "--material", "--steps",
+                                       "--repeats", "--warmup", "--bed-scale", "--csv",
+                                       "--scene", "--solver", NULL};
   for (int i = 0; i < argc; i++) {
     const char *a = argv[i];
     if (!strcmp(a, "--")) continue;
-    if (!strncmp(a, "--body=", 7)) o.body = a + 7;
-    else if (!strcmp(a, "--start=warm")) o.warm = 1;
-    else if (!strcmp(a, "--start=cold")) o.warm = 0;
-    else if (!strcmp(a, "--contact-law")) o.contact_law = 1;
-    else if (!strcmp(a, "--material=linear")) o.linear = 1;
-    else if (!strcmp(a, "--material=nonlinear")) o.linear = 0;
-    else if (!strncmp(a, "--steps=", 8)) o.steps = atoi(a + 8);
-    else if (!strncmp(a, "--repeats=", 10)) o.repeats = atoi(a + 10);
-    else if (!strncmp(a, "--warmup=", 9)) o.warmup = atoi(a + 9);
-    else if (!strncmp(a, "--bed-scale=", 12)) o.bed_scale = atoi(a + 12);
-    else if (!strncmp(a, "--csv=", 6)) o.csv = a + 6;
-    else if (!strncmp(a, "--scene=", 8)) o.scene = a + 8;
-    else if (!strcmp(a, "--verify")) o.verify = 1;
-    else if (!strcmp(a, "--solver=sweeps")) o.sweeps_only = 1;
-    else if (!strcmp(a, "--solver=newton")) o.sweeps_only = 0;
-    else if (!strcmp(a, "--raisim") || !strcmp(a, "--soilsim")) continue;
-    else {
-      fprintf(stderr, "benchmarks: unknown option '%s'\n"
-                      "options: --body=rigid|articulated|pinned|multilink|buggy "
-                      "--start=warm|cold --contact-law --material=linear|nonlinear "
-                      "--steps=N --repeats=R --warmup=N --bed-scale=K --csv=FILE --scene=FILE --verify "
-                      "--solver=newton|sweeps\n", a);
+    if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+      terrain_usage(stdout);
+      return 0;
+    }
+    if (!strcmp(a, "--contact-law")) {
+      o.contact_law = 1;
+      continue;
+    }
+    if (!strcmp(a, "--verify")) {
+      o.verify = 1;
+      continue;
+    }
+    if (!strcmp(a, "--raisim") || !strcmp(a, "--soilsim")) continue;
+    /* --option=VALUE or --option VALUE */
+    const char *eq = strchr(a, '=');
+    char name[32];
+    size_t nl = eq ? (size_t)(eq - a) : strlen(a);
+    int opt = -1;
+    if (nl < sizeof name) {
+      memcpy(name, a, nl);
+      name[nl] = 0;
+      opt = word_of(name, valued);
+    }
+    if (opt < 0) {
+      fprintf(stderr, "benchmarks: deformable_terrain: unknown option '%s'\n", a);
+      terrain_usage(stderr);
+      return 2;
+    }
+    const char *v = eq ? eq + 1 : i + 1 < argc ? argv[++i] : NULL;
+    if (!v || !*v) {
+      fprintf(stderr, "benchmarks: deformable_terrain: %s needs a value\n", name);
+      return 2;
+    }
+    long x = 0;
+    int ok = 1;
+    switch (opt) {
+    case 0:
+      ok = word_of(v, bodies) >= 0;
+      o.body = v;
+      break;
+    case 1:
+      ok = (o.warm = word_of(v, starts)) >= 0;
+      break;
+    case 2:
+      ok = (o.linear = word_of(v, materials)) >= 0;
+      break;
+    case 3:
+      ok = bench_parse_long(v, 1, MAX_STEPS, &x);
+      o.steps = (int)x;
+      break;
+    case 4:
+      ok = bench_parse_long(v, 1, MAX_REPEATS, &x);
+      o.repeats = (int)x;
+      break;
+    case 5:
+      ok = bench_parse_long(v, 0, MAX_STEPS, &x);
+      o.warmup = (int)x;
+      break;
+    case 6:
+      ok = bench_parse_long(v, 1, MAX_BED_SCALE, &x);
+      o.bed_scale = (int)x;
+      break;
+    case 7:
+      o.csv = v;
+      break;
+    case 8:
+      o.scene = v;
+      break;
+    default:
+      ok = (o.sweeps_only = word_of(v, solvers)) >= 0;
+      break;
+    }
+    if (!ok) {
+      char range[64];
+      long hi = opt == 6 ? MAX_BED_SCALE : opt == 4 ? MAX_REPEATS : MAX_STEPS;
+      snprintf(range, sizeof range, "an integer from %d to %ld", opt == 5 ? 0 : 1, hi);
+      const char *allowed = opt == 0   ? "rigid, articulated, pinned, multilink or buggy"
+                            : opt == 1 ? "warm or cold"
+                            : opt == 2 ? "linear or nonlinear"
+                            : opt == 9 ? "newton or sweeps"
+                                       : range;
+      fprintf(stderr, "benchmarks: deformable_terrain: invalid %s '%s': must be %s\n", name,
+              v, allowed);
       return 2;
     }
   }
-  if (o.repeats < 1 || o.bed_scale < 1 || o.warmup < 0) {
-    fprintf(stderr, "benchmarks: --repeats and --bed-scale must be >= 1, --warmup >= 0\n");
+  if (o.scene && strcmp(o.body, "buggy")) {
+    fprintf(stderr, "benchmarks: deformable_terrain: --scene loads a vehicle scene: it "
+                    "needs --body=buggy (the %s body is built in)\n", o.body);
     return 2;
   }
   if (!o.steps) o.steps = o.contact_law ? 2000 : !strcmp(o.body, "buggy") ? 2000 : 1500;
   if (o.csv) {
-    FILE *f = fopen(o.csv, "r");
+    /* opened before any run, so that a bad path costs no benchmark; the
+     * header goes into a new (empty) file */
+    FILE *f = fopen(o.csv, "a");
     if (!f) {
-      f = fopen(o.csv, "w");
-      if (f) {
-        fprintf(f, "case,body,start,material,steps,repeats,ms_per_step,ns_per_point,"
-                   "sweeps_per_step,error,newton_per_step\n");
-        fclose(f);
-      }
-    } else {
-      fclose(f);
+      fprintf(stderr, "benchmarks: deformable_terrain: cannot open --csv file '%s': %s\n",
+              o.csv, strerror(errno));
+      return 1;
+    }
+    int bad = 0;
+    if (ftell(f) == 0)
+      bad = fprintf(f, "case,body,start,material,steps,repeats,ms_per_step,ns_per_point,"
+                       "sweeps_per_step,error,newton_per_step\n") < 0;
+    if (fclose(f) || bad) {
+      fprintf(stderr, "benchmarks: deformable_terrain: cannot write --csv file '%s'\n", o.csv);
+      return 1;
     }
   }
   return o.contact_law ? bench_contact_law(&o) : bench_bodies(&o);

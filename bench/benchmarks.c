@@ -2,15 +2,32 @@
  * named cases.  Timings are reported, never asserted. */
 #include "bench.h"
 
+#include <errno.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static void usage(FILE *f)
 {
   fprintf(f, "usage: benchmarks --bench NAME [-- options]\n"
              "cases:\n"
+             "  deformable_terrain  bodies on soil (ms per step, ns per loaded point,\n"
+             "                      sweeps, sinkage error), the buggy (real-time factor),\n"
+             "                      the contact law alone (ns per visit)\n"
+             "                      [--body=NAME] [--start=warm|cold] [--steps=N] [--repeats=R]\n"
+             "                      [--contact-law] [--csv=FILE] ... (-- --help: all)\n"
              "  render              milliseconds per rendered frame\n"
              "                      [--scene FILE] [--size WxH] [--frames N] [--steps K] [--csv FILE]\n");
+}
+
+int bench_parse_long(const char *s, long lo, long hi, long *v)
+{
+  char *end;
+  errno = 0;
+  long x = strtol(s, &end, 10);
+  if (errno || end == s || *end || x < lo || x > hi) return 0;
+  *v = x;
+  return 1;
 }
 
 int main(int argc, char **argv)

@@ -3,31 +3,79 @@
 # (correctness only, never timing): the contact-law checks for both
 # materials, warm and cold starts reaching the same converged answer, and
 # the bodies of DESIGN 8 settling at the analytic sinkage, also on a
-# 100x larger bed.
+# 100x larger bed; then its refusals of bad options (a message naming the
+# option and what it allows, a non-zero exit, no run) and its CSV.
+#
+# make check sets top_srcdir and top_builddir (absolute); by hand:
+#   top_srcdir=. top_builddir=. sh tests/test_bench.sh
+
+# The checks are shell expressions in single quotes, expanded by eval.
+# shellcheck disable=SC2016,SC2034
+
+top_srcdir=${top_srcdir:-.}
 top_builddir=${top_builddir:-.}
-BENCH="$top_builddir/benchmarks"
-n=0
-nfail=0
-check() {
-  n=$((n + 1))
-  if out=$("$BENCH" --bench deformable_terrain -- "$@" 2>&1); then
-    echo "ok $n - benchmarks $*"
-  else
-    echo "not ok $n - benchmarks $*"
-    nfail=$((nfail + 1))
-  fi
-  printf '%s\n' "$out" | sed 's/^/# /'
+# the harness runs $SOILSIM: here the benchmark program
+SOILSIM=$top_builddir/benchmarks
+TAP_NAME=bench
+. "$top_srcdir/tests/tap.sh"
+trap 'rm -rf "$tmp"' EXIT
+trap 'exit 130' INT TERM HUP
+
+# a short run whose checks (--verify, or the contact law's own) are its
+# exit status; its report goes into the log as comments
+verified() {
+  run --bench deformable_terrain -- "$@"
+  check "benchmarks $*" 'rc_is 0'
+  sed 's/^/# /' "$tmp/out"
 }
-check --contact-law --material=linear --steps=300 --repeats=1
-check --contact-law --material=nonlinear --steps=300 --repeats=1
-check --contact-law --material=nonlinear --start=cold --steps=300 --repeats=1
-check --body=rigid --steps=1500 --repeats=1 --verify
+verified --contact-law --material=linear --steps=300 --repeats=1
+verified --contact-law --material=nonlinear --steps=300 --repeats=1
+verified --contact-law --material=nonlinear --start=cold --steps=300 --repeats=1
+verified --body=rigid --steps=1500 --repeats=1 --verify
 # the sweeps alone (the solver where the Newton phase declines)
-check --body=rigid --solver=sweeps --steps=1500 --repeats=1 --verify
-check --body=articulated --steps=1500 --repeats=1 --verify
-check --body=multilink --steps=1500 --repeats=1 --verify
+verified --body=rigid --solver=sweeps --steps=1500 --repeats=1 --verify
+verified --body=articulated --steps=1500 --repeats=1 --verify
+verified --body=multilink --steps=1500 --repeats=1 --verify
 # the same plate on a 100x larger bed (the step's cost must not notice it),
 # timed steps after untimed warm-up ones
-check --body=rigid --warmup=1400 --steps=100 --repeats=1 --bed-scale=10 --verify
+verified --body=rigid --warmup=1400 --steps=100 --repeats=1 --bed-scale=10 --verify
+
+# bad options: refused before any run (each returns at once), exit 2 for
+# usage and 1 for a file that cannot be used
+T="--bench deformable_terrain --"
+run $T --steps=abc
+check '--steps=abc: refused, the range named' \
+  'rc_is 2 && err_has "invalid --steps" && err_has "must be an integer from 1 to 100000000"'
+run $T --steps=99999999999999
+check '--steps beyond its range: refused' 'rc_is 2 && err_has "invalid --steps"'
+run $T --warmup -5
+check '--warmup -5 (the spaced form): refused' \
+  'rc_is 2 && err_has "invalid --warmup" && err_has "from 0 to"'
+run $T --body=foo
+check '--body=foo: refused, the bodies named' \
+  'rc_is 2 && err_has "must be rigid, articulated, pinned, multilink or buggy"'
+run $T --csv
+check '--csv without a file: refused' 'rc_is 2 && err_has "--csv needs a value"'
+run $T --csv="$tmp/no/such/dir/b.csv"
+check '--csv in a missing folder: refused before the run' \
+  'rc_is 1 && err_has "cannot open --csv file" && ! out_has "ms/step"'
+run $T --scene=scene.xml
+check '--scene without --body=buggy: refused' 'rc_is 2 && err_has "needs --body=buggy"'
+run $T --body=buggy --scene="$tmp/none.xml" --steps=1
+check 'a --scene that does not load: an error, not the default buggy' \
+  'rc_is 1 && err_has "cannot load --scene" && ! out_has "real-time factor"'
+run --bench nosuch
+check 'an unknown case: refused, the cases listed' \
+  'rc_is 2 && err_has "unknown case" && err_has "deformable_terrain" && err_has "render"'
+
+# the CSV in both option forms: one header, then one row per run
+run $T --contact-law --steps 20 --repeats 1 --csv "$tmp/b.csv"
+check '--csv FILE: written' 'rc_is 0'
+run $T --contact-law --steps=20 --repeats=1 --csv="$tmp/b.csv"
+check '--csv=FILE: appended' 'rc_is 0'
+check 'the CSV: one header and a row per run' \
+  '[ "$(wc -l <"$tmp/b.csv")" -eq 3 ] && head -1 "$tmp/b.csv" | grep -q "^case,body,start" &&
+   [ "$(grep -c "^contact_law,rigid,warm,nonlinear,20,1," "$tmp/b.csv")" -eq 2 ]'
+
 echo "1..$n"
 [ "$nfail" -eq 0 ]
