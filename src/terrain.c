@@ -179,8 +179,10 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
 
   ssPoly2 fp;
   ss_shape_footprint(&s, &fp);
-  /* a row's cells on the footprint's edge are clipped in x alone, in the
-   * row's band of the footprint (formed at the row's first such cell) */
+  /* a row's cells on the footprint's edge: area and centroid integrated
+   * along the row's band of the footprint (ss_poly_band, formed at the
+   * row's first such cell), the full clip where the band cannot be split
+   * into chains monotone in x (round-off on a sliver) */
   ssPolyChains ych;
   ssPolyBand band;
   int banded = ss_poly_ychains(&fp, &ych);
@@ -202,7 +204,7 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
     double cy0 = j == 0 ? y : y - 0.5 * dy, cy1 = j == ny - 1 ? y : y + 0.5 * dy;
     /* cells whose x range lies inside both chords of the row's band lie
      * inside the (convex) footprint: fully covered, no clipping; a margin
-     * of 1e-9 dx leaves the cells on the footprint's edge to the clipping
+     * of 1e-9 dx leaves the cells on the footprint's edge to the band
      * (and covers the round-off between the two rows' shared boundary) */
     double in0 = INFINITY, in1 = -INFINITY, a0 = b0, a1 = b1;
     ssPolyChains *yc = banded ? &ych : NULL;
