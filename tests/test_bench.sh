@@ -40,6 +40,11 @@ verified --body=multilink --steps=1500 --repeats=1 --verify
 # timed steps after untimed warm-up ones
 verified --body=rigid --warmup=1400 --steps=100 --repeats=1 --bed-scale=10 --verify
 
+# the buggy has no closed-form reference: --verify says so and checks nothing
+run --bench deformable_terrain -- --body=buggy --steps=2 --repeats=1 --verify
+check 'the buggy with --verify: runs, and says that nothing is checked' \
+  'rc_is 0 && out_has "real-time factor" && out_has "verify: none for the buggy"'
+
 # bad options: refused before any run (each returns at once), exit 2 for
 # usage and 1 for a file that cannot be used
 T="--bench deformable_terrain --"
