@@ -321,7 +321,7 @@ static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
     if (r == m) continue;
     for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) {
       double h = H[i * n + j], *xj = X + (size_t)m * j;
-      ss_row_sub_scaled(xj, h, xi, m);
+      ss_row_add_scaled(xj, -h, xi, m);
     }
   }
   for (int i = 0; i < n; i++) {
@@ -333,7 +333,7 @@ static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
     for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) {
       double h = H[i * n + j];
       const double *xj = X + (size_t)m * j;
-      ss_row_sub_scaled(xi, h, xj, m);
+      ss_row_add_scaled(xi, -h, xj, m);
     }
   }
 }
@@ -473,7 +473,7 @@ static inline void closure_solve(const ssArtWork *w, double *Z, int m)
     }
     for (int k = 0; k < i; k++) {
       double a = A[i * nr + k];
-      ss_row_sub_scaled(zi, a, Z + (size_t)m * k, m);
+      ss_row_add_scaled(zi, -a, Z + (size_t)m * k, m);
     }
     ss_row_div(zi, A[i * nr + i], m);
   }
@@ -485,7 +485,7 @@ static inline void closure_solve(const ssArtWork *w, double *Z, int m)
     }
     for (int k = i + 1; k < nr; k++) {
       double a = A[k * nr + i];
-      ss_row_sub_scaled(zi, a, Z + (size_t)m * k, m);
+      ss_row_add_scaled(zi, -a, Z + (size_t)m * k, m);
     }
     ss_row_div(zi, A[i * nr + i], m);
   }

@@ -16,27 +16,13 @@
 static inline double ss_max(double a, double b) { return a > b ? a : b; }
 static inline double ss_min(double a, double b) { return a < b ? a : b; }
 
-/* y[0..m) -= a x[0..m) for rows that do not overlap, two lanes at a time
+/* y[0..m) += a x[0..m) for rows that do not overlap, two lanes at a time
  * (GCC's vector extension: SSE2 on x86-64, plain pairs elsewhere), the
- * same products and differences, element by element, as the scalar loop
- * (no reassociation: the results are bit for bit).  The compiler leaves
- * the short row loops of the articulated solves scalar otherwise. */
+ * same products and sums, element by element, as the scalar loop (no
+ * reassociation: the results are bit for bit).  The compiler leaves the
+ * short row loops of the articulated solves scalar otherwise.  y -= a x
+ * is the same call with -a: y + (-a) x and y - a x round alike. */
 typedef double ssV2 __attribute__((vector_size(16)));
-static inline void ss_row_sub_scaled(double *y, double a, const double *x, int m)
-{
-  ssV2 av = {a, a};
-  int r = 0;
-  for (; r + 2 <= m; r += 2) {
-    ssV2 xv, yv;
-    memcpy(&xv, x + r, sizeof xv);
-    memcpy(&yv, y + r, sizeof yv);
-    yv -= av * xv;
-    memcpy(y + r, &yv, sizeof yv);
-  }
-  for (; r < m; r++) y[r] -= a * x[r];
-}
-
-/* y[0..m) += a x[0..m), likewise */
 static inline void ss_row_add_scaled(double *y, double a, const double *x, int m)
 {
   ssV2 av = {a, a};

@@ -686,10 +686,10 @@ static void test_mesh_on_soil(void)
 }
 
 /* The articulated solves' row updates taken two lanes at a time
- * (ss_row_sub_scaled, ss_row_add_scaled, ss_row_div in ss_math.h) give the
- * scalar loops' values bit for bit, for every row length up to 17 (pairs
- * and an odd tail), with signed zeros, subnormals, infinities and huge
- * values among the entries. */
+ * (ss_row_add_scaled, with -a for the solves' y -= a x, and ss_row_div in
+ * ss_math.h) give the scalar loops' values bit for bit, for every row
+ * length up to 17 (pairs and an odd tail), with signed zeros, subnormals,
+ * infinities and huge values among the entries. */
 static void test_row_lanes(void)
 {
   static const double special[] = {0.0, -0.0, 4.9e-324, -2.2e-308, INFINITY, -INFINITY,
@@ -717,7 +717,7 @@ static void test_row_lanes(void)
         ys[1][r] += a * x[r];
         ys[2][r] /= a;
       }
-      ss_row_sub_scaled(yv[0], a, x, m);
+      ss_row_add_scaled(yv[0], -a, x, m);
       ss_row_add_scaled(yv[1], a, x, m);
       ss_row_div(yv[2], a, m);
       for (int k = 0; k < 3; k++)
