@@ -393,6 +393,18 @@ static int word_of(const char *v, const char *const *words)
   return -1;
 }
 
+/* An option with a value: one of its words (the word's index into ival,
+ * or the word itself into sval), an integer in [lo, hi] into ival, or
+ * any string into sval. */
+typedef struct ValOpt {
+  const char *name;
+  const char *const *words; /* NULL-terminated, or NULL: no word list */
+  const char *allowed;      /* the words, as the message lists them */
+  long lo, hi;
+  int *ival;
+  const char **sval;
+} ValOpt;
+
 int bench_terrain(int argc, char **argv)
 {
   Opt o = {"rigid", 1, 0, 0, 0, 5, 0, 1, NULL, NULL, 0, 0};
@@ -401,9 +413,20 @@ int bench_terrain(int argc, char **argv)
   static const char *const starts[] = {"cold", "warm", NULL};
   static const char *const materials[] = {"nonlinear", "linear", NULL};
   static const char *const solvers[] = {"newton", "sweeps", NULL};
-  static const char *const valued[] = {"--body", "--start", "--material", "--steps",
-                                       "--repeats", "--warmup", "--bed-scale", "--csv",
-                                       "--scene", "--solver", NULL};
+  const ValOpt opts[] = {
+      {"--body", bodies, "rigid, articulated, pinned, multilink or buggy", 0, 0, NULL,
+       &o.body},
+      {"--start", starts, "warm or cold", 0, 0, &o.warm, NULL},
+      {"--material", materials, "linear or nonlinear", 0, 0, &o.linear, NULL},
+      {"--solver", solvers, "newton or sweeps", 0, 0, &o.sweeps_only, NULL},
+      {"--steps", NULL, NULL, 1, MAX_STEPS, &o.steps, NULL},
+      {"--repeats", NULL, NULL, 1, MAX_REPEATS, &o.repeats, NULL},
+      {"--warmup", NULL, NULL, 0, MAX_STEPS, &o.warmup, NULL},
+      {"--bed-scale", NULL, NULL, 1, MAX_BED_SCALE, &o.bed_scale, NULL},
+      {"--csv", NULL, NULL, 0, 0, NULL, &o.csv},
+      {"--scene", NULL, NULL, 0, 0, NULL, &o.scene},
+  };
+  const int nopt = (int)(sizeof opts / sizeof opts[0]);
   for (int i = 0; i < argc; i++) {
     const char *a = argv[i];
     if (!strcmp(a, "--")) continue;
@@ -422,74 +445,38 @@ int bench_terrain(int argc, char **argv)
     if (!strcmp(a, "--raisim") || !strcmp(a, "--soilsim")) continue;
     /* --option=VALUE or --option VALUE */
     const char *eq = strchr(a, '=');
-    char name[32];
     size_t nl = eq ? (size_t)(eq - a) : strlen(a);
-    int opt = -1;
-    if (nl < sizeof name) {
-      memcpy(name, a, nl);
-      name[nl] = 0;
-      opt = word_of(name, valued);
-    }
-    if (opt < 0) {
+    const ValOpt *p = NULL;
+    for (int k = 0; k < nopt && !p; k++)
+      if (strlen(opts[k].name) == nl && !strncmp(a, opts[k].name, nl)) p = opts + k;
+    if (!p) {
       fprintf(stderr, "benchmarks: deformable_terrain: unknown option '%s'\n", a);
       terrain_usage(stderr);
       return 2;
     }
     const char *v = eq ? eq + 1 : i + 1 < argc ? argv[++i] : NULL;
     if (!v || !*v) {
-      fprintf(stderr, "benchmarks: deformable_terrain: %s needs a value\n", name);
+      fprintf(stderr, "benchmarks: deformable_terrain: %s needs a value\n", p->name);
       return 2;
     }
-    long x = 0;
     int ok = 1;
-    switch (opt) {
-    case 0:
-      ok = word_of(v, bodies) >= 0;
-      o.body = v;
-      break;
-    case 1:
-      ok = (o.warm = word_of(v, starts)) >= 0;
-      break;
-    case 2:
-      ok = (o.linear = word_of(v, materials)) >= 0;
-      break;
-    case 3:
-      ok = bench_parse_long(v, 1, MAX_STEPS, &x);
-      o.steps = (int)x;
-      break;
-    case 4:
-      ok = bench_parse_long(v, 1, MAX_REPEATS, &x);
-      o.repeats = (int)x;
-      break;
-    case 5:
-      ok = bench_parse_long(v, 0, MAX_STEPS, &x);
-      o.warmup = (int)x;
-      break;
-    case 6:
-      ok = bench_parse_long(v, 1, MAX_BED_SCALE, &x);
-      o.bed_scale = (int)x;
-      break;
-    case 7:
-      o.csv = v;
-      break;
-    case 8:
-      o.scene = v;
-      break;
-    default:
-      ok = (o.sweeps_only = word_of(v, solvers)) >= 0;
-      break;
+    if (p->words) {
+      int k = word_of(v, p->words);
+      ok = k >= 0;
+      if (ok && p->ival) *p->ival = k;
+      if (ok && p->sval) *p->sval = v;
+    } else if (p->ival) {
+      long x;
+      ok = bench_parse_long(v, p->lo, p->hi, &x);
+      if (ok) *p->ival = (int)x;
+    } else {
+      *p->sval = v;
     }
     if (!ok) {
       char range[64];
-      long hi = opt == 6 ? MAX_BED_SCALE : opt == 4 ? MAX_REPEATS : MAX_STEPS;
-      snprintf(range, sizeof range, "an integer from %d to %ld", opt == 5 ? 0 : 1, hi);
-      const char *allowed = opt == 0   ? "rigid, articulated, pinned, multilink or buggy"
-                            : opt == 1 ? "warm or cold"
-                            : opt == 2 ? "linear or nonlinear"
-                            : opt == 9 ? "newton or sweeps"
-                                       : range;
-      fprintf(stderr, "benchmarks: deformable_terrain: invalid %s '%s': must be %s\n", name,
-              v, allowed);
+      snprintf(range, sizeof range, "an integer from %ld to %ld", p->lo, p->hi);
+      fprintf(stderr, "benchmarks: deformable_terrain: invalid %s '%s': must be %s\n",
+              p->name, v, p->words ? p->allowed : range);
       return 2;
     }
   }
