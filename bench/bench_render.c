@@ -65,49 +65,6 @@ static void usage(FILE *f)
           "environment: SOILSIM_GL=osmesa|egl picks the GL backend\n");
 }
 
-static int file_exists(const char *p)
-{
-  return access(p, R_OK) == 0;
-}
-
-/* The default scene: $top_srcdir, next to the executable, its parent, or
- * the source tree named in the build folder's Makefile (out-of-tree). */
-static int find_default_scene(char *out, size_t len)
-{
-  const char *rel = "scenes/buggy.xml";
-  const char *top = getenv("top_srcdir");
-  if (top && *top) {
-    snprintf(out, len, "%s/%s", top, rel);
-    if (file_exists(out)) return 1;
-  }
-  char exe[PATH_MAX];
-  ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-  if (n <= 0) return 0;
-  exe[n] = 0;
-  char *slash = strrchr(exe, '/');
-  if (!slash) return 0;
-  *slash = 0;
-  snprintf(out, len, "%s/%s", exe, rel);
-  if (file_exists(out)) return 1;
-  snprintf(out, len, "%s/../%s", exe, rel);
-  if (file_exists(out)) return 1;
-  char mk[PATH_MAX + 16];
-  snprintf(mk, sizeof mk, "%s/Makefile", exe);
-  FILE *f = fopen(mk, "r");
-  if (!f) return 0;
-  char line[PATH_MAX + 64];
-  int found = 0;
-  while (!found && fgets(line, sizeof line, f)) {
-    if (strncmp(line, "abs_top_srcdir = ", 17) != 0) continue;
-    char *v = line + 17;
-    v[strcspn(v, "\r\n")] = 0;
-    snprintf(out, len, "%s/%s", v, rel);
-    found = file_exists(out);
-  }
-  fclose(f);
-  return found;
-}
-
 static int parse_size(const char *s, int *w, int *h)
 {
   const char *x = strchr(s, 'x');
@@ -182,7 +139,7 @@ int bench_render(int argc, char **argv)
 
   char path[PATH_MAX + 64];
   if (!scene) {
-    if (!find_default_scene(path, sizeof path)) {
+    if (!bench_default_scene(path, sizeof path)) {
       fprintf(stderr, "benchmarks: render: cannot find scenes/buggy.xml; "
                       "give --scene FILE or set top_srcdir\n");
       return 1;

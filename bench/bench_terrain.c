@@ -12,6 +12,7 @@
 #include "worlds.h"
 
 #include <errno.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -90,17 +91,12 @@ static int build(const Opt *o, ssModel **mout, ssData **dout, char *why, size_t 
       return 0;
     }
     /* else the project's buggy, from the build or source tree */
-    char path[1024];
-    const char *top = getenv("top_srcdir");
-    for (int k = 0; k < 3; k++) {
-      const char *t = k == 0 ? "scenes/buggy.xml" : k == 1 ? "../scenes/buggy.xml" : NULL;
-      if (k == 2) {
-        if (!top) break;
-        snprintf(path, sizeof path, "%s/scenes/buggy.xml", top);
-        t = path;
-      }
-      if (ss_scene_load(t, mout, dout, &e) == SS_OK) return 1;
+    char path[PATH_MAX + 64];
+    if (!bench_default_scene(path, sizeof path)) {
+      snprintf(why, cap, "cannot find scenes/buggy.xml; give --scene=FILE or set top_srcdir");
+      return 0;
     }
+    if (ss_scene_load(path, mout, dout, &e) == SS_OK) return 1;
     snprintf(why, cap, "cannot load the buggy scene (give --scene=FILE): %s", e.message);
     return 0;
   }
