@@ -168,6 +168,11 @@ struct ssNewtonWork {
   NImpEval *ie, *ietry; /* (ncontact) their equations at y, at the trial */
 };
 
+const double *ss_newton_law(const ssData *d)
+{
+  return d->newton ? d->newton->lam : NULL;
+}
+
 void ss_newton_work_free(ssNewtonWork *w)
 {
   if (!w) return;
@@ -1313,10 +1318,11 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
        * warm start */
       if (f > tol2 * size && !(f <= tol * size)) break;
       /* the warm start may stand as it is (a settled body): then neither
-       * the apply nor check's pass is needed */
+       * the apply nor check's pass is needed, and w->lam holds the laws'
+       * impulses at its velocities (ss_newton_law) */
       if (it == 0 && w->ns == 0 && (*residual_out = warm_check(d, &s, w)) <= tol) {
         w->settled = 1;
-        return 1;
+        return 2;
       }
       apply(m, d, &s, w);
       *residual_out = check(m, d, &s, w);

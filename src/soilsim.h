@@ -461,6 +461,10 @@ typedef struct ssData {
                              the tests, equal to the default at round-off */
   int solver_gs_only;     /* 1: no Newton phase before the sweeps (solver.h);
                              the reference path of the tests */
+  int solver_settled;     /* 1: the last solve's answer was its warm start
+                             as it came (the Newton phase's settled body),
+                             whose laws' impulses the cache keeps (internal,
+                             solver.c) */
   struct ssNewtonWork *newton; /* the Newton phase's workspace (internal) */
   ssStepStats stats;
 } ssData;

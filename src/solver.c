@@ -439,6 +439,16 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
    * needed any more), then sorted into warm */
   ssWarmEntry *next = d->warm_next;
   n = 0;
+  /* A step whose warm start stood as it came (the Newton phase found a
+   * settled body's warm impulses within the tolerance of its laws there)
+   * keeps the laws' impulses at its velocities instead: as close to the
+   * answer, and ahead of the warm impulses by the step's drift.  Kept
+   * back, that drift (a settled plate's slow creep, each step's change
+   * below the tolerance, so no rate follows it) piles up over the steps
+   * until the warm start fails its check, and every few steps pay for
+   * the apply and check a converged Newton solve needs (the settled
+   * plate: every other step). */
+  const double *law = d->solver_settled ? ss_newton_law(d) : NULL;
   /* each collider's patch, over its points that keep a rate: the largest
    * squared slip, and sums of normal and tangential impulses (1-norms),
    * for CREEP_SLIP */
@@ -454,9 +464,11 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
       int trend = c->warm_trend && d->stats.converged;
       e->vertex = c->vertex;
       e->geom = c->geom;
+      /* (the soil points come first, as the Newton phase needs) */
+      const double *l = law ? law + 3 * i : c->lambda;
       double ch = 0, size = 0;
       for (int k = 0; k < 3; k++) {
-        e->traction[k] = c->lambda[k] * inv;
+        e->traction[k] = l[k] * inv;
         e->rate[k] = trend ? e->traction[k] - c->warm_t[k] : 0;
         ch += fabs(e->rate[k]);
         size += fabs(e->traction[k]);
@@ -559,6 +571,7 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   st->converged = 1;
   st->newton = 0;
   st->newton_sticking = 0;
+  d->solver_settled = 0;
   if (m->nv) memcpy(d->qvel_free, d->qvel, (size_t)m->nv * sizeof(double));
   int left = warm_start(m, d, converged, 0);
 
@@ -602,6 +615,7 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
     if (ok) {
       st->residual = res;
       sweeps = 0;
+      d->solver_settled = done == 2;
     }
   }
 

@@ -114,12 +114,18 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err);
  * when Newton converged: the contacts hold its impulses, d->qvel their
  * velocity, and *residual the check of that answer against every
  * contact's law at that velocity (the sweeps' measure: max |change| /
- * max |impulse|); 0 when it declined (everything as on entry).
- * *iterations: the Newton iterations spent either way; *sticking: the
- * soil points it solved in impulse form (sticking or nearly, newton.c). */
+ * max |impulse|); 2 when the first impulses passed that check as they
+ * came (a settled body: contacts and d->qvel untouched); 0 when it
+ * declined (everything as on entry).  *iterations: the Newton iterations
+ * spent either way; *sticking: the soil points it solved in impulse form
+ * (sticking or nearly, newton.c). */
 typedef struct ssNewtonWork ssNewtonWork;
 int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
                     int *sticking, double *residual);
+/* After ss_newton_solve returned 2 (and until it is called again): the
+ * soil points' impulses by their laws at d->qvel, three for each of the
+ * contacts before first_row (the contact frame's n, t1, t2) */
+const double *ss_newton_law(const ssData *d);
 void ss_newton_work_free(ssNewtonWork *w);
 
 /* Each soil bed's table of s^(n-1) (ss_math.h's ssPowTable in

@@ -521,6 +521,56 @@ out:
   free_world(&v);
 }
 
+/* A settled plate's warm start stands every step (the Newton phase takes
+ * no step and skips its check): the cache keeps the laws' impulses at the
+ * step's velocities, which run ahead of the warm impulses by the step's
+ * drift.  Were it to keep the warm impulses themselves, that drift (about
+ * 1e-10 of the tractions a step on this plate) would pile up until the
+ * warm start missed the tolerance, every few steps.  Each loaded point's
+ * cached normal traction is its law's pressure at its end-of-step
+ * velocity, to round-off (1e-12 relative: the impulse divided by A dt,
+ * the law evaluated again here); the warm impulses it held differ by up
+ * to the tolerance (1e-9). */
+static void test_settled_cache(void)
+{
+  World w = make_world(plate_soil(), 1.2, 0.02, 0.4, 0.6, 20, 0, 0, 0, 0);
+  const ssSoilMaterial *mat = &w.m->hfield_soilmat[w.bed];
+  const double dt = w.m->opt.timestep;
+  int steps = 200, settled = 0, points = 0, bad = 0;
+  double worst = 0, held = 0;
+  if (!run(&w, 1500)) {
+    ok(0, "settled plate: set-up");
+    free_world(&w);
+    return;
+  }
+  for (int k = 0; k < steps && run(&w, 1); k++) {
+    const ssData *d = w.d;
+    settled += d->solver_settled;
+    for (int i = 0; i < d->ncontact; i++) {
+      const ssContact *c = d->contact + i;
+      if (c->type != SS_CONTACT_SOIL || !c->loaded) continue;
+      const ssWarmEntry *e = NULL;
+      for (int j = 0; j < d->nwarm && !e; j++)
+        if (d->warm[j].geom == c->geom && d->warm[j].vertex == c->vertex) e = d->warm + j;
+      if (!e) {
+        bad++;
+        continue;
+      }
+      double delta = -(c->g0 + dt * c->v[0]);
+      double p = ss_soil_pressure(mat, c->width, c->sp + delta, c->sp) +
+                 ss_soil_viscous(mat, -c->v[0]);
+      worst = fmax(worst, fabs(e->traction[0] - p) / p);
+      held = fmax(held, fabs(c->lambda[0] / (c->area * dt) - p) / p);
+      points++;
+    }
+  }
+  ok(settled == steps && points > 100 * steps && bad == 0 && worst <= 1e-12,
+     "settled plate: its warm start stands in %d of %d steps; the cache keeps each of %d "
+     "loaded points' law at its velocity (worst %.2g relative, bound 1e-12; the warm "
+     "impulses held %.2g)", settled, steps, points, worst, held);
+  free_world(&w);
+}
+
 /* The Newton phase (solver.h) against the sweeps alone, one step from the
  * same state each.  Both stop at the solver tolerance tol in the sweeps'
  * measure (largest impulse change over largest impulse); a contraction of
@@ -725,6 +775,7 @@ int main(void)
   test_rigid();
   test_warm_trend();
   test_newton();
+  test_settled_cache();
   test_resting_on_slope();
   test_creeping_plate();
   test_power_table();
