@@ -4,19 +4,21 @@
  * time and step count, generalized positions and velocities, which systems
  * are still in the world, controller targets, bed poses, the three soil
  * arrays, the list of loaded vertices, the solver's warm-start cache, the
- * solver configuration and the last step's statistics.  Restoring it and
+ * solver configuration, the Newton phase's last answers (its start) and
+ * the last step's statistics.  Restoring it and
  * stepping gives bit-identical results to stepping on from the moment it was
  * written.  It does not hold the model: it is restored into a data made for
  * the same world, which a fingerprint of the model checks.
  *
- * Format, version 3 (versions 1, before the warm-start cache kept its
- * rates, and 2, before its entries said whether their collider crept, are
- * refused: their caches cannot replay this build's steps).  Every integer is little-endian; every double is its
+ * Format, version 4 (versions 1, before the warm-start cache kept its
+ * rates, 2, before its entries said whether their collider crept, and 3,
+ * before the Newton phase's start was kept, are refused: they cannot
+ * replay this build's steps).  Every integer is little-endian; every double is its
  * IEEE-754 bit pattern as a little-endian 64-bit integer (bit-exact).
  *
  *   header (32 bytes; the same layout in every version)
  *     0   8  magic "SOILCKPT"
- *     8   4  u32 format version (3)
+ *     8   4  u32 format version (4)
  *    12   4  u32 header size (32)
  *    16   8  u64 file size in bytes, trailer included
  *    24   4  u32 number of sections
@@ -41,6 +43,9 @@
  *     WARM  nwarm entries of 60 bytes: vertex (i32), geom (i32), creep
  *           (i32: 0 or 1, only for soil entries), traction (3 f64), rate
  *           (3 f64), in the solver's sort order
+ *     NEWT  the Newton phase's last two answers (ssNewtonRecord, the later
+ *           first), each: step (i64, -1: none), key (u64, 0 for none),
+ *           n (i32, 0 for none) and n f64 (c)
  *     STAT  soil_contacts, soil_loaded (i32), soil_contact_area,
  *           soil_normal_force (f64), rigid_contacts, sweeps (i32), residual
  *           (f64), converged (i32); the stage wall times are not saved, so
@@ -70,7 +75,7 @@
 #include <sys/stat.h>
 
 #define CKPT_MAGIC "SOILCKPT"
-#define CKPT_VERSION 3u
+#define CKPT_VERSION 4u
 #define CKPT_HEADER 32u
 #define CKPT_SECTION_HEAD 16u
 #define CKPT_TRAILER 8u
@@ -140,12 +145,12 @@ enum { NCOUNT = 15, NHASH = 7 };
 /* the sections, in the order they are written */
 enum {
   S_MODL, S_OPTS, S_CLCK, S_QPOS, S_QVEL, S_SYSA, S_PDTG, S_HPOS, S_HQUA,
-  S_SINK, S_PLAS, S_SHEA, S_LOAD, S_WARM, S_STAT, NTAG
+  S_SINK, S_PLAS, S_SHEA, S_LOAD, S_WARM, S_NEWT, S_STAT, NTAG
 };
 
 static const char section_tag[NTAG][5] = {
   "MODL", "OPTS", "CLCK", "QPOS", "QVEL", "SYSA", "PDTG", "HPOS", "HQUA",
-  "SINK", "PLAS", "SHEA", "LOAD", "WARM", "STAT"};
+  "SINK", "PLAS", "SHEA", "LOAD", "WARM", "NEWT", "STAT"};
 
 static const char *const count_name[NCOUNT] = {
   "generalized coordinates (nq)", "generalized velocities (nv)",
@@ -480,6 +485,17 @@ ssStatus ss_checkpoint_save_buffer(const ssModel *m, const ssData *d,
   }
   section_end(&w, s);
 
+  s = section_begin(&w, S_NEWT);
+  for (int k = 0; k < 2; k++) {
+    const ssNewtonRecord *r = d->newton_rec + k;
+    int some = r->step >= 0;
+    w_u64(&w, (uint64_t)(int64_t)(some ? r->step : -1));
+    w_u64(&w, some ? r->key : 0);
+    w_i32(&w, some ? r->n : 0);
+    if (some) w_f64s(&w, r->c, (size_t)r->n);
+  }
+  section_end(&w, s);
+
   s = section_begin(&w, S_STAT);
   const ssStepStats *ps = &d->stats;
   w_i32(&w, ps->soil_contacts);
@@ -808,6 +824,15 @@ ssStatus ss_checkpoint_info_buffer(const void *buf, size_t len,
   return SS_OK;
 }
 
+/* Most unknowns a Newton phase can have: 6 per body (or link) and bed, 1
+ * per PD row, at most 2 limit rows per dof */
+static uint64_t newton_max(const ssModel *m)
+{
+  uint64_t n = 6 * (uint64_t)m->nbody * (uint64_t)m->nhfield + (uint64_t)m->npd +
+               2 * (uint64_t)m->nv;
+  return n < INT32_MAX ? n : INT32_MAX;
+}
+
 /* Largest checkpoint a model can have (bytes); bigger files are refused
  * before they are read. */
 static uint64_t max_size(const ssModel *m)
@@ -818,7 +843,7 @@ static uint64_t max_size(const ssModel *m)
          8 + 4 * NCOUNT + 8 * NHASH + CKPT_SOURCE_MAX + OPTS_BYTES +
          CLCK_BYTES + STAT_BYTES + 8 * ((uint64_t)m->nq + (uint64_t)m->nv) +
          (uint64_t)m->nsys + 8 * (2 * (uint64_t)m->npd + 7 * (uint64_t)m->nhfield) +
-         8 * 3 * nhd + 4 * nhd + CKPT_WARM_BYTES * warm;
+         8 * 3 * nhd + 4 * nhd + CKPT_WARM_BYTES * warm + 2 * (20 + 8 * newton_max(m));
 }
 
 ssStatus ss_checkpoint_info(const char *path, ssCheckpointInfo *info,
@@ -939,6 +964,7 @@ typedef struct State {
   int nloaded, *loaded;
   int nwarm;
   ssWarmEntry *warm;
+  ssNewtonRecord rec[2];
   ssStepStats stats;
 } State;
 
@@ -947,6 +973,7 @@ static void state_free(State *s)
   free(s->qpos); free(s->qvel); free(s->pd_target); free(s->hpos);
   free(s->hquat); free(s->sink); free(s->plas); free(s->shea);
   free(s->active); free(s->loaded); free(s->warm);
+  free(s->rec[0].c); free(s->rec[1].c);
 }
 
 static void *alloc0(size_t n, size_t size)
@@ -1061,6 +1088,31 @@ static ssStatus parse_state(const ssModel *m, const Parsed *f, const char *path,
       return corrupt(err, path, "bad warm-start cache");
   }
 
+  /* the Newton phase's start: records of steps before this one, the later
+   * first, none after none */
+  r = section(f, S_NEWT);
+  for (int k = 0; k < 2; k++) {
+    ssNewtonRecord *q = s->rec + k;
+    int64_t step = (int64_t)r_u64(&r);
+    q->key = r_u64(&r);
+    int n = r_i32(&r);
+    int ok = !r.bad && step >= -1 && step < (int64_t)s->step && n >= 0 &&
+             (uint64_t)n <= newton_max(m) && (uint64_t)n * 8 <= r.n - r.off &&
+             (step >= 0 || (n == 0 && q->key == 0)) &&
+             (k == 0 || step < 0 || step < s->rec[0].step);
+    if (!ok) return corrupt(err, path, "bad section 'NEWT'");
+    q->step = (long)step;
+    q->n = n;
+    q->c = alloc0((size_t)n, sizeof(double));
+    if (!q->c)
+      return ss_error_set(err, SS_ERR_NOMEM, path, 0, "out of memory reading a checkpoint");
+    q->cap = n;
+    r_f64s(&r, q->c, (size_t)n);
+    for (int a = 0; a < n; a++)
+      if (!isfinite(q->c[a])) return corrupt(err, path, "bad section 'NEWT'");
+  }
+  if (r.bad || r.off != r.n) return corrupt(err, path, "bad section 'NEWT'");
+
   r = section(f, S_STAT);
   ssStepStats *ps = &s->stats;
   memset(ps, 0, sizeof *ps);
@@ -1117,6 +1169,17 @@ static ssStatus load(const ssModel *m, ssData *d, const unsigned char *p,
       d->cap_warm = s.nwarm;
     }
   }
+  for (int k = 0; k < 2 && !st; k++) {
+    ssNewtonRecord *r = d->newton_rec + k;
+    if (s.rec[k].n > r->cap) {
+      double *q = realloc(r->c, (size_t)s.rec[k].n * sizeof *q);
+      if (!q) st = ss_error_set(err, SS_ERR_NOMEM, path, 0, "out of memory");
+      else {
+        r->c = q;
+        r->cap = s.rec[k].n;
+      }
+    }
+  }
   if (st) {
     state_free(&s);
     return st;
@@ -1143,6 +1206,14 @@ static ssStatus load(const ssModel *m, ssData *d, const unsigned char *p,
   d->nsoil_loaded = s.nloaded;
   if (s.nwarm) memcpy(d->warm, s.warm, (size_t)s.nwarm * sizeof(ssWarmEntry));
   d->nwarm = s.nwarm;
+  for (int k = 0; k < 2; k++) {
+    ssNewtonRecord *r = d->newton_rec + k;
+    r->step = s.rec[k].step;
+    r->key = s.rec[k].key;
+    r->n = s.rec[k].n;
+    if (r->n) memcpy(r->c, s.rec[k].c, (size_t)r->n * sizeof(double));
+  }
+  d->newton_rec[2].step = -1;
   d->stats = s.stats;
   /* the contacts of the step before belong to another state */
   d->ncontact = 0;

@@ -70,6 +70,7 @@ void ss_data_free(ssData *d)
   free(d->soil_sinkage); free(d->soil_plastic); free(d->soil_shear);
   free(d->contact); free(d->jac); free(d->warm); free(d->warm_next);
   free(d->soil_loaded);
+  for (int k = 0; k < 3; k++) free(d->newton_rec[k].c);
   ss_newton_work_free(d->newton);
   free(d);
 }
@@ -96,6 +97,7 @@ void ss_data_reset(const ssModel *m, ssData *d)
   }
   d->ncontact = 0;
   d->nwarm = 0;
+  for (int k = 0; k < 3; k++) d->newton_rec[k].step = -1;
   d->nsoil_loaded = 0;
   memset(&d->stats, 0, sizeof d->stats);
   ss_forward(m, d);

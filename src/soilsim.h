@@ -401,6 +401,17 @@ typedef struct ssStepStats {
   double time_stage[6];
 } ssStepStats;
 
+/* One step's answer of the Newton phase (solver internals, newton.c): the
+ * contacts' effect on its unknowns, from which later steps start */
+typedef struct ssNewtonRecord {
+  long step;              /* the step it solved (d->step before it); -1: none */
+  int n, cap;             /* its unknowns (6 per contact link or body and bed,
+                             1 per joint row); room in c */
+  uint64_t key;           /* which unknowns (a hash of the links, beds and
+                             rows) */
+  double *c;              /* (n) y - y_free at the answer */
+} ssNewtonRecord;
+
 typedef struct ssContact ssContact; /* solver contact (internal layout) */
 typedef struct ssWarmEntry ssWarmEntry;
 
@@ -449,6 +460,11 @@ typedef struct ssData {
   ssWarmEntry *warm;      /* (nwarm) warm-start cache */
   int cap_warm_next;
   ssWarmEntry *warm_next; /* the next cache while it is sorted (scratch) */
+  ssNewtonRecord newton_rec[3]; /* the Newton phase's start (newton.c):
+                             the answers of the last two steps it solved
+                             ([0] the later), and this step's ([2]) until
+                             ss_solver_store_warm keeps it; saved in
+                             checkpoints */
   double *geom_patch;     /* (ngeom x 3) each collider's soil patch when the
                              cache is stored: fastest loaded slip, sums of
                              normal and of tangential impulses (scratch) */
@@ -461,6 +477,9 @@ typedef struct ssData {
                              the tests, equal to the default at round-off */
   int solver_gs_only;     /* 1: no Newton phase before the sweeps (solver.h);
                              the reference path of the tests */
+  int solver_no_predict;  /* 1: the Newton phase starts from the warm start
+                             alone, not from its last answers extrapolated
+                             (newton.c); the reference path of the tests */
   int solver_settled;     /* 1: the last solve's answer was its warm start
                              as it came (the Newton phase's settled body),
                              whose laws' impulses the cache keeps (internal,

@@ -511,6 +511,7 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
     d->cap_warm_next = cap;
   }
   d->nwarm = n;
+  ss_newton_keep(d);
   return SS_OK;
 }
 
@@ -572,6 +573,7 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   st->newton = 0;
   st->newton_sticking = 0;
   d->solver_settled = 0;
+  d->newton_rec[2].step = -1;
   if (m->nv) memcpy(d->qvel_free, d->qvel, (size_t)m->nv * sizeof(double));
   int left = warm_start(m, d, converged, 0);
 

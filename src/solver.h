@@ -126,6 +126,10 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
  * soil points' impulses by their laws at d->qvel, three for each of the
  * contacts before first_row (the contact frame's n, t1, t2) */
 const double *ss_newton_law(const ssData *d);
+/* Keep this step's answer of the Newton phase (d->newton_rec) as the start
+ * of the next steps; once the step has passed its checks, with the cache
+ * (ss_solver_store_warm) */
+void ss_newton_keep(ssData *d);
 void ss_newton_work_free(ssNewtonWork *w);
 
 /* Each soil bed's table of s^(n-1) (ss_math.h's ssPowTable in

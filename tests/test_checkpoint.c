@@ -308,8 +308,11 @@ static void test_lazy_jacobian(void)
   lazy_jacobian("plate, n = 1.1 and cohesion", &soil);
 }
 
-/* The warm-start cache is what makes warm replays exact: restoring without
- * it changes the result (so the replay tests above can tell). */
+/* The warm-start cache and the Newton phase's last answers are what make
+ * warm replays exact: restoring without either changes the result (so the
+ * replay tests above can tell).  (Without the cache alone the dragged
+ * plate replays exactly: its Newton phase starts from its last answers,
+ * extrapolated, and not from the cache.) */
 static void test_cache_matters(void)
 {
   ssModel *m;
@@ -320,16 +323,22 @@ static void test_cache_matters(void)
   unsigned char *buf = NULL;
   ssError e;
   int okr = run(m, a, 120) && run(m, d, 60) && (buf = snapshot(m, d, &len));
-  ssData *c = ss_data_new(m);
-  okr = okr && ss_checkpoint_load_buffer(m, c, buf, len, &e) == SS_OK;
-  c->nwarm = 0; /* as an XML reload would have it */
-  okr = okr && run(m, c, 60);
-  ok(okr && !same_state(m, a, c) && a->step == c->step,
-     "dragged plate: a restore without the warm-start cache does not replay "
-     "exactly (the cache is needed and saved)");
+  const char *what[2] = {"the warm-start cache and the Newton phase's last answers",
+                         "the Newton phase's last answers"};
+  for (int k = 0; k < 2; k++) {
+    ssData *c = ss_data_new(m);
+    int okc = okr && ss_checkpoint_load_buffer(m, c, buf, len, &e) == SS_OK;
+    /* as an XML reload would have it */
+    if (k == 0) c->nwarm = 0;
+    c->newton_rec[0].step = c->newton_rec[1].step = -1;
+    okc = okc && run(m, c, 60);
+    ok(okc && !same_state(m, a, c) && a->step == c->step,
+       "dragged plate: a restore without %s does not replay exactly (needed and saved)",
+       what[k]);
+    ss_data_free(c);
+  }
   free(buf);
   ss_data_free(a);
-  ss_data_free(c);
   ss_data_free(d);
   ss_model_free(m);
 }
@@ -464,10 +473,10 @@ static void damage_tests(const char *what, const ssModel *m, const ssData *src,
     ok(0, "%s: checkpoint", what);
     return;
   }
-  ok(!memcmp(good, "SOILCKPT", 8) && le(good + 8, 4) == 3 && le(good + 16, 8) == n &&
+  ok(!memcmp(good, "SOILCKPT", 8) && le(good + 8, 4) == 4 && le(good + 16, 8) == n &&
      le(good + 28, 4) == crc32_ref(good, 28) && !memcmp(good + n - 8, "CRC ", 4) &&
      le(good + n - 4, 4) == crc32_ref(good, n - 4),
-     "%s: layout: signature, version 3, size and CRC-32 in the header, CRC-32 "
+     "%s: layout: signature, version 4, size and CRC-32 in the header, CRC-32 "
      "trailer (%zu bytes)", what, n);
 
   /* the victim: a data in another state that must survive every attack */
@@ -544,8 +553,8 @@ static void damage_tests(const char *what, const ssModel *m, const ssData *src,
     int width;
     uint64_t value;
   } forge[] = {
-    {"version 2 (an older build's)", NULL, 8, 4, 2},
-    {"version 4", NULL, 8, 4, 4},
+    {"version 3 (an older build's)", NULL, 8, 4, 3},
+    {"version 5", NULL, 8, 4, 5},
     {"header size", NULL, 12, 4, 64},
     {"section count too high", NULL, 24, 4, 17},
     {"section count too low", NULL, 24, 4, 14},
@@ -575,6 +584,9 @@ static void damage_tests(const char *what, const ssModel *m, const ssData *src,
     {"warm entry vertex negative", "WARM", 16, 4, 0xFFFFFFF0u},
     {"warm entry rate NaN", "WARM", 16 + 12 + 24, 8, UINT64_C(0x7ff8000000000000)},
     {"warm entry creep flag 2", "WARM", 16 + 8, 4, 2},
+    {"Newton record of step -2", "NEWT", 16, 8, UINT64_C(0xFFFFFFFFFFFFFFFE)},
+    {"Newton record of a step not yet taken", "NEWT", 16, 8, UINT64_C(1) << 40},
+    {"Newton record of 2^31 - 1 unknowns", "NEWT", 16 + 16, 4, 0x7FFFFFFFu},
   };
   int nforge = (int)(sizeof forge / sizeof forge[0]), fail = 0;
   for (int k = 0; k < nforge; k++) {
@@ -704,10 +716,10 @@ static void test_foreign_and_mismatch(void)
   /* info without a model */
   ssCheckpointInfo info;
   ok(ss_checkpoint_save(m, d, path, &e) == SS_OK && ss_checkpoint_info(path, &info, &e) == SS_OK &&
-     info.version == 3 && info.step == 20 && info.time == d->time &&
+     info.version == 4 && info.step == 20 && info.time == d->time &&
      info.bytes == n && strstr(info.source, "plate.xml") &&
      info.opt.solver_max_sweeps == m->opt.solver_max_sweeps,
-     "ss_checkpoint_info: version 3, step 20, time, size, source '%s'", info.source);
+     "ss_checkpoint_info: version 4, step 20, time, size, source '%s'", info.source);
 
   /* another world */
   ssModel *ml;
