@@ -1029,12 +1029,27 @@ static int lu_factor(double *A, int *piv, int n)
         A[k * n + j] = A[p * n + j];
         A[p * n + j] = t;
       }
+    /* the rows below, two at a time (one pass over the pivot row); y - f x
+     * as y + (-f) x, which rounds alike (ss_math.h) */
     double inv = 1 / A[k * n + k];
-    for (int i = k + 1; i < n; i++) {
+    const double *x = A + k * n + k + 1;
+    int i = k + 1, len = n - k - 1;
+    for (; i + 1 < n; i += 2) {
+      double f0 = A[i * n + k] * inv, f1 = A[(i + 1) * n + k] * inv;
+      A[i * n + k] = f0;
+      A[(i + 1) * n + k] = f1;
+      double *y0 = A + i * n + k + 1, *y1 = y0 + n;
+      if (f0 != 0 && f1 != 0) {
+        ss_row2_add_scaled(y0, -f0, y1, -f1, x, len);
+      } else {
+        if (f0 != 0) ss_row_add_scaled(y0, -f0, x, len);
+        if (f1 != 0) ss_row_add_scaled(y1, -f1, x, len);
+      }
+    }
+    if (i < n) {
       double f = A[i * n + k] * inv;
       A[i * n + k] = f;
-      if (f != 0)
-        for (int j = k + 1; j < n; j++) A[i * n + j] -= f * A[k * n + j];
+      if (f != 0) ss_row_add_scaled(A + i * n + k + 1, -f, x, len);
     }
   }
   return 1;

@@ -37,6 +37,28 @@ static inline void ss_row_add_scaled(double *y, double a, const double *x, int m
   for (; r < m; r++) y[r] += a * x[r];
 }
 
+/* y0 += a0 x and y1 += a1 x, likewise, in one pass over x */
+static inline void ss_row2_add_scaled(double *y0, double a0, double *y1, double a1,
+                                      const double *x, int m)
+{
+  ssV2 av0 = {a0, a0}, av1 = {a1, a1};
+  int r = 0;
+  for (; r + 2 <= m; r += 2) {
+    ssV2 xv, yv0, yv1;
+    memcpy(&xv, x + r, sizeof xv);
+    memcpy(&yv0, y0 + r, sizeof yv0);
+    memcpy(&yv1, y1 + r, sizeof yv1);
+    yv0 += av0 * xv;
+    yv1 += av1 * xv;
+    memcpy(y0 + r, &yv0, sizeof yv0);
+    memcpy(y1 + r, &yv1, sizeof yv1);
+  }
+  for (; r < m; r++) {
+    y0[r] += a0 * x[r];
+    y1[r] += a1 * x[r];
+  }
+}
+
 /* y[0..m) /= a, likewise */
 static inline void ss_row_div(double *y, double a, int m)
 {

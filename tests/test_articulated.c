@@ -698,7 +698,7 @@ static void test_row_lanes(void)
   int differ = 0, rows = 0, entries = 0;
   for (int m = 0; m <= 17; m++)
     for (int trial = 0; trial < 200; trial++) {
-      double x[17], y[17], ys[3][17], yv[3][17];
+      double x[17], y[17], ys[5][17], yv[5][17];
       for (int r = 0; r < m; r++) {
         s = s * 6364136223846793005ull + 1442695040888963407ull;
         double u = (double)(s >> 11) / 9007199254740992.0 - 0.5;
@@ -708,7 +708,8 @@ static void test_row_lanes(void)
         y[r] = (s >> 7) % 9 == 0 ? special[(s >> 20) % 10] : u;
       }
       double a = trial % 10 == 0 ? special[trial / 10 % 10] : 0.37 * (trial - 100);
-      for (int k = 0; k < 3; k++) {
+      double b = trial % 7 == 0 ? special[trial / 7 % 10] : 0.5 - 0.11 * trial;
+      for (int k = 0; k < 5; k++) {
         memcpy(ys[k], y, sizeof y);
         memcpy(yv[k], y, sizeof y);
       }
@@ -716,18 +717,22 @@ static void test_row_lanes(void)
         ys[0][r] -= a * x[r];
         ys[1][r] += a * x[r];
         ys[2][r] /= a;
+        ys[3][r] -= a * x[r];
+        ys[4][r] -= b * x[r];
       }
       ss_row_add_scaled(yv[0], -a, x, m);
       ss_row_add_scaled(yv[1], a, x, m);
       ss_row_div(yv[2], a, m);
-      for (int k = 0; k < 3; k++)
+      ss_row2_add_scaled(yv[3], -a, yv[4], -b, x, m);
+      for (int k = 0; k < 5; k++)
         for (int r = 0; r < m; r++)
           if (memcmp(&ys[k][r], &yv[k][r], sizeof(double)) && !(isnan(ys[k][r]) && isnan(yv[k][r])))
             differ++;
       rows++;
-      entries += 3 * m;
+      entries += 5 * m;
     }
-  ok(differ == 0, "row updates two lanes at a time: the scalar loops' values bit for bit "
+  ok(differ == 0, "row updates two lanes at a time (one row or two): the scalar loops' "
+     "values bit for bit "
      "(%d of %d entries differ over %d rows)", differ, entries, rows);
 }
 
