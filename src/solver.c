@@ -86,6 +86,25 @@ static void rows_impulse(const double *X, const double dl[3], double w[6])
   for (int i = 0; i < 6; i++) w[i] = X[i] * dl[0] + X[6 + i] * dl[1] + X[12 + i] * dl[2];
 }
 
+/* The same from the contact's point and frame, where X is not formed (it
+ * is only for the sweeps): X^T dl = (p x f; f), f = frame^T dl */
+static void link_impulse(const ssContact *c, const double dl[3], double w[6])
+{
+  const double *fr = c->frame;
+  for (int k = 0; k < 3; k++) w[3 + k] = fr[k] * dl[0] + fr[3 + k] * dl[1] + fr[6 + k] * dl[2];
+  ss_v3_cross(w, c->pos, w + 3);
+}
+
+/* and its contact-frame velocity X V = frame (v_o + omega x p) from the
+ * link's spatial velocity V = (omega; v_o) */
+static void link_point_velocity(const ssContact *c, const double V[6], double v[3])
+{
+  double w[3];
+  ss_v3_cross(w, V, c->pos);
+  ss_v3_add(w, w, V + 3);
+  ss_m3_mulv(v, c->frame, w);
+}
+
 /* u += Y w over the system's velocities */
 static void link_apply(ssData *d, const ssContact *c, const double *Y,
                        const double w[6])
@@ -104,7 +123,7 @@ static void contact_velocity(const ssModel *m, const ssData *d,
   if (c->link >= 0) {
     double V[6];
     ss_art_link_velocity(m, d, c->link, V);
-    rows_velocity(d->jac + c->jadr, V, v);
+    link_point_velocity(c, V, v);
     return;
   }
   const double *u = d->qvel + c->vadr;
@@ -152,7 +171,7 @@ static void apply_impulse(const ssModel *m, ssData *d, const ssContact *c,
     const double *Y, *Lam;
     double w[6];
     ss_art_link_block(m, d, c->link, &Y, &Lam);
-    rows_impulse(d->jac + c->jadr, dl, w);
+    link_impulse(c, dl, w);
     link_apply(d, c, Y, w);
     return;
   }
@@ -370,7 +389,7 @@ static int warm_start(const ssModel *m, ssData *d, int converged, int creep_rate
         memset(g.F, 0, sizeof g.F);
       }
       double w[6];
-      rows_impulse(d->jac + c->jadr, c->lambda, w);
+      link_impulse(c, c->lambda, w);
       for (int k = 0; k < 6; k++) g.F[k] += w[k];
     } else {
       group_close(d, &g);
@@ -622,14 +641,15 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   }
 
   /* what only the sweeps use: the body contacts' responses (a rigid
-   * body's J, W and G, a link contact's LX and G), and the soil points' laws
+   * body's J, W and G, a link contact's X, LX and G), and the soil points' laws
    * (the Newton phase has its own) */
   for (int i = 0; i < d->ncontact && sweeps > 0; i++) {
     ssContact *c = d->contact + i;
     double *J = d->jac + c->jadr;
-    if (c->link >= 0)
+    if (c->link >= 0) {
+      ss_art_contact_rows(c->pos, c->frame, J);
       ss_art_contact_response(m, d, c->link, J, J + 18, c->G);
-    else if (c->nv > 0 && (c->type == SS_CONTACT_SOIL || c->type == SS_CONTACT_RIGID)) {
+    } else if (c->nv > 0 && (c->type == SS_CONTACT_SOIL || c->type == SS_CONTACT_RIGID)) {
       int b = m->geom_body[c->geom];
       ss_dyn_contact_jacobian(d, b, c->pos, c->frame, J);
       ss_dyn_contact_response(m, d, b, J, J + 3 * c->nv, c->G);
@@ -695,7 +715,7 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
       /* one spatial velocity per link run */
       if (c->link != link) ss_art_link_velocity(m, d, c->link, V);
       link = c->link;
-      rows_velocity(d->jac + c->jadr, V, v);
+      link_point_velocity(c, V, v);
     } else if (c->nv) {
       contact_velocity(m, d, c, v);
     }

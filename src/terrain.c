@@ -38,22 +38,17 @@ static long contact_jlen(const ssModel *m, int sys)
   return m->sys_type[sys] == SS_SYS_ARTICULATED ? 36 : 6L * m->sys_nv[sys];
 }
 
-/* fill the system-dependent part of a contact: a link contact's rows X;
- * a rigid body's J and every response, which only the sweeps use, come
- * when they run (ss_solver_solve) */
+/* fill the system-dependent part of a contact: its system and link; a
+ * link contact's rows X, a rigid body's J and every response, which only
+ * the sweeps use, come when they run (ss_solver_solve) */
 static void attach(const ssModel *m, ssData *d, ssContact *c, int sys)
 {
+  (void)d;
   if (sys >= 0 && m->sys_nv[sys] > 0) {
     c->sys = sys;
     c->vadr = m->sys_vadr[sys];
     c->nv = m->sys_nv[sys];
-    if (m->sys_type[sys] == SS_SYS_ARTICULATED) {
-      double *J = d->jac + c->jadr;
-      c->link = m->geom_body[c->geom];
-      /* X now; LX (J + 18) and G when sweeps need them
-       * (ss_art_contact_response) */
-      ss_art_contact_rows(c->pos, c->frame, J);
-    }
+    if (m->sys_type[sys] == SS_SYS_ARTICULATED) c->link = m->geom_body[c->geom];
   } else {
     c->sys = -1;
     c->nv = 0;
