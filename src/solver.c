@@ -88,7 +88,7 @@ static void rows_impulse(const double *X, const double dl[3], double w[6])
 
 /* The same from the contact's point and frame, where X is not formed (it
  * is only for the sweeps): X^T dl = (p x f; f), f = frame^T dl */
-static void link_impulse(const ssContact *c, const double dl[3], double w[6])
+static inline void link_impulse(const ssContact *c, const double dl[3], double w[6])
 {
   const double *fr = c->frame;
   for (int k = 0; k < 3; k++) w[3 + k] = fr[k] * dl[0] + fr[3 + k] * dl[1] + fr[6 + k] * dl[2];
@@ -97,7 +97,7 @@ static void link_impulse(const ssContact *c, const double dl[3], double w[6])
 
 /* and its contact-frame velocity X V = frame (v_o + omega x p) from the
  * link's spatial velocity V = (omega; v_o) */
-static void link_point_velocity(const ssContact *c, const double V[6], double v[3])
+static inline void link_point_velocity(const ssContact *c, const double V[6], double v[3])
 {
   double w[3];
   ss_v3_cross(w, V, c->pos);
