@@ -808,6 +808,44 @@ void ss_art_link_motion(const ssModel *m, const ssData *d, int b,
   memcpy(V, sv, sizeof sv);
 }
 
+void ss_art_link_motion_cols(const ssModel *m, const ssData *d, int b, const double *U,
+                             int ldu, int ncol, double *out, int ldo)
+{
+  const ssArtWork *w = d->art[m->body_sys[b]];
+  /* two columns at a time, their six sums in registers (SSE2 pairs, the
+   * same products and sums as the scalar loop) */
+  int c = 0;
+  for (; c + 2 <= ncol; c += 2) {
+    ssV2 acc[6] = {{0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}};
+    for (int a = b; a >= 0; a = m->body_parent[a]) {
+      int nd = m->body_ndof[a];
+      if (!nd) continue;
+      int k0 = m->body_dofadr[a] - w->v0;
+      for (int k = k0; k < k0 + nd; k++) {
+        ssV2 u;
+        memcpy(&u, U + (size_t)ldu * k + c, sizeof u);
+        const double *S = w->S + 6 * k;
+        for (int i = 0; i < 6; i++) {
+          ssV2 sv = {S[i], S[i]};
+          acc[i] += sv * u;
+        }
+      }
+    }
+    for (int i = 0; i < 6; i++) memcpy(out + (size_t)ldo * i + c, &acc[i], sizeof acc[i]);
+  }
+  for (; c < ncol; c++) {
+    double V[6] = {0, 0, 0, 0, 0, 0};
+    for (int a = b; a >= 0; a = m->body_parent[a]) {
+      int nd = m->body_ndof[a];
+      if (!nd) continue;
+      int k0 = m->body_dofadr[a] - w->v0;
+      for (int k = k0; k < k0 + nd; k++)
+        for (int i = 0; i < 6; i++) V[i] += w->S[6 * k + i] * U[(size_t)ldu * k + c];
+    }
+    for (int i = 0; i < 6; i++) out[(size_t)ldo * i + c] = V[i];
+  }
+}
+
 void ss_art_point_velocity(const ssModel *m, const ssData *d, int b,
                            const double p[3], double v[3])
 {

@@ -83,6 +83,11 @@ void ss_art_link_velocity(const ssModel *m, const ssData *d, int b,
  * spatial motion J_b u. */
 void ss_art_link_motion(const ssModel *m, const ssData *d, int b,
                         const double *u, double V[6]);
+/* The same for the ncol columns of U (the system's velocities, row k = dof
+ * k at U + ldu k), into out (6 x ncol, row i at out + ldo i): each column
+ * summed in ss_art_link_motion's order, its V bit for bit */
+void ss_art_link_motion_cols(const ssModel *m, const ssData *d, int b, const double *U,
+                             int ldu, int ncol, double *out, int ldo);
 /* Contact rows of a world point p with contact frame `frame` (rows n, t1,
  * t2) on a link: X (3 x 6) maps the link's spatial velocity to the
  * contact-frame velocity of the point.  The contact's Jacobian is X J_b,

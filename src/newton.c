@@ -1153,20 +1153,30 @@ static void lam_matrix(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork
       col0 = 6 * s->ngroup + (gc - s->ngroup);
       stride = 3;
     }
-    for (int k = 0; k < ncol; k++) {
-      for (int i = 0; i < nv; i++) w->col[i] = Y[stride * i + k];
-      for (int gr = 0; gr < s->ngroup; gr++) {
-        if (w->grp[gr].sys != sys) continue;
+    for (int gr = 0; gr < s->ngroup; gr++) {
+      const NGroup *G = w->grp + gr;
+      if (G->sys != sys) continue;
+      double *out = w->Lam + (size_t)(6 * gr) * n + col0;
+      if (G->link >= 0) {
+        /* a link's block at once (the group_motion of each column, bit
+         * for bit), straight from Y's rows on the link's path */
+        ss_art_link_motion_cols(m, d, G->link, Y, stride, ncol, out, n);
+        continue;
+      }
+      for (int k = 0; k < ncol; k++) {
         double V[6];
-        group_motion(m, d, w->grp + gr, w->col, V);
-        for (int a = 0; a < 6; a++) w->Lam[(size_t)(6 * gr + a) * n + col0 + k] = V[a];
+        for (int i = 0; i < nv; i++) w->col[i] = Y[stride * i + k];
+        group_motion(m, d, G, w->col, V);
+        for (int a = 0; a < 6; a++) out[(size_t)a * n + k] = V[a];
       }
-      for (int r = 0; r < s->nrow; r++) {
-        const ssContact *c = d->contact + s->first_row + r;
-        if (c->sys != sys) continue;
-        int dof = c->dof - vadr;
-        w->Lam[(size_t)(6 * s->ngroup + r) * n + col0 + k] = d->jac[c->jadr + dof] * w->col[dof];
-      }
+    }
+    for (int r = 0; r < s->nrow; r++) {
+      const ssContact *c = d->contact + s->first_row + r;
+      if (c->sys != sys) continue;
+      int dof = c->dof - vadr;
+      for (int k = 0; k < ncol; k++)
+        w->Lam[(size_t)(6 * s->ngroup + r) * n + col0 + k] =
+            d->jac[c->jadr + dof] * Y[stride * dof + k];
     }
   }
 }
