@@ -330,6 +330,30 @@ static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
   }
   for (int i = 0; i < n; i++) {
     double *xi = X + (size_t)m * i;
+    if (m == 6) {
+      /* a response block's six columns: the row's sum over its ancestors
+       * in registers, three pairs (the same products and sums, in the
+       * same order, as the row updates below) */
+      ssV2 a0, a1, a2, x0, x1, x2;
+      memcpy(&a0, xi, sizeof a0);
+      memcpy(&a1, xi + 2, sizeof a1);
+      memcpy(&a2, xi + 4, sizeof a2);
+      for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) {
+        double h = -H[i * n + j];
+        ssV2 hv = {h, h};
+        const double *xj = X + 6 * (size_t)j;
+        memcpy(&x0, xj, sizeof x0);
+        memcpy(&x1, xj + 2, sizeof x1);
+        memcpy(&x2, xj + 4, sizeof x2);
+        a0 += hv * x0;
+        a1 += hv * x1;
+        a2 += hv * x2;
+      }
+      memcpy(xi, &a0, sizeof a0);
+      memcpy(xi + 2, &a1, sizeof a1);
+      memcpy(xi + 4, &a2, sizeof a2);
+      continue;
+    }
     for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) {
       double h = H[i * n + j];
       const double *xj = X + (size_t)m * j;
@@ -720,11 +744,30 @@ static void body_response(const ssModel *m, ssArtWork *w, int lb)
       }
     }
     closure_solve(w, Z, 6);
+    /* each row's sum t = (MiKT Z)_k in registers, three pairs (the same
+     * products and sums, in order, as six-wide row updates of t) */
     for (int k = 0; k < n; k++) {
       const double *Mk = w->MiKT + (size_t)k * nr;
-      double t[6] = {0, 0, 0, 0, 0, 0};
-      for (int i = 0; i < nr; i++) ss_row_add_scaled(t, Mk[i], Z + 6 * i, 6);
-      for (int r = 0; r < 6; r++) Y[6 * k + r] -= t[r];
+      ssV2 t0 = {0, 0}, t1 = {0, 0}, t2 = {0, 0}, z0, z1, z2, y;
+      for (int i = 0; i < nr; i++) {
+        ssV2 mv = {Mk[i], Mk[i]};
+        memcpy(&z0, Z + 6 * i, sizeof z0);
+        memcpy(&z1, Z + 6 * i + 2, sizeof z1);
+        memcpy(&z2, Z + 6 * i + 4, sizeof z2);
+        t0 += mv * z0;
+        t1 += mv * z1;
+        t2 += mv * z2;
+      }
+      double *yk = Y + 6 * k;
+      memcpy(&y, yk, sizeof y);
+      y -= t0;
+      memcpy(yk, &y, sizeof y);
+      memcpy(&y, yk + 2, sizeof y);
+      y -= t1;
+      memcpy(yk + 2, &y, sizeof y);
+      memcpy(&y, yk + 4, sizeof y);
+      y -= t2;
+      memcpy(yk + 4, &y, sizeof y);
     }
   }
   double *Lam = w->Lam + 36 * lb;
