@@ -58,7 +58,7 @@ ssContact *ss_contact_new(ssData *d, long njac)
     d->jac = q;
     d->cap_jac = cap;
   }
-  memset(c, 0, offsetof(ssContact, cache));
+  memset(c, 0, offsetof(ssContact, pos));
   c->cache.law.pw.s = 0; /* empty (see ssPointCache) */
   c->cache.ready = 0;
   c->link = -1;

@@ -40,27 +40,35 @@ struct ssContact {
   int run;           /* solver: contacts from this one on the same link */
   long jadr, jlen;   /* offset and length in ssData.jac: J (3 nv) then
                         W (nv x 3), or X (3 x 6) for a link contact */
-  double pos[3];     /* contact point, world */
-  double frame[9];   /* rows n, t1, t2 (world); n = bed +z / surface normal */
   double area;       /* soil: quadrature weight A (m^2) */
   double width;      /* soil: effective width b (m) */
   double g0;         /* separation along n at the step start (m, > 0 above) */
   double sp, j;      /* soil: plastic sinkage and shear before the step */
-  double G[9];       /* impulse response J W (3 x 3) */
   double lambda[3];  /* impulse in the contact frame (N s) */
   double mu;         /* rigid: friction coefficient */
   double vn_target;  /* rigid: lowest allowed normal velocity (m/s) */
   double row_a, row_b;/* PD: impulse = row_a - row_b v (before clamping) */
   double row_bound;  /* PD: |impulse| <= row_bound (effort dt) */
   int dof;           /* PD, limit: global velocity index */
-  double v[3];       /* contact-frame velocity at the end of the solve */
   int loaded;        /* soil: 1 if the point carries load at the end */
-  double warm_t[3];  /* soil: the cached traction its warm start came from */
   int warm_trend;    /* soil: 1 when warm_t is a converged step's traction,
                         so that this step's change can be formed */
-  ssPointCache cache;/* soil: the point solve's law and reused values (last:
-                        ss_contact_new zeroes what comes before it and marks
-                        it empty, without clearing its 264 bytes) */
+  /* From here on ss_contact_new leaves the fields as they were (it zeroes
+   * those above): each is written before it is read.  pos and frame: by
+   * the soil and rigid contacts' creators, and read only for those
+   * contacts; G: by the sweeps' set-up (soil and rigid contacts of moving
+   * bodies), by attach (terrain.c) for a static body's, by the joint rows'
+   * creators; v: by the solve's end, for every contact; warm_t: by the
+   * warm start, and read only where warm_trend says it was; cache: marked
+   * empty by ss_contact_new. */
+  double pos[3];     /* contact point, world */
+  double frame[9];   /* rows n, t1, t2 (world); n = bed +z / surface normal */
+  double G[9];       /* impulse response J W (3 x 3) */
+  double v[3];       /* contact-frame velocity at the end of the solve */
+  double warm_t[3];  /* soil: the cached traction its warm start came from */
+  ssPointCache cache;/* soil: the point solve's law and reused values
+                        (ss_contact_new marks it empty without clearing its
+                        264 bytes) */
 };
 
 /* A cached traction from the previous step (warm start).  The next step
@@ -93,7 +101,8 @@ struct ssWarmEntry {
  * checks a file's entries with it). */
 int ss_solver_warm_cmp(const ssWarmEntry *a, const ssWarmEntry *b);
 
-/* Room for one more contact (zeroed, its point cache empty, link = -1)
+/* Room for one more contact (zeroed up to pos, see ssContact; its point
+ * cache empty, link = -1)
  * with njac doubles of Jacobian storage in d->jac (6 nv for J and W, 36
  * for a link contact's X and LX); NULL when out of memory. */
 ssContact *ss_contact_new(ssData *d, long njac);
