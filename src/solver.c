@@ -440,8 +440,8 @@ SS_SORT_RUNS(sort_runs, ssWarmEntry, warm_less)
 ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
 {
   const double dt = m->opt.timestep;
-  int n = 0;
-  for (int i = 0; i < d->ncontact; i++) n += cached(d->contact + i);
+  /* room for every contact (those cached are fewer: no pass to count them) */
+  int n = d->ncontact;
   if (n > d->cap_warm) {
     ssWarmEntry *p = realloc(d->warm, (size_t)n * sizeof *p);
     if (!p) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
