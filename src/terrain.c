@@ -393,6 +393,17 @@ void ss_terrain_update(const ssModel *m, ssData *d)
     d->soil_sinkage[v] = d->soil_plastic[v];
     d->soil_shear[v] = 0;
   }
+  /* room for the new list of loaded vertices (at most one per contact)
+   * and the scratch of its sort after it; without it the old list stays
+   * (worst case some vertices recover a step late) */
+  if (2 * d->ncontact > d->cap_soil_loaded) {
+    int *p = realloc(d->soil_loaded, (size_t)d->ncontact * 2 * sizeof(int));
+    if (p) {
+      d->soil_loaded = p;
+      d->cap_soil_loaded = 2 * d->ncontact;
+    }
+  }
+  int collect = 2 * d->ncontact <= d->cap_soil_loaded;
   /* the material of bed `bed` and s^(n-1) for it: 1 where n = 1, else
    * by its table (solver.h), else libm, as the law forms it */
   int nload = 0, bed = -1;
@@ -426,24 +437,12 @@ void ss_terrain_update(const ssModel *m, ssData *d)
     st->soil_loaded++;
     st->soil_contact_area += c->area;
     st->soil_normal_force += c->lambda[0] / dt;
+    if (collect) d->soil_loaded[nload] = v;
     nload++;
   }
-  /* the new list of loaded vertices (unique), and room for the scratch of
-   * its sort after it */
-  if (2 * nload > d->cap_soil_loaded) {
-    int *p = realloc(d->soil_loaded, (size_t)nload * 2 * sizeof(int));
-    if (!p) {
-      /* keep the old list: worst case some vertices recover a step late */
-      return;
-    }
-    d->soil_loaded = p;
-    d->cap_soil_loaded = 2 * nload;
-  }
-  int n = 0;
-  for (int i = 0; i < d->ncontact; i++) {
-    const ssContact *c = d->contact + i;
-    if (c->type == SS_CONTACT_SOIL && c->loaded) d->soil_loaded[n++] = c->vertex;
-  }
+  if (!collect) return;
+  /* the new list of loaded vertices (unique) */
+  int n = nload;
   /* one collider's vertices come in order already (then the sort only
    * checks them); several colliders' are merged.  (With none loaded the
    * list may not exist yet: no arithmetic on its NULL.) */
