@@ -839,16 +839,7 @@ void ss_art_link_velocity(const ssModel *m, const ssData *d, int b,
 void ss_art_link_motion(const ssModel *m, const ssData *d, int b,
                         const double *u, double V[6])
 {
-  const ssArtWork *w = d->art[m->body_sys[b]];
-  double sv[6] = {0, 0, 0, 0, 0, 0};
-  for (int a = b; a >= 0; a = m->body_parent[a]) {
-    int nd = m->body_ndof[a];
-    if (!nd) continue;
-    int k0 = m->body_dofadr[a] - w->v0;
-    for (int k = k0; k < k0 + nd; k++)
-      for (int i = 0; i < 6; i++) sv[i] += w->S[6 * k + i] * u[k];
-  }
-  memcpy(V, sv, sizeof sv);
+  ss_art_link_motion_cols(m, d, b, u, 1, 1, V, 1);
 }
 
 void ss_art_link_motion_cols(const ssModel *m, const ssData *d, int b, const double *U,
@@ -856,7 +847,7 @@ void ss_art_link_motion_cols(const ssModel *m, const ssData *d, int b, const dou
 {
   const ssArtWork *w = d->art[m->body_sys[b]];
   /* two columns at a time, their six sums in registers (SSE2 pairs, the
-   * same products and sums as the scalar loop) */
+   * same products and sums as the scalar loop for the last odd one) */
   int c = 0;
   for (; c + 2 <= ncol; c += 2) {
     ssV2 acc[6] = {{0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}};

@@ -1276,8 +1276,9 @@ static int predict(const ssModel *m, const ssData *d, const Setup *s, ssNewtonWo
                    uint64_t key)
 {
   const ssNewtonRecord *r1 = d->newton_rec, *r2 = d->newton_rec + 1;
-  if (!m->opt.terrain_warm_start || d->solver_no_predict || r1->step != d->step - 1 || r2->step != d->step - 2 ||
-      r1->n != s->n || r2->n != s->n || r1->key != key || r2->key != key)
+  if (!m->opt.terrain_warm_start || d->solver_no_predict || r1->step != d->step - 1 ||
+      r2->step != d->step - 2 || r1->n != s->n || r2->n != s->n || r1->key != key ||
+      r2->key != key)
     return 0;
   for (int a = 0; a < s->n; a++) w->y[a] = w->yfree[a] + (2 * r1->c[a] - r2->c[a]);
   return 1;

@@ -41,9 +41,8 @@ static long contact_jlen(const ssModel *m, int sys)
 /* fill the system-dependent part of a contact: its system and link; a
  * link contact's rows X, a rigid body's J and every response, which only
  * the sweeps use, come when they run (ss_solver_solve) */
-static void attach(const ssModel *m, ssData *d, ssContact *c, int sys)
+static void attach(const ssModel *m, ssContact *c, int sys)
 {
-  (void)d;
   if (sys >= 0 && m->sys_nv[sys] > 0) {
     c->sys = sys;
     c->vadr = m->sys_vadr[sys];
@@ -255,7 +254,7 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       c->g0 = g0;
       c->sp = sp[k];
       c->j = jj[k];
-      attach(m, d, c, sys);
+      attach(m, c, sys);
     }
   }
   return SS_OK;
@@ -343,7 +342,7 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
           -pair->restitution * vn > c->vn_target)
         c->vn_target = -pair->restitution * vn;
     }
-    attach(m, d, c, sys);
+    attach(m, c, sys);
   }
   return SS_OK;
 }
@@ -441,14 +440,14 @@ void ss_terrain_update(const ssModel *m, ssData *d)
     nload++;
   }
   if (!collect) return;
-  /* the new list of loaded vertices (unique) */
-  int n = nload;
-  /* one collider's vertices come in order already (then the sort only
-   * checks them); several colliders' are merged.  (With none loaded the
-   * list may not exist yet: no arithmetic on its NULL.) */
-  const int *v = n > 1 ? merge_sort_runs(d->soil_loaded, d->soil_loaded + n, n) : d->soil_loaded;
+  /* the new list of loaded vertices (unique): one collider's vertices
+   * come in order already (then the sort only checks them); several
+   * colliders' are merged.  (With none loaded the list may not exist yet:
+   * no arithmetic on its NULL.) */
+  const int *v = nload > 1 ? merge_sort_runs(d->soil_loaded, d->soil_loaded + nload, nload)
+                           : d->soil_loaded;
   int u = 0;
-  for (int i = 0; i < n; i++)
+  for (int i = 0; i < nload; i++)
     if (u == 0 || d->soil_loaded[u - 1] != v[i]) d->soil_loaded[u++] = v[i];
   d->nsoil_loaded = u;
 }
