@@ -864,46 +864,17 @@ int ss_poly_contains(const ssPoly2 *p, double x, double y)
 /* ---------------------------------------------------------------------- */
 /* vertical ray casts                                                      */
 
-/* Parameter interval [*t0, *t1] of the line o + t d inside the finite
- * cylinder x^2 + y^2 <= r^2, |z| <= hl (shape frame).  0 when it misses. */
-static int cylinder_interval(const double o[3], const double d[3], double r,
-                             double hl, double *t0, double *t1)
+/* The slab |o + t d| <= h along one axis, with d's reciprocal id formed
+ * once (0 where d = 0: the line is parallel to it, inside or not) and
+ * e = h signed as d, so that the entry and exit need no comparison:
+ * [(-e - o) id, (e - o) id]. */
+static inline int slab(double o, double h, double e, double id, int par, double *tin,
+                       double *tout)
 {
-  double lin = -INFINITY, lout = INFINITY, sin_ = -INFINITY, sout = INFINITY;
-
-  /* lateral surface: infinite cylinder */
-  double a = d[0] * d[0] + d[1] * d[1];
-  double b = o[0] * d[0] + o[1] * d[1];
-  double c = o[0] * o[0] + o[1] * o[1] - r * r;
-  if (a == 0) {
-    if (c > 0) return 0;
-  } else {
-    double disc = b * b - a * c;
-    if (disc < 0) return 0;
-    /* stable roots q / a and c / q */
-    double q = -(b + copysign(sqrt(disc), b));
-    if (q == 0) {
-      lin = lout = 0;
-    } else {
-      double r1 = q / a, r2 = c / q;
-      lin = ss_min(r1, r2);
-      lout = ss_max(r1, r2);
-    }
-  }
-
-  /* caps: the slab between them */
-  if (d[2] == 0) {
-    if (fabs(o[2]) > hl) return 0;
-  } else {
-    double s1 = (-hl - o[2]) / d[2], s2 = (hl - o[2]) / d[2];
-    sin_ = ss_min(s1, s2);
-    sout = ss_max(s1, s2);
-  }
-
-  double tin = ss_max(lin, sin_), tout = ss_min(lout, sout);
-  if (!(tin <= tout)) return 0;
-  *t0 = tin;
-  *t1 = tout;
+  if (par) return fabs(o) <= h;
+  double t0 = (-e - o) * id, t1 = (e - o) * id;
+  *tin = t0 > *tin ? t0 : *tin;
+  *tout = t1 < *tout ? t1 : *tout;
   return 1;
 }
 
@@ -918,47 +889,86 @@ static int sphere_lowest(const double c[3], double r, double x, double y,
   return 1;
 }
 
-int ss_shape_lowest_z(const ssShape *s, double x, double y, double *z)
+void ss_shape_cast_init(ssShapeCast *c, const ssShape *s)
 {
   const double *R = s->R;
+  memset(c, 0, sizeof *c);
+  c->type = s->type;
+  ss_v3_copy(c->pos, s->pos);
+  c->r = s->size[0];
+  for (int k = 0; k < 3; k++) {
+    /* the line (x, y, pos_z) + t e_z in the shape frame: o + t d with
+     * o = R^T (x - pos_x, y - pos_y, 0) */
+    c->ox[k] = R[k];
+    c->oy[k] = R[3 + k];
+    c->d[k] = R[6 + k];
+    c->par[k] = c->d[k] == 0;
+    c->id[k] = c->par[k] ? 0 : 1 / c->d[k];
+    double h = s->type == SS_GEOM_BOX ? 0.5 * s->size[k] : 0.5 * s->size[1];
+    c->h[k] = h;
+    c->e[k] = copysign(h, c->d[k]);
+  }
+  /* the lateral surface: a t^2 + 2 b t + c = 0 with a fixed */
+  c->a = c->d[0] * c->d[0] + c->d[1] * c->d[1];
+  c->ia = c->a > 0 ? 1 / c->a : 0;
+  c->rr = c->r * c->r;
+  double hl = 0.5 * s->size[1];
+  for (int e = 0; e < 2; e++) {
+    double sg = e ? 1 : -1;
+    c->end[e][0] = s->pos[0] + sg * hl * R[2];
+    c->end[e][1] = s->pos[1] + sg * hl * R[5];
+    c->end[e][2] = s->pos[2] + sg * hl * R[8];
+  }
+}
 
-  if (s->type == SS_GEOM_SPHERE) return sphere_lowest(s->pos, s->size[0], x, y, z);
-  if (s->type != SS_GEOM_BOX && s->type != SS_GEOM_CYLINDER &&
-      s->type != SS_GEOM_CAPSULE)
+int ss_shape_cast_lowest_z(const ssShapeCast *c, double x, double y, double *z)
+{
+  if (c->type == SS_GEOM_SPHERE) return sphere_lowest(c->pos, c->r, x, y, z);
+  if (c->type != SS_GEOM_BOX && c->type != SS_GEOM_CYLINDER && c->type != SS_GEOM_CAPSULE)
     return 0;
+  double wx = x - c->pos[0], wy = y - c->pos[1];
+  double o0 = c->ox[0] * wx + c->oy[0] * wy, o1 = c->ox[1] * wx + c->oy[1] * wy;
+  double o2 = c->ox[2] * wx + c->oy[2] * wy;
+  double tin = -INFINITY, tout = INFINITY;
 
-  /* the line through (x, y, pos_z) in the shape frame: z = pos_z + t */
-  double w[3] = {x - s->pos[0], y - s->pos[1], 0}, o[3];
-  double d[3] = {R[6], R[7], R[8]};
-  ss_m3_mulvT(o, R, w);
-
-  if (s->type == SS_GEOM_BOX) {
-    /* slab method; a line parallel to a slab is in it or misses */
-    double tin = -INFINITY, tout = INFINITY;
-    for (int k = 0; k < 3; k++) {
-      double h = 0.5 * s->size[k];
-      if (d[k] == 0) {
-        if (fabs(o[k]) > h) return 0;
-        continue;
-      }
-      double t1 = (-h - o[k]) / d[k], t2 = (h - o[k]) / d[k];
-      tin = ss_max(tin, ss_min(t1, t2));
-      tout = ss_min(tout, ss_max(t1, t2));
-    }
-    if (!(tin <= tout)) return 0;
-    *z = s->pos[2] + tin;
+  if (c->type == SS_GEOM_BOX) {
+    /* slab method */
+    if (!slab(o0, c->h[0], c->e[0], c->id[0], c->par[0], &tin, &tout) ||
+        !slab(o1, c->h[1], c->e[1], c->id[1], c->par[1], &tin, &tout) ||
+        !slab(o2, c->h[2], c->e[2], c->id[2], c->par[2], &tin, &tout) || !(tin <= tout))
+      return 0;
+    *z = c->pos[2] + tin;
     return 1;
   }
 
-  double r = s->size[0], hl = 0.5 * s->size[1], t0, t1;
-  int hit = cylinder_interval(o, d, r, hl, &t0, &t1);
-  double best = hit ? s->pos[2] + t0 : INFINITY;
-  if (s->type == SS_GEOM_CAPSULE) {
+  /* the finite cylinder x^2 + y^2 <= r^2, |z| <= hl: the infinite one's
+   * interval (stable roots q / a and cc / q), then the caps' slab */
+  int hit = 1;
+  double b = o0 * c->d[0] + o1 * c->d[1], cc = o0 * o0 + o1 * o1 - c->rr;
+  if (c->a == 0) {
+    hit = !(cc > 0);
+  } else {
+    double disc = b * b - c->a * cc;
+    if (disc < 0) {
+      hit = 0;
+    } else {
+      double q = -(b + copysign(sqrt(disc), b));
+      if (q == 0) {
+        tin = tout = 0;
+      } else {
+        double r1 = q * c->ia, r2 = cc / q;
+        tin = ss_min(r1, r2);
+        tout = ss_max(r1, r2);
+      }
+    }
+  }
+  hit = hit && slab(o2, c->h[2], c->e[2], c->id[2], c->par[2], &tin, &tout) && tin <= tout;
+  double best = hit ? c->pos[2] + tin : INFINITY;
+  if (c->type == SS_GEOM_CAPSULE) {
     /* union with the end spheres: the first entry of any piece */
-    for (int e = -1; e <= 1; e += 2) {
-      double ce[3] = {s->pos[0] + e * hl * R[2], s->pos[1] + e * hl * R[5],
-                      s->pos[2] + e * hl * R[8]}, ze;
-      if (sphere_lowest(ce, r, x, y, &ze)) {
+    for (int e = 0; e < 2; e++) {
+      double ze;
+      if (sphere_lowest(c->end[e], c->r, x, y, &ze)) {
         hit = 1;
         best = fmin(best, ze);
       }
@@ -967,6 +977,13 @@ int ss_shape_lowest_z(const ssShape *s, double x, double y, double *z)
   if (!hit) return 0;
   *z = best;
   return 1;
+}
+
+int ss_shape_lowest_z(const ssShape *s, double x, double y, double *z)
+{
+  ssShapeCast c;
+  ss_shape_cast_init(&c, s);
+  return ss_shape_cast_lowest_z(&c, x, y, z);
 }
 
 /* ---------------------------------------------------------------------- */

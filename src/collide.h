@@ -97,6 +97,23 @@ int ss_poly_contains(const ssPoly2 *p, double x, double y);
  * the z where the upward ray first enters the solid.  Exact ray/shape
  * intersection.  Returns 1 and sets *z on a hit, 0 if the line misses. */
 int ss_shape_lowest_z(const ssShape *s, double x, double y, double *z);
+/* ss_shape_lowest_z for many lines through one shape: what does not depend
+ * on (x, y) formed once (ss_shape_cast_init), the direction's reciprocals
+ * among it, so that a line costs no division for a box and one for a
+ * cylinder (the results differ from a division's by rounding).
+ * ss_shape_lowest_z is the two in one. */
+typedef struct ssShapeCast {
+  int type;
+  double pos[3];
+  double ox[3], oy[3]; /* the line's origin in the shape frame: ox wx + oy wy */
+  double d[3], id[3];  /* its direction there, and 1/d (0 where d = 0) */
+  int par[3];          /* d = 0: parallel to that axis' slab */
+  double h[3], e[3];   /* slab half-widths, and signed as d */
+  double r, rr, a, ia; /* radius, r^2, d_x^2 + d_y^2 and its reciprocal */
+  double end[2][3];    /* a capsule's sphere centres */
+} ssShapeCast;
+void ss_shape_cast_init(ssShapeCast *c, const ssShape *s);
+int ss_shape_cast_lowest_z(const ssShapeCast *c, double x, double y, double *z);
 /* Rigid contact candidates against a surface with unit normal n: points of
  * the shape that can be lowest along n -- box: its 8 corners; sphere: the
  * point c - r n; capsule: c_i - r n for both end spheres; cylinder: for each

@@ -173,6 +173,8 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
 
   ssPoly2 fp;
   ss_shape_footprint(&s, &fp);
+  ssShapeCast cast;
+  ss_shape_cast_init(&cast, &s);
   /* a row's cells on the footprint's edge: area and centroid integrated
    * along the row's band of the footprint (ss_poly_band, formed at the
    * row's first such cell), the full clip where the band cannot be split
@@ -232,7 +234,7 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       double zl;
       if (m->geom_type[g] == SS_GEOM_MESH) {
         if (!mesh_depth(m, d, g, R, p, qx, qy, lo[2], &zl)) continue;
-      } else if (!ss_shape_lowest_z(&s, qx, qy, &zl)) {
+      } else if (!ss_shape_cast_lowest_z(&cast, qx, qy, &zl)) {
         continue;
       }
       int k = j * nx + i;
