@@ -484,49 +484,73 @@ static void solve_tangent(const TBlock *B, Mobil *J, double tf, double tl,
  * Jacobian.  Returns 1 with the impulse in lam once both residuals pass at
  * the same point (and the point does not stick there); 0 leaves the point
  * to the safeguarded loop, e.g. when an iterate leaves lambda_n > 0,
- * 0 < sigma <= |c_t|. */
+ * 0 < sigma <= |c_t|.  sure = 0: the start is not known to slip; the
+ * first evaluation tests that on its bound first (0 if it may stick). */
 static int coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu,
                         const double v0[3], const double G[9], double tol,
-                        double x, double sigma, double lam[3], int *iters)
+                        double x, double sigma, int sure, double lam[3], int *iters)
 {
-  double S = L->S;
+  /* slip_eval and slip_slope written out on scalars (the same
+   * expressions, so the same iterates): this loop is most of a warm
+   * coupled visit, and the Slip record would live in memory */
+  const double S = L->S, *Gt = B->G, e0 = B->e[0], e1 = B->e[1];
   for (int it = 0; it < 6; it++) {
+    double ct0 = v0[1] + e0 * x, ct1 = v0[2] + e1 * x;
+    double tf = tf0 + mu * x, e = 0, m = 0;
+    int out = !(sigma > 0) || sigma * sigma > ct0 * ct0 + ct1 * ct1;
+    if (!out || !sure) m = mobil_at(J, sigma, &e);
+    if (!sure) {
+      /* the start's cheap stick test (ss_point_soil), on this first
+       * evaluation's bound (not an iteration of its own): within it, the
+       * point may stick */
+      double ct[2] = {ct0, ct1};
+      if (stick_fits(B, ct, tf * m)) return 0;
+      sure = 1;
+    }
     (*iters)++;
-    double ct[2] = {v0[1] + B->e[0] * x, v0[2] + B->e[1] * x};
-    double tf = tf0 + mu * x;
-    if (!(sigma > 0) || sigma * sigma > ct[0] * ct[0] + ct[1] * ct[1]) return 0;
-    Slip z;
-    slip_eval(B, J, tf, ct, sigma, &z);
-    if (!z.ok) return 0;
-    double lt0 = -z.T * z.w[0], lt1 = -z.T * z.w[1];
+    if (out) return 0;
+    double T = tf * m, dT = tf * e * J->r;
+    double M0 = sigma + T * Gt[0], M1 = T * Gt[1], M2 = T * Gt[2], M3 = sigma + T * Gt[3];
+    double det = M0 * M3 - M1 * M2;
+    if (!(det > 0)) return 0;
+    double wa0 = M3 * ct0 - M1 * ct1, wa1 = M0 * ct1 - M2 * ct0;
+    double ra = sqrt(wa0 * wa0 + wa1 * wa1), id = 1 / det;
+    double wn = ra * id, w0 = wa0 * id, w1 = wa1 * id;
+    double lt0 = -T * w0, lt1 = -T * w1;
     double dP, d2P, vn = v0[0] + G[0] * x + G[1] * lt0 + G[2] * lt1;
-    double F1 = x - S * law_pressure(L, vn, &dP, &d2P), F2 = z.q - 1;
-    if (fabs(F1) <= tol * x && fabs(z.wn - 1) <= tol) {
+    double F1 = x - S * law_pressure(L, vn, &dP, &d2P);
+    if (fabs(F1) <= tol * x && fabs(wn - 1) <= tol) {
       /* a slip solution excludes sticking for SPD G; checked all the same,
        * with m(sigma) >= m0 deciding most cases without m0 */
-      if (stick_fits(B, ct, z.T) && stick_fits(B, ct, tf * mobil_m0(J))) return 0;
+      double ct[2] = {ct0, ct1};
+      if (stick_fits(B, ct, T) && stick_fits(B, ct, tf * mobil_m0(J))) return 0;
       lam[0] = x;
       lam[1] = lt0;
       lam[2] = lt1;
       return 1;
     }
+    /* q = 1/|w| and its slope (slip_slope): M w' = -(w + T' G w) */
+    double q = det / ra, F2 = q - 1;
+    double Mi0 = M3 * id, Mi1 = -M1 * id, Mi2 = -M2 * id, Mi3 = M0 * id;
+    double Gw0 = Gt[0] * w0 + Gt[1] * w1, Gw1 = Gt[2] * w0 + Gt[3] * w1;
+    double a0 = w0 + dT * Gw0, a1 = w1 + dT * Gw1;
+    double dw0 = -(Mi0 * a0 + Mi1 * a1), dw1 = -(Mi2 * a0 + Mi3 * a1);
+    double dq = -(w0 * dw0 + w1 * dw1) * q * q * q;
     /* d lambda_t/d lambda_n and d lambda_t/d sigma (M w = c_t, see
      * solve_tangent), then the 2x2 Newton step */
-    slip_slope(B, &z);
-    double Tx = mu * z.m, r[2], wx[2];
-    r[0] = B->e[0] - Tx * z.Gw[0];
-    r[1] = B->e[1] - Tx * z.Gw[1];
-    mul2(z.Mi, r, wx);
-    double ltx0 = -Tx * z.w[0] - z.T * wx[0], ltx1 = -Tx * z.w[1] - z.T * wx[1];
-    double lts0 = -z.dT * z.w[0] - z.T * z.dw[0], lts1 = -z.dT * z.w[1] - z.T * z.dw[1];
+    double Tx = mu * m;
+    double r0 = e0 - Tx * Gw0, r1 = e1 - Tx * Gw1;
+    double wx0 = Mi0 * r0 + Mi1 * r1, wx1 = Mi2 * r0 + Mi3 * r1;
+    double ltx0 = -Tx * w0 - T * wx0, ltx1 = -Tx * w1 - T * wx1;
+    double lts0 = -dT * w0 - T * dw0, lts1 = -dT * w1 - T * dw1;
     double J11 = 1 - S * dP * (G[0] + G[1] * ltx0 + G[2] * ltx1);
     double J12 = -S * dP * (G[1] * lts0 + G[2] * lts1);
-    double J21 = -(z.w[0] * wx[0] + z.w[1] * wx[1]) * z.q * z.q * z.q;
-    double J22 = z.dq;
-    double det = J11 * J22 - J12 * J21;
-    if (!(det > 0)) return 0;
-    x -= (J22 * F1 - J12 * F2) / det;
-    sigma -= (J11 * F2 - J21 * F1) / det;
+    double J21 = -(w0 * wx0 + w1 * wx1) * q * q * q;
+    double J22 = dq;
+    double jdet = J11 * J22 - J12 * J21;
+    if (!(jdet > 0)) return 0;
+    x -= (J22 * F1 - J12 * F2) / jdet;
+    sigma -= (J11 * F2 - J21 * F1) / jdet;
     if (!(x > 0)) return 0;
   }
   return 0;
@@ -560,19 +584,22 @@ int ss_point_soil(ssContact *c, const double v0[3], double tol)
     double vt1 = ct[1] + B->G[2] * lt[0] + B->G[3] * lt[1];
     double sig0 = sqrt(vt0 * vt0 + vt1 * vt1), tf = tf0 + mu * ln, lam[3], e;
     /* cheap stick test first: beyond the bound at the guessed slip speed
-     * (>= the bound at zero slip) it surely slips: the coupled Newton */
+     * (>= the bound at zero slip) it surely slips: the coupled Newton.
+     * Warm, its first evaluation is at sig0 and makes the test itself on
+     * the bound it forms there (sure = 0) */
     if (ln > 0 && sig0 > 0) {
-      double Ts = tf * mobil_at(J, sig0, &e);
+      int sure = 0;
       if (!(lt[0] != 0 || lt[1] != 0)) {
         /* no shear to go by: sigma + T(sigma) gamma = |c_t| for an
          * isotropic block of the block's compliance gamma along c_t */
-        double Gc[2];
+        double Gc[2], Ts = tf * mobil_at(J, sig0, &e);
         mul2(B->G, ct, Gc);
         double s1 = sig0 - Ts * (ct[0] * Gc[0] + ct[1] * Gc[1]) / (sig0 * sig0);
         if (s1 > 0.5 * sig0) sig0 = s1;
+        sure = !stick_fits(B, ct, Ts);
+        if (!sure) sig0 = 0; /* it may stick: not the coupled Newton */
       }
-      if (!stick_fits(B, ct, Ts) &&
-          coupled_slip(L, B, J, tf0, mu, v0, G, tol, ln, sig0, lam, &iters)) {
+      if (sig0 > 0 && coupled_slip(L, B, J, tf0, mu, v0, G, tol, ln, sig0, sure, lam, &iters)) {
         memcpy(c->lambda, lam, sizeof lam);
         return iters;
       }
