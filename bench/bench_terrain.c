@@ -327,7 +327,7 @@ static int bench_contact_law(const Opt *o)
           /* cold: a new contact, no first guess and nothing cached from the
            * last visit; its set-up is part of its first visit */
           c[i].lambda[0] = c[i].lambda[1] = c[i].lambda[2] = 0;
-          memset(&c[i].cache, 0, sizeof c[i].cache);
+          c[i].cache_ready = 0;
           ss_point_setup(&mat, pt, dt, &c[i]);
         }
         ss_point_soil(&c[i], vi + 3 * i, tol);

@@ -672,12 +672,12 @@ void ss_point_setup(const ssSoilMaterial *mat, const ssPowTable *tab, double dt,
     L.pser = ss_pow_series(L.m1);
     L.pser.tab = tab;
   }
-  if (k->law.pw.s > 0 && k->law.m1 == L.m1) L.pw = k->law.pw;
+  if (c->cache_ready && k->law.pw.s > 0 && k->law.m1 == L.m1) L.pw = k->law.pw;
   k->law = L;
   Mobil J;
   mobil_init(&J, c->j, mat->shear_displacement, dt);
-  if (!(k->ready && k->mob.x0 == J.x0 && k->mob.r == J.r)) k->mob = J;
-  k->ready = 1;
+  if (!(c->cache_ready && k->mob.x0 == J.x0 && k->mob.r == J.r)) k->mob = J;
+  c->cache_ready = 1;
   tblock_init(&k->tb, c->G);
   k->tf0 = L.S * mat->cohesion;
   k->mu = mat->friction_coefficient;

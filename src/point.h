@@ -43,17 +43,18 @@ typedef struct ssTBlock {
   int inert;     /* G_tt = 0: no response (static body) */
 } ssTBlock;
 
-/* The point's solve state kept on the contact (the contact is rebuilt,
- * zeroed, every step).  ss_solver_solve sets it up once per step before
- * the sweeps; ss_solver_soil_point sets it up at every call, keeping the
+/* The point's solve state kept on the contact (the contact is rebuilt
+ * every step).  ss_solver_solve sets it up once per step before the
+ * sweeps; ss_solver_soil_point sets it up at every call, keeping the
  * reused values only while what they were made from is unchanged (n - 1;
- * j/K and dt/K).  Zeroed: nothing set up or cached. */
+ * j/K and dt/K).  Empty, whatever its bytes, while the contact's
+ * cache_ready is 0 (ssContact): a new contact's cache is not written at
+ * all, so that the steps without sweeps never touch its cache lines. */
 typedef struct ssPointCache {
   ssLaw law;
   ssMobil mob;
   ssTBlock tb;
   double tf0, mu;           /* shear bound tf = tf0 + mu lambda_n: A dt c, mu */
-  int ready;                /* mob holds values */
 } ssPointCache;
 
 /* Set up the law of soil contact c for this step from its material

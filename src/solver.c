@@ -59,8 +59,6 @@ ssContact *ss_contact_new(ssData *d, long njac)
     d->cap_jac = cap;
   }
   memset(c, 0, offsetof(ssContact, pos));
-  c->cache.law.pw.s = 0; /* empty (see ssPointCache) */
-  c->cache.ready = 0;
   c->link = -1;
   c->jadr = jadr;
   c->jlen = njac;

@@ -53,22 +53,23 @@ struct ssContact {
   int loaded;        /* soil: 1 if the point carries load at the end */
   int warm_trend;    /* soil: 1 when warm_t is a converged step's traction,
                         so that this step's change can be formed */
+  int cache_ready;   /* soil: cache holds a set-up law (ss_point_setup); 0:
+                        empty, whatever its bytes */
   /* From here on ss_contact_new leaves the fields as they were (it zeroes
    * those above): each is written before it is read.  pos and frame: by
    * the soil and rigid contacts' creators, and read only for those
    * contacts; G: by the sweeps' set-up (soil and rigid contacts of moving
    * bodies), by attach (terrain.c) for a static body's, by the joint rows'
    * creators; v: by the solve's end, for every contact; warm_t: by the
-   * warm start, and read only where warm_trend says it was; cache: marked
-   * empty by ss_contact_new. */
+   * warm start, and read only where warm_trend says it was; cache: by
+   * ss_point_setup, read only where cache_ready says it was. */
   double pos[3];     /* contact point, world */
   double frame[9];   /* rows n, t1, t2 (world); n = bed +z / surface normal */
   double G[9];       /* impulse response J W (3 x 3) */
   double v[3];       /* contact-frame velocity at the end of the solve */
   double warm_t[3];  /* soil: the cached traction its warm start came from */
   ssPointCache cache;/* soil: the point solve's law and reused values
-                        (ss_contact_new marks it empty without clearing its
-                        264 bytes) */
+                        (empty while cache_ready is 0) */
 };
 
 /* A cached traction from the previous step (warm start).  The next step
@@ -101,8 +102,8 @@ struct ssWarmEntry {
  * checks a file's entries with it). */
 int ss_solver_warm_cmp(const ssWarmEntry *a, const ssWarmEntry *b);
 
-/* Room for one more contact (zeroed up to pos, see ssContact; its point
- * cache empty, link = -1)
+/* Room for one more contact (zeroed up to pos, see ssContact, so its point
+ * cache empty; link = -1)
  * with njac doubles of Jacobian storage in d->jac (6 nv for J and W, 36
  * for a link contact's X and LX); NULL when out of memory. */
 ssContact *ss_contact_new(ssData *d, long njac);
