@@ -864,31 +864,6 @@ int ss_poly_contains(const ssPoly2 *p, double x, double y)
 /* ---------------------------------------------------------------------- */
 /* vertical ray casts                                                      */
 
-/* The slab |o + t d| <= h along one axis, with d's reciprocal id formed
- * once (0 where d = 0: the line is parallel to it, inside or not) and
- * e = h signed as d, so that the entry and exit need no comparison:
- * [(-e - o) id, (e - o) id]. */
-static inline int slab(double o, double h, double e, double id, int par, double *tin,
-                       double *tout)
-{
-  if (par) return fabs(o) <= h;
-  double t0 = (-e - o) * id, t1 = (e - o) * id;
-  *tin = t0 > *tin ? t0 : *tin;
-  *tout = t1 < *tout ? t1 : *tout;
-  return 1;
-}
-
-/* lowest z of a sphere over (x, y), in the caller's frame */
-static int sphere_lowest(const double c[3], double r, double x, double y,
-                         double *z)
-{
-  double dx = x - c[0], dy = y - c[1];
-  double h = r * r - (dx * dx + dy * dy);
-  if (h < 0) return 0;
-  *z = c[2] - sqrt(h);
-  return 1;
-}
-
 void ss_shape_cast_init(ssShapeCast *c, const ssShape *s)
 {
   const double *R = s->R;
@@ -919,64 +894,6 @@ void ss_shape_cast_init(ssShapeCast *c, const ssShape *s)
     c->end[e][1] = s->pos[1] + sg * hl * R[5];
     c->end[e][2] = s->pos[2] + sg * hl * R[8];
   }
-}
-
-int ss_shape_cast_lowest_z(const ssShapeCast *c, double x, double y, double *z)
-{
-  if (c->type == SS_GEOM_SPHERE) return sphere_lowest(c->pos, c->r, x, y, z);
-  if (c->type != SS_GEOM_BOX && c->type != SS_GEOM_CYLINDER && c->type != SS_GEOM_CAPSULE)
-    return 0;
-  double wx = x - c->pos[0], wy = y - c->pos[1];
-  double o0 = c->ox[0] * wx + c->oy[0] * wy, o1 = c->ox[1] * wx + c->oy[1] * wy;
-  double o2 = c->ox[2] * wx + c->oy[2] * wy;
-  double tin = -INFINITY, tout = INFINITY;
-
-  if (c->type == SS_GEOM_BOX) {
-    /* slab method */
-    if (!slab(o0, c->h[0], c->e[0], c->id[0], c->par[0], &tin, &tout) ||
-        !slab(o1, c->h[1], c->e[1], c->id[1], c->par[1], &tin, &tout) ||
-        !slab(o2, c->h[2], c->e[2], c->id[2], c->par[2], &tin, &tout) || !(tin <= tout))
-      return 0;
-    *z = c->pos[2] + tin;
-    return 1;
-  }
-
-  /* the finite cylinder x^2 + y^2 <= r^2, |z| <= hl: the infinite one's
-   * interval (stable roots q / a and cc / q), then the caps' slab */
-  int hit = 1;
-  double b = o0 * c->d[0] + o1 * c->d[1], cc = o0 * o0 + o1 * o1 - c->rr;
-  if (c->a == 0) {
-    hit = !(cc > 0);
-  } else {
-    double disc = b * b - c->a * cc;
-    if (disc < 0) {
-      hit = 0;
-    } else {
-      double q = -(b + copysign(sqrt(disc), b));
-      if (q == 0) {
-        tin = tout = 0;
-      } else {
-        double r1 = q * c->ia, r2 = cc / q;
-        tin = ss_min(r1, r2);
-        tout = ss_max(r1, r2);
-      }
-    }
-  }
-  hit = hit && slab(o2, c->h[2], c->e[2], c->id[2], c->par[2], &tin, &tout) && tin <= tout;
-  double best = hit ? c->pos[2] + tin : INFINITY;
-  if (c->type == SS_GEOM_CAPSULE) {
-    /* union with the end spheres: the first entry of any piece */
-    for (int e = 0; e < 2; e++) {
-      double ze;
-      if (sphere_lowest(c->end[e], c->r, x, y, &ze)) {
-        hit = 1;
-        best = fmin(best, ze);
-      }
-    }
-  }
-  if (!hit) return 0;
-  *z = best;
-  return 1;
 }
 
 int ss_shape_lowest_z(const ssShape *s, double x, double y, double *z)

@@ -10,6 +10,8 @@
 
 #include "soilsim.h"
 
+#include <math.h>
+
 /* A collider placed in the caller's frame. */
 typedef struct ssShape {
   int type;        /* ssGeomType (box, sphere, cylinder, capsule) */
@@ -113,7 +115,90 @@ typedef struct ssShapeCast {
   double end[2][3];    /* a capsule's sphere centres */
 } ssShapeCast;
 void ss_shape_cast_init(ssShapeCast *c, const ssShape *s);
-int ss_shape_cast_lowest_z(const ssShapeCast *c, double x, double y, double *z);
+/* (inline: soil_contacts calls it once per cell) */
+/* The slab |o + t d| <= h along one axis, with d's reciprocal id formed
+ * once (0 where d = 0: the line is parallel to it, inside or not) and
+ * e = h signed as d, so that the entry and exit need no comparison:
+ * [(-e - o) id, (e - o) id]. */
+static inline int ss_cast_slab(double o, double h, double e, double id, int par, double *tin,
+                       double *tout)
+{
+  if (par) return fabs(o) <= h;
+  double t0 = (-e - o) * id, t1 = (e - o) * id;
+  *tin = t0 > *tin ? t0 : *tin;
+  *tout = t1 < *tout ? t1 : *tout;
+  return 1;
+}
+
+/* lowest z of a sphere over (x, y), in the caller's frame */
+static inline int ss_cast_sphere(const double c[3], double r, double x, double y,
+                         double *z)
+{
+  double dx = x - c[0], dy = y - c[1];
+  double h = r * r - (dx * dx + dy * dy);
+  if (h < 0) return 0;
+  *z = c[2] - sqrt(h);
+  return 1;
+}
+
+static inline int ss_shape_cast_lowest_z(const ssShapeCast *c, double x, double y, double *z)
+{
+  if (c->type == SS_GEOM_SPHERE) return ss_cast_sphere(c->pos, c->r, x, y, z);
+  if (c->type != SS_GEOM_BOX && c->type != SS_GEOM_CYLINDER && c->type != SS_GEOM_CAPSULE)
+    return 0;
+  double wx = x - c->pos[0], wy = y - c->pos[1];
+  double o0 = c->ox[0] * wx + c->oy[0] * wy, o1 = c->ox[1] * wx + c->oy[1] * wy;
+  double o2 = c->ox[2] * wx + c->oy[2] * wy;
+  double tin = -INFINITY, tout = INFINITY;
+
+  if (c->type == SS_GEOM_BOX) {
+    /* slab method */
+    if (!ss_cast_slab(o0, c->h[0], c->e[0], c->id[0], c->par[0], &tin, &tout) ||
+        !ss_cast_slab(o1, c->h[1], c->e[1], c->id[1], c->par[1], &tin, &tout) ||
+        !ss_cast_slab(o2, c->h[2], c->e[2], c->id[2], c->par[2], &tin, &tout) || !(tin <= tout))
+      return 0;
+    *z = c->pos[2] + tin;
+    return 1;
+  }
+
+  /* the finite cylinder x^2 + y^2 <= r^2, |z| <= hl: the infinite one's
+   * interval (stable roots q / a and cc / q), then the caps' slab */
+  int hit = 1;
+  double b = o0 * c->d[0] + o1 * c->d[1], cc = o0 * o0 + o1 * o1 - c->rr;
+  if (c->a == 0) {
+    hit = !(cc > 0);
+  } else {
+    double disc = b * b - c->a * cc;
+    if (disc < 0) {
+      hit = 0;
+    } else {
+      double q = -(b + copysign(sqrt(disc), b));
+      if (q == 0) {
+        tin = tout = 0;
+      } else {
+        double r1 = q * c->ia, r2 = cc / q;
+        tin = r1 < r2 ? r1 : r2;
+        tout = r1 > r2 ? r1 : r2;
+      }
+    }
+  }
+  hit = hit && ss_cast_slab(o2, c->h[2], c->e[2], c->id[2], c->par[2], &tin, &tout) && tin <= tout;
+  double best = hit ? c->pos[2] + tin : INFINITY;
+  if (c->type == SS_GEOM_CAPSULE) {
+    /* union with the end spheres: the first entry of any piece */
+    for (int e = 0; e < 2; e++) {
+      double ze;
+      if (ss_cast_sphere(c->end[e], c->r, x, y, &ze)) {
+        hit = 1;
+        best = fmin(best, ze);
+      }
+    }
+  }
+  if (!hit) return 0;
+  *z = best;
+  return 1;
+}
+
 /* Rigid contact candidates against a surface with unit normal n: points of
  * the shape that can be lowest along n -- box: its 8 corners; sphere: the
  * point c - r n; capsule: c_i - r n for both end spheres; cylinder: for each
