@@ -347,7 +347,10 @@ static int warm_start(const ssModel *m, ssData *d, int converged, int creep_rate
       c->warm_trend = converged;
       double ln = t[0] > 0 ? t[0] * scale : 0;
       double lt0 = t[1] * scale, lt1 = t[2] * scale;
-      double lim = scale * ss_soil_shear_strength(&m->hfield_soilmat[c->hfield], ln / scale);
+      /* the bound at zero slip as the laws form it (point.c, newton.c):
+       * A dt c + mu lambda_n, the strength tau_f(p_n) times A dt */
+      const ssSoilMaterial *mat = &m->hfield_soilmat[c->hfield];
+      double lim = scale * mat->cohesion + mat->friction_coefficient * ln;
       double mag = sqrt(lt0 * lt0 + lt1 * lt1);
       if (mag > lim) {
         lt0 *= lim / mag;
