@@ -15,6 +15,7 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -232,7 +233,21 @@ static void group_close(ssData *d, Group *g)
  * in vertex order and the colliders in order, so a step's entries arrive
  * sorted or in a few runs (one per bed), and the warm start's look-ups
  * walk the cache forwards without skipping other colliders' entries.
- * Entry e against the key (geom, vertex): <0, 0, >0. */
+ * The key (geom, vertex) as one number: the geom taken as unsigned, then
+ * the vertex with its sign bit flipped (signed order as unsigned). */
+static inline uint64_t warm_key(int geom, int vertex)
+{
+  return (uint64_t)(uint32_t)geom << 32 | ((uint32_t)vertex ^ 0x80000000u);
+}
+
+static inline uint64_t entry_key(const ssWarmEntry *e)
+{
+  return warm_key(e->geom, e->vertex);
+}
+
+/* entry e against the key (geom, vertex): <0, 0, >0, the order of
+ * warm_key in two comparisons (the sort's, where most pairs differ in the
+ * geom or not at all) */
 static inline int cmp_key(const ssWarmEntry *e, int geom, int vertex)
 {
   unsigned ge = (unsigned)e->geom, g = (unsigned)geom;
@@ -267,24 +282,25 @@ static void row_key(const ssData *d, const ssContact *c, int *geom, int *vertex)
 static const ssWarmEntry *find_warm(const ssData *d, int geom, int vertex, int *cursor)
 {
   int p = *cursor, n = d->nwarm;
-  if (p < n && cmp_key(d->warm + p, geom, vertex) <= 0) {
+  const uint64_t key = warm_key(geom, vertex);
+  if (p < n && entry_key(d->warm + p) <= key) {
     for (int k = 0; k < 8 && p < n; k++, p++) {
-      int c = cmp_key(d->warm + p, geom, vertex);
-      if (c == 0) {
+      uint64_t ek = entry_key(d->warm + p);
+      if (ek == key) {
         *cursor = p + 1;
         return d->warm + p;
       }
-      if (c > 0) return NULL; /* passed it: not cached */
+      if (ek > key) return NULL; /* passed it: not cached */
     }
   }
   /* the first entry not below the key */
   int a = 0, b = n;
   while (a < b) {
     int mid = a + (b - a) / 2;
-    if (cmp_key(d->warm + mid, geom, vertex) < 0) a = mid + 1;
+    if (entry_key(d->warm + mid) < key) a = mid + 1;
     else b = mid;
   }
-  if (a == n || cmp_key(d->warm + a, geom, vertex) != 0) return NULL;
+  if (a == n || entry_key(d->warm + a) != key) return NULL;
   *cursor = a + 1;
   return d->warm + a;
 }
