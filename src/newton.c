@@ -1076,8 +1076,9 @@ static void lu_solve(const double *A, const int *piv, int n, double *x)
 
 /* Points at y that stick or come near it (point_law's STICKS, NEAR; the
  * law run again on copies of the points, their memos kept) go to impulse
- * form, from their impulse there or, sticking, the one their contact
- * holds (the warm start).  Returns how many went. */
+ * form, from their impulse there or, sticking, their warm start's
+ * (ss_solver_warm_lambda: applied or still pending).  Returns how many
+ * went. */
 static int switch_points(const ssModel *m, const ssData *d, const Setup *s, ssNewtonWork *w)
 {
   int moved = 0, gprev = -1;
@@ -1091,10 +1092,11 @@ static int switch_points(const ssModel *m, const ssData *d, const Setup *s, ssNe
       gprev = g;
       M = mat_of(w->grp + g, m->opt.timestep);
     }
-    double lam[3];
+    double lam[3], warm[3];
     int st = point_law(&M, &P, w->sum[g].V, lam, NULL);
     if (st != NEAR && st != STICKS) continue;
-    const double *m0 = st == STICKS ? d->contact[i].lambda + 1 : lam + 1;
+    if (st == STICKS) ss_solver_warm_lambda(m, d, i, warm);
+    const double *m0 = st == STICKS ? warm + 1 : lam + 1;
     w->pt[i].imp = 1;
     w->imp[w->ns++] = i;
     w->mu[2 * i] = m0[0];
@@ -1197,6 +1199,7 @@ static void unknowns_of(const ssModel *m, const ssData *d, const Setup *s,
  * u = u_free + sum Y_b F_b + sum W_r lambda_r */
 static void apply(const ssModel *m, ssData *d, const Setup *s, const ssNewtonWork *w)
 {
+  d->warm_pending = 0; /* the answer replaces the warm start, applied or not */
   for (int i = 0; i < s->first_row; i++)
     memcpy(d->contact[i].lambda, w->lam + 3 * i, 3 * sizeof(double));
   memcpy(d->qvel, d->qvel_free, (size_t)m->nv * sizeof(double));
@@ -1269,6 +1272,14 @@ static uint64_t unknowns_key(const ssData *d, const Setup *s, const ssNewtonWork
   return h;
 }
 
+/* (solver.h) */
+int ss_newton_may_predict(const ssModel *m, const ssData *d)
+{
+  const ssNewtonRecord *r1 = d->newton_rec, *r2 = d->newton_rec + 1;
+  return m->opt.terrain_warm_start && !d->solver_no_predict && !d->solver_gs_only &&
+         r1->step == d->step - 1 && r2->step == d->step - 2;
+}
+
 /* y <- y_free + 2 c_1 - c_2 where the two steps before left their answers
  * for these unknowns; 1 if it did.  A cold start (terrain_warm_start off)
  * starts cold here too. */
@@ -1276,8 +1287,7 @@ static int predict(const ssModel *m, const ssData *d, const Setup *s, ssNewtonWo
                    uint64_t key)
 {
   const ssNewtonRecord *r1 = d->newton_rec, *r2 = d->newton_rec + 1;
-  if (!m->opt.terrain_warm_start || d->solver_no_predict || r1->step != d->step - 1 ||
-      r2->step != d->step - 2 || r1->n != s->n || r2->n != s->n || r1->key != key ||
+  if (!ss_newton_may_predict(m, d) || r1->n != s->n || r2->n != s->n || r1->key != key ||
       r2->key != key)
     return 0;
   for (int a = 0; a < s->n; a++) w->y[a] = w->yfree[a] + (2 * r1->c[a] - r2->c[a]);
@@ -1417,9 +1427,14 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
   for (int i = 0; i < first_row; i++)
     w->pt[i].gtt = slip_response(w->grp[w->group_of[i]].gq, w->pt[i].r);
   unknowns_of(m, d, &s, w, d->qvel_free, w->yfree);
-  unknowns_of(m, d, &s, w, d->qvel, w->y);
   uint64_t key = unknowns_key(d, &s, w);
   int from_last = *predicted = may_predict && predict(m, d, &s, w, key);
+  if (!from_last) {
+    /* from the warm start: its impulses and velocities (solver.c applies
+     * them only now, where a solve starts from them) */
+    ss_solver_warm_apply(m, d);
+    unknowns_of(m, d, &s, w, d->qvel, w->y);
+  }
   /* Newton with backtracking on |phi|^2, until |phi| is within ten times
    * the solver's tolerance of the contacts' effect |Lam F| (both weighted,
    * see residual); then the answer is applied and checked against every

@@ -480,10 +480,20 @@ typedef struct ssData {
   int solver_no_predict;  /* 1: the Newton phase starts from the warm start
                              alone, not from its last answers extrapolated
                              (newton.c); the reference path of the tests */
+  int solver_warm_eager;  /* 1: the warm start is applied at once, also
+                             where the Newton phase may start from its
+                             prediction (solver.c); the reference path of
+                             the tests, the same bits */
   int solver_settled;     /* 1: the last solve's answer was its warm start
                              as it came (the Newton phase's settled body),
                              whose laws' impulses the cache keeps (internal,
                              solver.c) */
+  int warm_pending;       /* 1: the warm start's cache entries are matched
+                             (ssContact.warm_entry) but their impulses are
+                             not yet in the contacts and qvel
+                             (ss_solver_warm_apply; internal, solver.c) */
+  int warm_creep_rates;   /* the pending warm start extrapolates creeping
+                             colliders too (internal) */
   struct ssNewtonWork *newton; /* the Newton phase's workspace (internal) */
   ssStepStats stats;
 } ssData;

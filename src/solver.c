@@ -321,6 +321,101 @@ static void body_run_close(const ssModel *m, ssData *d, BodyRun *r)
   memset(r->F, 0, sizeof r->F);
 }
 
+/* The warm start's velocity change, accumulated over the contacts in
+ * order: a link run's and a rigid body's impulses reach u once, at the
+ * run's end */
+typedef struct WarmApply {
+  Group g;
+  BodyRun br;
+} WarmApply;
+
+/* contact c's warm impulse from its cache entry e (with the creeping
+ * colliders' rates or without) into lam, whose entries a joint row leaves
+ * as they are (0) */
+static inline __attribute__((always_inline)) void
+warm_impulse(const ssModel *m, const ssContact *c, const ssWarmEntry *e, int creep_rates,
+             double lam[3])
+{
+  const double dt = m->opt.timestep;
+  if (c->type == SS_CONTACT_PD) {
+    double l = e->traction[0] * dt;
+    lam[0] = l > c->row_bound ? c->row_bound : l < -c->row_bound ? -c->row_bound : l;
+  } else if (c->type == SS_CONTACT_LIMIT) {
+    lam[0] = e->traction[0] > 0 ? e->traction[0] * dt : 0;
+  } else {
+    double scale = c->area * dt, t[3];
+    static const double none[3] = {0, 0, 0};
+    const double *rate = e->creep && !creep_rates ? none : e->rate;
+    for (int k = 0; k < 3; k++) t[k] = e->traction[k] + rate[k];
+    double ln = t[0] > 0 ? t[0] * scale : 0;
+    double lt0 = t[1] * scale, lt1 = t[2] * scale;
+    /* the bound at zero slip as the laws form it (point.c, newton.c):
+     * A dt c + mu lambda_n, the strength tau_f(p_n) times A dt */
+    const ssSoilMaterial *mat = &m->hfield_soilmat[c->hfield];
+    double lim = scale * mat->cohesion + mat->friction_coefficient * ln;
+    double mag = sqrt(lt0 * lt0 + lt1 * lt1);
+    if (mag > lim) {
+      lt0 *= lim / mag;
+      lt1 *= lim / mag;
+    }
+    lam[0] = ln;
+    lam[1] = lt0;
+    lam[2] = lt1;
+  }
+}
+
+/* contact c's warm impulse, and its velocity change into a */
+static inline __attribute__((always_inline)) void
+warm_one(const ssModel *m, ssData *d, ssContact *c, const ssWarmEntry *e, int creep_rates,
+         WarmApply *a)
+{
+  warm_impulse(m, c, e, creep_rates, c->lambda);
+  if (!c->nv) return;
+  Group *g = &a->g;
+  BodyRun *br = &a->br;
+  if (c->link < 0 && c->type == SS_CONTACT_SOIL) {
+    /* a rigid body's run likewise, as J^T lambda */
+    group_close(d, g);
+    int b = m->geom_body[c->geom];
+    if (br->body != b) {
+      body_run_close(m, d, br);
+      br->body = b;
+    }
+    /* J^T lambda = (f; r x f), f = frame^T lambda, r from the centre of
+     * mass (J is formed only for the sweeps) */
+    const double *fr = c->frame, *l = c->lambda;
+    double f[3], r[3], t[3];
+    for (int k = 0; k < 3; k++) f[k] = fr[k] * l[0] + fr[3 + k] * l[1] + fr[6 + k] * l[2];
+    ss_v3_sub(r, c->pos, d->body_xipos + 3 * b);
+    ss_v3_cross(t, r, f);
+    for (int k = 0; k < 3; k++) {
+      br->F[k] += f[k];
+      br->F[3 + k] += t[k];
+    }
+  } else if (c->link >= 0 && !d->solver_full) {
+    body_run_close(m, d, br);
+    if (!g->first || g->first->link != c->link) {
+      group_close(d, g);
+      g->first = c;
+      ss_art_link_block(m, d, c->link, &g->Y, &g->Lam);
+      memset(g->F, 0, sizeof g->F);
+    }
+    double w[6];
+    link_impulse(c, c->lambda, w);
+    for (int k = 0; k < 6; k++) g->F[k] += w[k];
+  } else {
+    group_close(d, g);
+    body_run_close(m, d, br);
+    apply_impulse(m, d, c, c->lambda);
+  }
+}
+
+static void warm_close(const ssModel *m, ssData *d, WarmApply *a)
+{
+  group_close(d, &a->g);
+  body_run_close(m, d, &a->br);
+}
+
 /* Initial impulses from last step's tractions extrapolated by their rate
  * (ssWarmEntry), scaled by the current area and time step and projected
  * into the current bounds; joint rows start from last step's impulse
@@ -328,95 +423,60 @@ static void body_run_close(const ssModel *m, ssData *d, BodyRun *r)
  * previous step's stats), so this step may form their rate.  A creeping
  * collider's entries (creep) are extrapolated only with creep_rates.  On
  * entry d->qvel is the free velocity; returns how many matched entries'
- * rates were left out. */
+ * rates were left out.
+ * Where the Newton phase may start from its prediction instead
+ * (ss_newton_may_predict; on the rolling buggy, most steps), only the
+ * cache entries are matched (c->warm_entry) and the tractions they came
+ * from kept (warm_t, warm_trend: the cache's rates need them whatever the
+ * solve starts from); the impulses stay 0 and d->qvel free until
+ * ss_solver_warm_apply, which the Newton phase calls only where it starts
+ * from the warm start after all, and the solve before any sweep. */
 static int warm_start(const ssModel *m, ssData *d, int converged, int creep_rates)
 {
-  int left = 0;
-  const double dt = m->opt.timestep;
-  Group g = {NULL, NULL, NULL, {0}, {0}};
-  BodyRun br = {-1, {0}};
-  int cursor = 0;
+  int left = 0, cursor = 0, defer = !d->solver_warm_eager && ss_newton_may_predict(m, d);
+  WarmApply a = {{NULL, NULL, NULL, {0}, {0}}, {-1, {0}}};
+  d->warm_creep_rates = creep_rates;
   for (int i = 0; i < d->ncontact; i++) {
     ssContact *c = d->contact + i;
     c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
-    if (!m->opt.terrain_warm_start || c->type == SS_CONTACT_RIGID || !d->nwarm)
-      continue;
-    int geom = c->geom, vertex = c->vertex;
-    if (c->type != SS_CONTACT_SOIL) row_key(d, c, &geom, &vertex);
-    const ssWarmEntry *e = find_warm(d, geom, vertex, &cursor);
+    const ssWarmEntry *e = NULL;
+    if (m->opt.terrain_warm_start && c->type != SS_CONTACT_RIGID && d->nwarm) {
+      int geom = c->geom, vertex = c->vertex;
+      if (c->type != SS_CONTACT_SOIL) row_key(d, c, &geom, &vertex);
+      e = find_warm(d, geom, vertex, &cursor);
+    }
+    if (defer) c->warm_entry = e ? (int)(e - d->warm) : -1;
     if (!e) continue;
-    if (c->type == SS_CONTACT_PD) {
-      double l = e->traction[0] * dt;
-      c->lambda[0] = l > c->row_bound ? c->row_bound : l < -c->row_bound ? -c->row_bound : l;
-    } else if (c->type == SS_CONTACT_LIMIT) {
-      c->lambda[0] = e->traction[0] > 0 ? e->traction[0] * dt : 0;
-    } else {
-      double scale = c->area * dt, t[3];
-      static const double none[3] = {0, 0, 0};
-      const double *rate = e->rate;
-      if (e->creep && !creep_rates) {
-        rate = none;
-        left++;
-      }
-      for (int k = 0; k < 3; k++) t[k] = e->traction[k] + rate[k];
+    if (c->type == SS_CONTACT_SOIL) {
+      if (e->creep && !creep_rates) left++;
       memcpy(c->warm_t, e->traction, sizeof c->warm_t);
       c->warm_trend = converged;
-      double ln = t[0] > 0 ? t[0] * scale : 0;
-      double lt0 = t[1] * scale, lt1 = t[2] * scale;
-      /* the bound at zero slip as the laws form it (point.c, newton.c):
-       * A dt c + mu lambda_n, the strength tau_f(p_n) times A dt */
-      const ssSoilMaterial *mat = &m->hfield_soilmat[c->hfield];
-      double lim = scale * mat->cohesion + mat->friction_coefficient * ln;
-      double mag = sqrt(lt0 * lt0 + lt1 * lt1);
-      if (mag > lim) {
-        lt0 *= lim / mag;
-        lt1 *= lim / mag;
-      }
-      c->lambda[0] = ln;
-      c->lambda[1] = lt0;
-      c->lambda[2] = lt1;
     }
-    if (!c->nv) continue;
-    if (c->link < 0 && c->type == SS_CONTACT_SOIL) {
-      /* a rigid body's run likewise, as J^T lambda */
-      group_close(d, &g);
-      int b = m->geom_body[c->geom];
-      if (br.body != b) {
-        body_run_close(m, d, &br);
-        br.body = b;
-      }
-      /* J^T lambda = (f; r x f), f = frame^T lambda, r from the centre of
-       * mass (J is formed only for the sweeps) */
-      const double *fr = c->frame, *l = c->lambda;
-      double f[3], r[3], t[3];
-      for (int k = 0; k < 3; k++) f[k] = fr[k] * l[0] + fr[3 + k] * l[1] + fr[6 + k] * l[2];
-      ss_v3_sub(r, c->pos, d->body_xipos + 3 * b);
-      ss_v3_cross(t, r, f);
-      for (int k = 0; k < 3; k++) {
-        br.F[k] += f[k];
-        br.F[3 + k] += t[k];
-      }
-    } else if (c->link >= 0 && !d->solver_full) {
-      /* a link run's impulses reach u once, at the run's end */
-      body_run_close(m, d, &br);
-      if (!g.first || g.first->link != c->link) {
-        group_close(d, &g);
-        g.first = c;
-        ss_art_link_block(m, d, c->link, &g.Y, &g.Lam);
-        memset(g.F, 0, sizeof g.F);
-      }
-      double w[6];
-      link_impulse(c, c->lambda, w);
-      for (int k = 0; k < 6; k++) g.F[k] += w[k];
-    } else {
-      group_close(d, &g);
-      body_run_close(m, d, &br);
-      apply_impulse(m, d, c, c->lambda);
-    }
+    if (!defer) warm_one(m, d, c, e, creep_rates, &a);
   }
-  group_close(d, &g);
-  body_run_close(m, d, &br);
+  warm_close(m, d, &a);
+  d->warm_pending = defer;
   return left;
+}
+
+void ss_solver_warm_lambda(const ssModel *m, const ssData *d, int i, double lam[3])
+{
+  const ssContact *c = d->contact + i;
+  memcpy(lam, c->lambda, 3 * sizeof(double));
+  if (d->warm_pending && c->warm_entry >= 0)
+    warm_impulse(m, c, d->warm + c->warm_entry, d->warm_creep_rates, lam);
+}
+
+void ss_solver_warm_apply(const ssModel *m, ssData *d)
+{
+  if (!d->warm_pending) return;
+  d->warm_pending = 0;
+  WarmApply a = {{NULL, NULL, NULL, {0}, {0}}, {-1, {0}}};
+  for (int i = 0; i < d->ncontact; i++) {
+    ssContact *c = d->contact + i;
+    if (c->warm_entry >= 0) warm_one(m, d, c, d->warm + c->warm_entry, d->warm_creep_rates, &a);
+  }
+  warm_close(m, d, &a);
 }
 
 static int cached(const ssContact *c)
@@ -656,6 +716,9 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
       d->solver_settled = done == 2;
     }
   }
+  /* the sweeps start from the warm start, or from the Newton phase's
+   * answer (which left nothing pending) */
+  ss_solver_warm_apply(m, d);
 
   /* what only the sweeps use: the body contacts' responses (a rigid
    * body's J, W and G, a link contact's X, LX and G), and the soil points' laws

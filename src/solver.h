@@ -38,6 +38,9 @@ struct ssContact {
   int link;          /* articulated link whose block serves the contact, or
                         -1 (J and W stored) */
   int run;           /* solver: contacts from this one on the same link */
+  int warm_entry;    /* index of its warm-start cache entry in d->warm, -1
+                        none: set where the warm start's impulses wait
+                        for ss_solver_warm_apply (d->warm_pending) */
   long jadr, jlen;   /* offset and length in ssData.jac: J (3 nv) then
                         W (nv x 3), or X (3 x 6) for a link contact */
   double area;       /* soil: quadrature weight A (m^2) */
@@ -113,6 +116,16 @@ ssContact *ss_contact_new(ssData *d, long njac);
  * cache is not touched: ss_solver_store_warm keeps this step's tractions
  * once the step has passed its checks. */
 ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err);
+/* The warm start's impulses into the contacts and their velocity change
+ * into d->qvel, where they are still pending (d->warm_pending): where the
+ * Newton phase may start from its prediction (ss_newton_may_predict), the
+ * solve matches the cache first and applies the impulses only where a
+ * solve starts from them after all; the prediction's answer replaces
+ * both. */
+void ss_solver_warm_apply(const ssModel *m, ssData *d);
+/* Contact i's warm-start impulse, applied yet or not (the Newton phase's
+ * points that stick at its start take their tangential impulses from it) */
+void ss_solver_warm_lambda(const ssModel *m, const ssData *d, int i, double lam[3]);
 ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err);
 
 /* The Newton phase (newton.c): when every contact is a soil point on an
@@ -120,18 +133,26 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err);
  * step's contacts by Newton's method on the contact links' spatial
  * velocities and the rows' velocities.  On entry d->qvel_free holds the
  * free velocity, the contacts their first impulses and d->qvel the matching
- * velocity; contacts [first_row, ncontact) are the joint rows.  Returns 1
- * when Newton converged: the contacts hold its impulses, d->qvel their
- * velocity, and *residual the check of that answer against every
- * contact's law at that velocity (the sweeps' measure: max |change| /
- * max |impulse|); 2 when the first impulses passed that check as they
- * came (a settled body: contacts and d->qvel untouched); 0 when it
- * declined (everything as on entry).  *iterations: the Newton iterations
- * spent either way; *sticking: the soil points it solved in impulse form
+ * velocity, or, with d->warm_pending, the warm start waits to be applied
+ * (ss_solver_warm_apply: the phase applies it where it starts from it,
+ * not where it starts from its prediction); contacts [first_row,
+ * ncontact) are the joint rows.  Returns 1 when Newton converged: the
+ * contacts hold its impulses, d->qvel their velocity, and *residual the
+ * check of that answer against every contact's law at that velocity (the
+ * sweeps' measure: max |change| / max |impulse|); 2 when the first
+ * impulses passed that check as they came (a settled body: contacts and
+ * d->qvel untouched); 0 when it declined (everything as on entry, the
+ * warm start perhaps applied).  *iterations: the Newton iterations spent
+ * either way; *sticking: the soil points it solved in impulse form
  * (sticking or nearly, newton.c). */
 typedef struct ssNewtonWork ssNewtonWork;
 int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
                     int *sticking, double *residual);
+/* 1 where this step's Newton phase may start from its last two answers
+ * extrapolated (their records are the two steps before this one's, and
+ * neither the warm start nor the prediction is switched off); whether it
+ * does depends on its unknowns too (newton.c, predict) */
+int ss_newton_may_predict(const ssModel *m, const ssData *d);
 /* After ss_newton_solve returned 2 (and until it is called again): the
  * soil points' impulses by their laws at d->qvel, three for each of the
  * contacts before first_row (the contact frame's n, t1, t2) */

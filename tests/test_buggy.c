@@ -301,6 +301,51 @@ static void test_predictor(void)
   ss_model_free(m);
 }
 
+/* The warm start waits (solver.c, warm_start) where the Newton phase may
+ * start from its prediction, and is applied only where a solve starts
+ * from it after all: the Newton phase declining its prediction, its
+ * points that stick taking their warm impulses (ss_solver_warm_lambda),
+ * the sweeps.  The turning buggy (scenes/buggy_turn.xml), whose Newton
+ * phase puts points in impulse form, some of them sticking (step 856
+ * took its warm impulses 0 before ss_solver_warm_lambda): 200 steps from
+ * step 800, both ways from one checkpoint; the checkpoints after them the
+ * same bytes. */
+static void test_warm_deferred(void)
+{
+  ssModel *m;
+  ssData *d;
+  ssError e;
+  if (!load_scene_file("scenes/buggy_turn.xml", &m, &d)) {
+    ok(0, "buggy_turn.xml loads");
+    return;
+  }
+  unsigned char *buf = NULL, *end[2] = {NULL, NULL};
+  size_t len = 0, end_len[2] = {0, 0};
+  int good = run(m, d, 800, NULL) && ss_checkpoint_save_buffer(m, d, &buf, &len, &e) == SS_OK;
+  int deferred = 0, sticking = 0;
+  for (int k = 0; k < 2 && good; k++) {
+    good = ss_checkpoint_load_buffer(m, d, buf, len, &e) == SS_OK;
+    d->solver_warm_eager = k;
+    for (int i = 0; i < 200 && good; i++) {
+      int defer = !k && ss_newton_may_predict(m, d);
+      good = run(m, d, 1, NULL);
+      deferred += defer;
+      sticking += defer && d->stats.newton_sticking > 0;
+    }
+    good = good && ss_checkpoint_save_buffer(m, d, &end[k], &end_len[k], &e) == SS_OK;
+  }
+  d->solver_warm_eager = 0;
+  ok(good && end_len[0] == end_len[1] && !memcmp(end[0], end[1], end_len[0]) &&
+         deferred >= 100 && sticking > 0,
+     "turning buggy, 200 steps: the warm start deferred in %d steps (%d with points in "
+     "impulse form) and applied at once: the same bytes after them", deferred, sticking);
+  free(buf);
+  free(end[0]);
+  free(end[1]);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 static void test_drive(void)
 {
   ssModel *m;
@@ -477,6 +522,7 @@ int main(void)
   test_packed_groups();
   test_newton();
   test_predictor();
+  test_warm_deferred();
   test_newton_sticking();
   test_drive();
   return done_testing();
