@@ -1346,38 +1346,33 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
   *sticking = 0;
   *residual_out = INFINITY;
   if (first_row == 0) return 0;
-  /* suited: soil points on articulated links or free bodies, PD rows */
+  /* suited: soil points on articulated links or free bodies (checked
+   * where each run of one link or body on one bed starts, below), PD
+   * rows */
   int ngroup = 0, nrow = d->ncontact - first_row;
-  for (int i = 0; i < d->ncontact; i++) {
-    const ssContact *c = d->contact + i;
-    int owner = c->nv > 0 && (c->link >= 0 || (c->nv == 6 && m->sys_type[c->sys] == SS_SYS_FREE));
-    if (i < first_row ? !(c->type == SS_CONTACT_SOIL && owner)
-                      : !(c->type == SS_CONTACT_PD && c->nv > 0))
-      return 0;
-    /* runs of one link or body on one bed: at least as many as the groups */
-    if (i < first_row && (i == 0 || c[-1].link != c->link || c[-1].sys != c->sys ||
-                          c[-1].hfield != c->hfield))
-      ngroup++;
-  }
-  int n = 6 * ngroup + nrow;
-  ssNewtonWork *w = work(d, n, d->ncontact, m->nv, ngroup);
+  for (int i = first_row; i < d->ncontact; i++)
+    if (!(d->contact[i].type == SS_CONTACT_PD && d->contact[i].nv > 0)) return 0;
+  ssNewtonWork *w = work(d, 0, d->ncontact, m->nv, 0);
   if (!w) return 0;
   /* groups: one per link (or body) and bed (a link's contacts may come in
    * several runs); every point of a bed shares the bed's frame (the
    * bed's axes, terrain.c's frame_from_bed: the same bits for all its
    * points of a step), so it is compared only where a run starts */
-  ngroup = 0;
   for (int i = 0; i < first_row; i++) {
     const ssContact *c = d->contact + i;
+    if (c->type != SS_CONTACT_SOIL) return 0;
     int g = 0;
     if (i > 0 && c[-1].link == c->link && c[-1].sys == c->sys && c[-1].hfield == c->hfield) {
       w->group_of[i] = g = w->group_of[i - 1];
     } else {
+      if (!(c->nv > 0 && (c->link >= 0 || (c->nv == 6 && m->sys_type[c->sys] == SS_SYS_FREE))))
+        return 0;
       while (g < ngroup && !(w->grp[g].link == c->link && w->grp[g].sys == c->sys &&
                              w->grp[g].mat == &m->hfield_soilmat[c->hfield]))
         g++;
       w->group_of[i] = g;
     }
+    if (g == w->cap_g && !work(d, 0, 0, 0, 2 * g + 4)) return 0;
     NGroup *G = w->grp + g;
     if (i > 0 && g == w->group_of[i - 1] && c[-1].hfield == c->hfield) {
       /* the run goes on: the group and frame are the last point's */
@@ -1411,7 +1406,8 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     P->mob.x = -1;
     P->imp = 0;
   }
-  n = 6 * ngroup + nrow;
+  int n = 6 * ngroup + nrow;
+  if (!work(d, n, 0, 0, ngroup)) return 0;
   Setup s = {ngroup, nrow, n, first_row};
 
   lam_matrix(m, d, &s, w);
