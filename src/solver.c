@@ -116,8 +116,8 @@ static void link_apply(ssData *d, const ssContact *c, const double *Y,
 }
 
 /* the contact's velocity J u, from the full velocity */
-static void contact_velocity(const ssModel *m, const ssData *d,
-                             const ssContact *c, double v[3])
+static inline __attribute__((always_inline)) void
+contact_velocity(const ssModel *m, const ssData *d, const ssContact *c, double v[3])
 {
   if (c->link >= 0) {
     double V[6];
