@@ -879,6 +879,8 @@ void ss_shape_cast_init(ssShapeCast *c, const ssShape *s)
     c->d[k] = R[6 + k];
     c->par[k] = c->d[k] == 0;
     c->id[k] = c->par[k] ? 0 : 1 / c->d[k];
+    /* a box's half sizes; a cylinder's or capsule's half length (its
+     * caps' slab is the third) */
     double h = s->type == SS_GEOM_BOX ? 0.5 * s->size[k] : 0.5 * s->size[1];
     c->h[k] = h;
     c->e[k] = copysign(h, c->d[k]);

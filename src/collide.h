@@ -115,13 +115,13 @@ typedef struct ssShapeCast {
   double end[2][3];    /* a capsule's sphere centres */
 } ssShapeCast;
 void ss_shape_cast_init(ssShapeCast *c, const ssShape *s);
-/* (inline: soil_contacts calls it once per cell) */
+
 /* The slab |o + t d| <= h along one axis, with d's reciprocal id formed
  * once (0 where d = 0: the line is parallel to it, inside or not) and
  * e = h signed as d, so that the entry and exit need no comparison:
  * [(-e - o) id, (e - o) id]. */
-static inline int ss_cast_slab(double o, double h, double e, double id, int par, double *tin,
-                       double *tout)
+static inline int ss_cast_slab(double o, double h, double e, double id, int par,
+                               double *tin, double *tout)
 {
   if (par) return fabs(o) <= h;
   double t0 = (-e - o) * id, t1 = (e - o) * id;
@@ -132,7 +132,7 @@ static inline int ss_cast_slab(double o, double h, double e, double id, int par,
 
 /* lowest z of a sphere over (x, y), in the caller's frame */
 static inline int ss_cast_sphere(const double c[3], double r, double x, double y,
-                         double *z)
+                                 double *z)
 {
   double dx = x - c[0], dy = y - c[1];
   double h = r * r - (dx * dx + dy * dy);
@@ -141,6 +141,8 @@ static inline int ss_cast_sphere(const double c[3], double r, double x, double y
   return 1;
 }
 
+/* ss_shape_lowest_z of the prepared shape c (inline: soil_contacts calls
+ * it once per cell) */
 static inline int ss_shape_cast_lowest_z(const ssShapeCast *c, double x, double y, double *z)
 {
   if (c->type == SS_GEOM_SPHERE) return ss_cast_sphere(c->pos, c->r, x, y, z);
