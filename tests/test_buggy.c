@@ -12,6 +12,15 @@
 #include <string.h>
 #include <unistd.h>
 
+/* the scene at rel (from the source tree) into *m, *d; a failed test
+ * line naming it where it does not load */
+static int load(const char *rel, ssModel **m, ssData **d)
+{
+  if (load_scene_file(rel, m, d)) return 1;
+  ok(0, "%s loads", rel);
+  return 0;
+}
+
 /* what a run watches: the largest loop-closure error, and the solver's
  * sweeps (steps over 20 sweeps: the Newton phase did not finish them) */
 typedef struct Watch {
@@ -87,10 +96,7 @@ static void test_statics(void)
 {
   ssModel *m;
   ssData *d;
-  if (!load_scene_file("scenes/buggy_rigid.xml", &m, &d)) {
-    ok(0, "buggy_rigid.xml loads");
-    return;
-  }
+  if (!load("scenes/buggy_rigid.xml", &m, &d)) return;
   ok(fabs(total_mass(m) - 896) < 1e-9, "the buggy weighs 896 kg (%.6g)", total_mass(m));
   set_drive(m, d, 0);
   Watch w = {0};
@@ -168,10 +174,7 @@ static void test_packed_groups(void)
 {
   ssModel *m;
   ssData *d;
-  if (!load_scene_file("scenes/buggy.xml", &m, &d)) {
-    ok(0, "buggy.xml loads");
-    return;
-  }
+  if (!load("scenes/buggy.xml", &m, &d)) return;
   run(m, d, 300, NULL);
   int nc = 0;
   double diff = solver_paths_difference(m, d, 8, &nc);
@@ -194,10 +197,7 @@ static void test_newton_sticking(void)
 {
   ssModel *m;
   ssData *d;
-  if (!load_scene_file("tests/data/buggy_turn_4cm.xml", &m, &d)) {
-    ok(0, "buggy_turn_4cm.xml loads");
-    return;
-  }
+  if (!load("tests/data/buggy_turn_4cm.xml", &m, &d)) return;
   run(m, d, 200, NULL);
   const double tol = m->opt.solver_tolerance;
   double worst = 0;
@@ -229,10 +229,7 @@ static void test_newton(void)
 {
   ssModel *m;
   ssData *d;
-  if (!load_scene_file("scenes/buggy.xml", &m, &d)) {
-    ok(0, "buggy.xml loads");
-    return;
-  }
+  if (!load("scenes/buggy.xml", &m, &d)) return;
   run(m, d, 300, NULL);
   const double tol = m->opt.solver_tolerance;
   double worst = 0;
@@ -268,10 +265,7 @@ static void test_predictor(void)
   ssModel *m;
   ssData *d;
   ssError e;
-  if (!load_scene_file("scenes/buggy.xml", &m, &d)) {
-    ok(0, "buggy.xml loads");
-    return;
-  }
+  if (!load("scenes/buggy.xml", &m, &d)) return;
   const int N = 200;
   const double tol = m->opt.solver_tolerance, dt = m->opt.timestep;
   unsigned char *buf = NULL;
@@ -315,10 +309,7 @@ static void test_warm_deferred(void)
   ssModel *m;
   ssData *d;
   ssError e;
-  if (!load_scene_file("scenes/buggy_turn.xml", &m, &d)) {
-    ok(0, "buggy_turn.xml loads");
-    return;
-  }
+  if (!load("scenes/buggy_turn.xml", &m, &d)) return;
   unsigned char *buf = NULL, *end[2] = {NULL, NULL};
   size_t len = 0, end_len[2] = {0, 0};
   int good = run(m, d, 800, NULL) && ss_checkpoint_save_buffer(m, d, &buf, &len, &e) == SS_OK;
@@ -350,10 +341,7 @@ static void test_drive(void)
 {
   ssModel *m;
   ssData *d;
-  if (!load_scene_file("tests/data/buggy_4cm.xml", &m, &d)) {
-    ok(0, "buggy_4cm.xml loads");
-    return;
-  }
+  if (!load("tests/data/buggy_4cm.xml", &m, &d)) return;
   int chassis = body(m, "chassis"), wrl = body(m, "wheel_rl");
   double x0 = d->body_xipos[3 * chassis], slip_sum = 0;
   Watch watch = {0};
@@ -466,10 +454,7 @@ static void test_steering(void)
 {
   ssModel *m;
   ssData *d;
-  if (!load_scene_file("tests/data/buggy_turn_4cm.xml", &m, &d)) {
-    ok(0, "buggy_turn_4cm.xml loads");
-    return;
-  }
+  if (!load("tests/data/buggy_turn_4cm.xml", &m, &d)) return;
   int chassis = body(m, "chassis");
   Watch w = {0};
   run(m, d, 6000, &w);
