@@ -37,6 +37,12 @@ static void limit_row(ssContact *c, const double v0[3])
   c->lambda[0] = l > 0 ? l : 0;
 }
 
+/* the zeroed head of a new contact is copied from here: GCC lowers a
+ * memset of its 176 bytes to `rep stos`, whose start-up costs about three
+ * times the eleven loads and stores of this copy (10 ns a contact on the
+ * benchmark machine, some 7 % of a settled plate point's step) */
+static const ssContact contact_zero;
+
 ssContact *ss_contact_new(ssData *d, long njac)
 {
   if (d->ncontact == d->cap_contact) {
@@ -59,7 +65,7 @@ ssContact *ss_contact_new(ssData *d, long njac)
     d->jac = q;
     d->cap_jac = cap;
   }
-  memset(c, 0, offsetof(ssContact, pos));
+  memcpy(c, &contact_zero, offsetof(ssContact, pos));
   c->link = -1;
   c->jadr = jadr;
   c->jlen = njac;
