@@ -394,6 +394,10 @@ typedef struct ssStepStats {
                                the sweeps (0: it declined or did not apply) */
   int newton_sticking;      /* soil points that phase solved in impulse form
                                (sticking or nearly; see README) */
+  int newton_linear;        /* 1: that phase's answer is the end of its last
+                               step by the laws' linear model, not evaluated
+                               there (newton.c, apply_linear; checked as
+                               every answer is) */
   double residual;          /* final relative impulse change */
   int converged;            /* 1 if the tolerance was met */
   /* wall time of each stage of the last step (s): forward kinematics, free
@@ -480,6 +484,11 @@ typedef struct ssData {
   int solver_no_predict;  /* 1: the Newton phase starts from the warm start
                              alone, not from its last answers extrapolated
                              (newton.c); the reference path of the tests */
+  int solver_no_linear_end; /* 1: the Newton phase evaluates the laws at
+                             the end of its last step before its check, as
+                             at every other step, instead of applying its
+                             linear model there (newton.c); the reference
+                             path of the tests */
   int solver_warm_eager;  /* 1: the warm start is applied at once, also
                              where the Newton phase may start from its
                              prediction (solver.c); the reference path of

@@ -674,6 +674,7 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   st->converged = 1;
   st->newton = 0;
   st->newton_sticking = 0;
+  st->newton_linear = 0;
   d->solver_settled = 0;
   d->newton_rec[2].step = -1;
   if (m->nv) memcpy(d->qvel_free, d->qvel, (size_t)m->nv * sizeof(double));
