@@ -251,48 +251,81 @@ static void test_newton(void)
   ss_model_free(m);
 }
 
-/* The Newton phase's start (newton.c, predict): the driving buggy's last
- * two answers extrapolated, against the warm start alone, 100 steps each
- * way from step 1000 (the steady drive; steps 800-1000, over a bump of
- * the suspension's, gain little).  Fewer Newton iterations (2.23 against
- * 2.58 a step; at least 5 % fewer asked), no more sweeps, and the same
- * motion: both ways every step's impulses are
- * converged answers, within 1e3 tol of each other relative (the bound of
- * test_plate.c's newton_case), so the chassis heights part by at most
- * sum_k k eps g dt^2 = N^2/2 1e3 tol g dt^2 over N steps. */
-static void test_predictor(void)
+/* The driving buggy (scenes/buggy.xml) after 1000 steps, then N steps
+ * twice from that state (its checkpoint): way k (0, 1) with the solver's
+ * reference flag set as set_way(d, k) sets it (left at way 0 after),
+ * each converged step handed to each(m, d, k, ctx); *way_z[k] the
+ * chassis height after way k.  Two ways of solving the same steps that
+ * must agree: both ways every step's impulses are converged answers,
+ * within 1e3 tol of each other relative (the bound of test_plate.c's
+ * newton_case), so the chassis heights part by at most
+ * sum_k k eps g dt^2 = N^2/2 1e3 tol g dt^2, returned in *bound (tol, the
+ * scene's solver tolerance, in *tol).  0 (with
+ * a failed test line) where the scene does not load, a step fails or
+ * does not converge. */
+static int drive_two_ways(int N, void (*set_way)(ssData *d, int way),
+                          void (*each)(const ssModel *m, const ssData *d, int way, void *ctx),
+                          void *ctx, double way_z[2], double *tol, double *bound)
 {
   ssModel *m;
   ssData *d;
   ssError e;
-  if (!load("scenes/buggy.xml", &m, &d)) return;
-  const int N = 200;
-  const double tol = m->opt.solver_tolerance, dt = m->opt.timestep;
+  if (!load("scenes/buggy.xml", &m, &d)) return 0;
+  const double dt = m->opt.timestep;
+  *tol = m->opt.solver_tolerance;
+  *bound = 0.5 * N * N * 1e3 * *tol * 9.81 * dt * dt;
   unsigned char *buf = NULL;
   size_t len = 0;
   int good = run(m, d, 1000, NULL) && ss_checkpoint_save_buffer(m, d, &buf, &len, &e) == SS_OK;
-  long newton[2] = {0, 0}, sweeps[2] = {0, 0};
-  double z[2] = {0, 0};
   int chassis = body(m, "chassis");
   for (int k = 0; k < 2 && good; k++) {
     good = ss_checkpoint_load_buffer(m, d, buf, len, &e) == SS_OK;
-    d->solver_no_predict = k;
+    set_way(d, k);
     for (int i = 0; i < N && good; i++) {
       good = run(m, d, 1, NULL) && d->stats.converged;
-      newton[k] += d->stats.newton;
-      sweeps[k] += d->stats.sweeps;
+      if (good) each(m, d, k, ctx);
     }
-    z[k] = d->body_xpos[3 * chassis + 2];
+    way_z[k] = d->body_xpos[3 * chassis + 2];
   }
-  double dz = fabs(z[0] - z[1]), bound = 0.5 * N * N * 1e3 * tol * 9.81 * dt * dt;
-  ok(good && 20 * newton[0] <= 19 * newton[1] && sweeps[0] <= sweeps[1] && dz <= bound,
-     "driving buggy, %d steps: %.2f Newton iterations a step from the last answers "
-     "extrapolated, %.2f from the warm start alone (%ld and %ld sweeps); chassis heights "
-     "%.2g m apart (bound %.2g)", N, (double)newton[0] / N, (double)newton[1] / N, sweeps[0],
-     sweeps[1], dz, bound);
+  set_way(d, 0);
+  if (!good) ok(0, "driving buggy: %d steps both ways from step 1000", N);
   free(buf);
   ss_data_free(d);
   ss_model_free(m);
+  return good;
+}
+
+/* The Newton phase's start (newton.c, predict): the driving buggy's last
+ * two answers extrapolated, against the warm start alone
+ * (solver_no_predict), 200 steps each way from step 1000 (the steady
+ * drive; steps 800-1000, over a bump of the suspension's, gain little).
+ * Fewer Newton iterations (2.23 against 2.57 a step; at least 5 % fewer
+ * asked), no more sweeps, and the same motion (drive_two_ways' bound). */
+typedef struct PredictWays {
+  long newton[2], sweeps[2];
+} PredictWays;
+
+static void predict_way(ssData *d, int way) { d->solver_no_predict = way; }
+
+static void predict_step(const ssModel *m, const ssData *d, int way, void *ctx)
+{
+  PredictWays *p = ctx;
+  p->newton[way] += d->stats.newton;
+  p->sweeps[way] += d->stats.sweeps;
+}
+
+static void test_predictor(void)
+{
+  const int N = 200;
+  PredictWays p = {{0, 0}, {0, 0}};
+  double z[2], tol, bound;
+  if (!drive_two_ways(N, predict_way, predict_step, &p, z, &tol, &bound)) return;
+  double dz = fabs(z[0] - z[1]);
+  ok(20 * p.newton[0] <= 19 * p.newton[1] && p.sweeps[0] <= p.sweeps[1] && dz <= bound,
+     "driving buggy, %d steps: %.2f Newton iterations a step from the last answers "
+     "extrapolated, %.2f from the warm start alone (%ld and %ld sweeps); chassis heights "
+     "%.2g m apart (bound %.2g)", N, (double)p.newton[0] / N, (double)p.newton[1] / N,
+     p.sweeps[0], p.sweeps[1], dz, bound);
 }
 
 /* How far a step's impulses are from their laws at the step's end
@@ -336,57 +369,49 @@ static double law_departure(const ssModel *m, const ssData *d)
 /* The Newton phase's linear end (newton.c, apply_linear): the step
  * expected to end a solve is applied by the laws' linear model at its
  * start, not evaluated at its end first.  The driving buggy, 200 steps
- * from step 1000 both ways from one checkpoint (solver_no_linear_end: the
- * reference): the linear end in most steps, never in the reference; every
+ * each way from step 1000 (solver_no_linear_end: the reference): the
+ * linear end in most steps, never in the reference; every
  * step's impulses meet their laws at the end velocities within the
  * solver's tolerance, recomputed here apart from the solver (the check
  * accepts an answer within tol in its measure; the laws' powers and
  * exponentials agree with soil.c's to a few ulp, so 2 tol); no more
  * Newton iterations (5 % slack for the paths parting at round-off); the
- * chassis heights within test_predictor's bound. */
+ * same motion (drive_two_ways' bound). */
+typedef struct LinearWays {
+  long newton[2];
+  int linear[2], checked[2];
+  double worst[2];
+} LinearWays;
+
+static void linear_way(ssData *d, int way) { d->solver_no_linear_end = way; }
+
+static void linear_step(const ssModel *m, const ssData *d, int way, void *ctx)
+{
+  LinearWays *l = ctx;
+  l->newton[way] += d->stats.newton;
+  l->linear[way] += d->stats.newton_linear;
+  if (d->stats.newton_sticking == 0 && d->stats.sweeps == 0) {
+    l->worst[way] = fmax(l->worst[way], law_departure(m, d));
+    l->checked[way]++;
+  }
+}
+
 static void test_linear_end(void)
 {
-  ssModel *m;
-  ssData *d;
-  ssError e;
-  if (!load("scenes/buggy.xml", &m, &d)) return;
   const int N = 200;
-  const double tol = m->opt.solver_tolerance, dt = m->opt.timestep;
-  unsigned char *buf = NULL;
-  size_t len = 0;
-  int good = run(m, d, 1000, NULL) && ss_checkpoint_save_buffer(m, d, &buf, &len, &e) == SS_OK;
-  long newton[2] = {0, 0};
-  int linear[2] = {0, 0}, checked[2] = {0, 0};
-  double z[2] = {0, 0}, worst[2] = {0, 0};
-  int chassis = body(m, "chassis");
-  for (int k = 0; k < 2 && good; k++) {
-    good = ss_checkpoint_load_buffer(m, d, buf, len, &e) == SS_OK;
-    d->solver_no_linear_end = k;
-    for (int i = 0; i < N && good; i++) {
-      good = run(m, d, 1, NULL) && d->stats.converged;
-      newton[k] += d->stats.newton;
-      linear[k] += d->stats.newton_linear;
-      if (d->stats.newton_sticking == 0 && d->stats.sweeps == 0) {
-        worst[k] = fmax(worst[k], law_departure(m, d));
-        checked[k]++;
-      }
-    }
-    z[k] = d->body_xpos[3 * chassis + 2];
-  }
-  d->solver_no_linear_end = 0;
-  double dz = fabs(z[0] - z[1]), bound = 0.5 * N * N * 1e3 * tol * 9.81 * dt * dt;
-  ok(good && linear[0] >= N / 2 && linear[1] == 0 && checked[0] >= N / 2 &&
-         checked[1] >= N / 2 && worst[0] <= 2 * tol && worst[1] <= 2 * tol &&
-         20 * newton[0] <= 21 * newton[1] && dz <= bound,
+  LinearWays l = {{0, 0}, {0, 0}, {0, 0}, {0, 0}};
+  double z[2], tol, bound;
+  if (!drive_two_ways(N, linear_way, linear_step, &l, z, &tol, &bound)) return;
+  double dz = fabs(z[0] - z[1]);
+  ok(l.linear[0] >= N / 2 && l.linear[1] == 0 && l.checked[0] >= N / 2 &&
+         l.checked[1] >= N / 2 && l.worst[0] <= 2 * tol && l.worst[1] <= 2 * tol &&
+         20 * l.newton[0] <= 21 * l.newton[1] && dz <= bound,
      "driving buggy, %d steps: the Newton phase ends by its linear model in %d (the "
      "reference %d); the impulses' largest departure from their laws %.2g and %.2g "
      "(bound %.2g, %d and %d steps); %.2f and %.2f Newton iterations a step; chassis "
-     "heights %.2g m apart (bound %.2g)", N, linear[0], linear[1], worst[0], worst[1],
-     2 * tol, checked[0], checked[1], (double)newton[0] / N, (double)newton[1] / N, dz,
-     bound);
-  free(buf);
-  ss_data_free(d);
-  ss_model_free(m);
+     "heights %.2g m apart (bound %.2g)", N, l.linear[0], l.linear[1], l.worst[0],
+     l.worst[1], 2 * tol, l.checked[0], l.checked[1], (double)l.newton[0] / N,
+     (double)l.newton[1] / N, dz, bound);
 }
 
 /* The warm start waits (solver.c, warm_start) where the Newton phase may
