@@ -1014,10 +1014,19 @@ static void newton_matrix(const Setup *s, ssNewtonWork *w, const double *H)
     const double *L = w->Lam + (size_t)a * n;
     double *Ar = w->A + (size_t)a * n;
     for (int g = 0; g < s->ngroup; g++) {
+      /* two columns at a time (SSE2 pairs): each entry's products and
+       * sums in the order of the scalar sum
+       * -(L0 H0j + L1 H1j + ... + L5 H5j) */
       const double *Hg = H + 36 * g, *Lg = L + 6 * g;
-      for (int j = 0; j < 6; j++)
-        Ar[6 * g + j] = -(Lg[0] * Hg[j] + Lg[1] * Hg[6 + j] + Lg[2] * Hg[12 + j] +
-                          Lg[3] * Hg[18 + j] + Lg[4] * Hg[24 + j] + Lg[5] * Hg[30 + j]);
+      ssV2 l[6];
+      for (int k = 0; k < 6; k++) l[k] = (ssV2){Lg[k], Lg[k]};
+      for (int j = 0; j < 6; j += 2) {
+        ssV2 h[6];
+        for (int k = 0; k < 6; k++) memcpy(&h[k], Hg + 6 * k + j, sizeof h[k]);
+        ssV2 t = -(l[0] * h[0] + l[1] * h[1] + l[2] * h[2] + l[3] * h[3] + l[4] * h[4] +
+                   l[5] * h[5]);
+        memcpy(Ar + 6 * g + j, &t, sizeof t);
+      }
     }
     for (int r = 0; r < s->nrow; r++) {
       int k = 6 * s->ngroup + r;
