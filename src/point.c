@@ -663,23 +663,36 @@ void ss_point_setup(const ssSoilMaterial *mat, const ssPowTable *tab, double dt,
                     ssContact *c)
 {
   ssPointCache *k = &c->cache;
-  Law L = {c->area * dt, dt, c->g0, c->sp,
-           (c->width > 0 && mat->bekker_kc != 0 ? mat->bekker_kc / c->width : 0) +
-               mat->bekker_kphi,
-           mat->sinkage_exponent, mat->sinkage_exponent - 1,
-           mat->elastic_stiffness, mat->damping, mat->sinkage_exponent == 1.0, {0, {0}, 0, NULL}, {0, 0, 0}};
-  if (!L.linear) {
-    L.pser = ss_pow_series(L.m1);
-    L.pser.tab = tab;
+  /* written field by field in place: a compound literal of the law (184
+   * bytes) is zeroed by `rep stos` first, dear at once per point and
+   * step (see ss_contact_new) */
+  Law *L = &k->law;
+  double m1 = mat->sinkage_exponent - 1;
+  int keep_pw = c->cache_ready && L->pw.s > 0 && L->m1 == m1;
+  L->S = c->area * dt;
+  L->dt = dt;
+  L->g0 = c->g0;
+  L->sp = c->sp;
+  L->k = (c->width > 0 && mat->bekker_kc != 0 ? mat->bekker_kc / c->width : 0) +
+         mat->bekker_kphi;
+  L->n = mat->sinkage_exponent;
+  L->m1 = m1;
+  L->Ke = mat->elastic_stiffness;
+  L->D = mat->damping;
+  L->linear = mat->sinkage_exponent == 1.0;
+  if (!L->linear) {
+    L->pser = ss_pow_series(m1);
+    L->pser.tab = tab;
+  } else {
+    L->pser = (ssPowSeries){0, {0}, 0, NULL};
   }
-  if (c->cache_ready && k->law.pw.s > 0 && k->law.m1 == L.m1) L.pw = k->law.pw;
-  k->law = L;
+  if (!keep_pw) L->pw = (ssPowMemo){0, 0, 0};
   Mobil J;
   mobil_init(&J, c->j, mat->shear_displacement, dt);
   if (!(c->cache_ready && k->mob.x0 == J.x0 && k->mob.r == J.r)) k->mob = J;
   c->cache_ready = 1;
   tblock_init(&k->tb, c->G);
-  k->tf0 = L.S * mat->cohesion;
+  k->tf0 = L->S * mat->cohesion;
   k->mu = mat->friction_coefficient;
 }
 
