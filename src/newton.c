@@ -37,10 +37,11 @@
  * with the friction law as a projection (the natural map), smooth enough
  * for Newton on either side of sticking; each Newton step eliminates them
  * point by point (a Schur complement onto the links' velocities), so the
- * linear system stays 6 per link.  The phase declines (and leaves
- * impulses and velocities as it found them) when a contact is not a soil
- * point on an articulated link or a free body or a PD row, or when Newton
- * does not converge fast. */
+ * linear system stays 6 per link.  The phase declines when a contact is
+ * not a soil point on an articulated link or a free body or a PD row, or
+ * when Newton does not converge fast; it leaves impulses and velocities
+ * as it found them unless an answer it applied failed its check before
+ * (then that answer, impulses and velocities consistent: solver.h). */
 #include "solver.h"
 #include "articulated.h"
 #include "ss_math.h"
@@ -1257,8 +1258,11 @@ static void apply(const ssModel *m, ssData *d, const Setup *s, const ssNewtonWor
 
 /* The end of the step expected to end the solve, y + dy, by the laws'
  * linear model at y instead of an evaluation there: each soil point's
- * impulse lam + K X dy (0 where the model unloads it, or where it was not
- * loaded at y) and F + H dy, the model the step solved exactly.  Where
+ * impulse lam + K X dy (0 where it was not loaded at y) and F + H dy, the
+ * model the step solved exactly.  Where the model unloads a loaded point
+ * (a kink within the step) it declines, INFINITY, before applying
+ * anything: a clipped impulse would part the contacts' impulses from the
+ * F that gives the velocities, which the check does not see.  Where
  * the step ends the solve its error is second order in dy (1e-10 and
  * less of the impulses where the step is 1e-5 of the velocities), far
  * within the check, which decides as for any answer; only where it fails
@@ -1267,6 +1271,7 @@ static void apply(const ssModel *m, ssData *d, const Setup *s, const ssNewtonWor
  * it) and returns check's measure of it. */
 static double apply_linear(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork *w)
 {
+  /* (the scratch sums' V hold each group's dy, frame about o) */
   for (int g = 0; g < s->ngroup; g++) to_group(w->grp + g, w->dy + 6 * g, w->sum[g].V);
   for (int i = 0; i < s->first_row; i++) {
     const double *l = w->lam + 3 * i, *K = w->K + 6 * i;
@@ -1275,7 +1280,7 @@ static double apply_linear(const ssModel *m, ssData *d, const Setup *s, ssNewton
     if (!(l[0] > 0)) continue;
     point_velocity(w->pt[i].r, w->sum[w->group_of[i]].V, dv);
     double ln = l[0] + K[0] * dv[0];
-    if (!(ln > 0)) continue;
+    if (!(ln > 0)) return INFINITY;
     lt[0] = ln;
     lt[1] = l[1] + K[1] * dv[0] + K[3] * dv[1] + K[4] * dv[2];
     lt[2] = l[2] + K[2] * dv[0] + K[4] * dv[1] + K[5] * dv[2];
@@ -1515,8 +1520,10 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
    * laws' linear model and checked at once, without evaluating the laws
    * at its end first (apply_linear): where its check passes (the rolling
    * buggy: 188 of 200 steps, tests/test_buggy.c) that evaluation is saved;
-   * where it fails, the loop goes on as without it.  The contacts and
-   * d->qvel are untouched until an answer is applied. */
+   * where it declines or its check fails, the loop goes on as without it
+   * (after a failed check the contacts and d->qvel hold that answer, as
+   * after any failed check).  The
+   * contacts and d->qvel are untouched until an answer is applied. */
   const double tol = m->opt.solver_tolerance, tol2 = tol * tol, try2 = 100 * tol2;
   double size, size_try;
   /* After a step that needed no Newton step the warm start usually

@@ -141,8 +141,11 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err);
  * check of that answer against every contact's law at that velocity (the
  * sweeps' measure: max |change| / max |impulse|); 2 when the first
  * impulses passed that check as they came (a settled body: contacts and
- * d->qvel untouched); 0 when it declined (everything as on entry, the
- * warm start perhaps applied).  *iterations: the Newton iterations spent
+ * d->qvel untouched); 0 when it declined: everything as on entry (the
+ * warm start perhaps applied), unless an answer it applied failed its
+ * check first (apply_linear's, or one at 10 tol): then the contacts hold
+ * that answer and d->qvel its velocity, a consistent start for the
+ * sweeps.  *iterations: the Newton iterations spent
  * either way; *sticking: the soil points it solved in impulse form
  * (sticking or nearly, newton.c). */
 typedef struct ssNewtonWork ssNewtonWork;
