@@ -867,7 +867,7 @@ int ss_poly_contains(const ssPoly2 *p, double x, double y)
 void ss_shape_cast_init(ssShapeCast *c, const ssShape *s)
 {
   const double *R = s->R;
-  memset(c, 0, sizeof *c);
+  /* every field written below */
   c->type = s->type;
   ss_v3_copy(c->pos, s->pos);
   c->r = s->size[0];
