@@ -251,82 +251,6 @@ static void test_newton(void)
   ss_model_free(m);
 }
 
-/* The driving buggy (scenes/buggy.xml) after 1000 steps, then N steps
- * twice from that state (its checkpoint): way k (0, 1) with the solver's
- * reference flag set as set_way(d, k) sets it, each converged step
- * handed to each(m, d, k, ctx); way_z[k] the
- * chassis height after way k.  Two ways of solving the same steps that
- * must agree: both ways every step's impulses are converged answers,
- * within 1e3 tol of each other relative (the bound of test_plate.c's
- * newton_case), so the chassis heights part by at most
- * sum_k k eps g dt^2 = N^2/2 1e3 tol g dt^2, returned in *bound (tol, the
- * scene's solver tolerance, in *tol).  0 (with
- * a failed test line) where the scene does not load, a step fails or
- * does not converge. */
-static int drive_two_ways(int N, void (*set_way)(ssData *d, int way),
-                          void (*each)(const ssModel *m, const ssData *d, int way, void *ctx),
-                          void *ctx, double way_z[2], double *tol, double *bound)
-{
-  ssModel *m;
-  ssData *d;
-  ssError e;
-  if (!load("scenes/buggy.xml", &m, &d)) return 0;
-  const double dt = m->opt.timestep;
-  *tol = m->opt.solver_tolerance;
-  *bound = 0.5 * N * N * 1e3 * *tol * 9.81 * dt * dt;
-  unsigned char *buf = NULL;
-  size_t len = 0;
-  int good = run(m, d, 1000, NULL) && ss_checkpoint_save_buffer(m, d, &buf, &len, &e) == SS_OK;
-  int chassis = body(m, "chassis");
-  for (int k = 0; k < 2 && good; k++) {
-    good = ss_checkpoint_load_buffer(m, d, buf, len, &e) == SS_OK;
-    set_way(d, k);
-    for (int i = 0; i < N && good; i++) {
-      good = run(m, d, 1, NULL) && d->stats.converged;
-      if (good) each(m, d, k, ctx);
-    }
-    way_z[k] = d->body_xpos[3 * chassis + 2];
-  }
-  if (!good) ok(0, "driving buggy: %d steps both ways from step 1000", N);
-  free(buf);
-  ss_data_free(d);
-  ss_model_free(m);
-  return good;
-}
-
-/* The Newton phase's start (newton.c, predict): the driving buggy's last
- * two answers extrapolated, against the warm start alone
- * (solver_no_predict), 200 steps each way from step 1000 (the steady
- * drive; steps 800-1000, over a bump of the suspension's, gain little).
- * Fewer Newton iterations (2.23 against 2.57 a step; at least 5 % fewer
- * asked), no more sweeps, and the same motion (drive_two_ways' bound). */
-typedef struct PredictWays {
-  long newton[2], sweeps[2];
-} PredictWays;
-
-static void predict_way(ssData *d, int way) { d->solver_no_predict = way; }
-
-static void predict_step(const ssModel *m, const ssData *d, int way, void *ctx)
-{
-  PredictWays *p = ctx;
-  p->newton[way] += d->stats.newton;
-  p->sweeps[way] += d->stats.sweeps;
-}
-
-static void test_predictor(void)
-{
-  const int N = 200;
-  PredictWays p = {{0, 0}, {0, 0}};
-  double z[2], tol, bound;
-  if (!drive_two_ways(N, predict_way, predict_step, &p, z, &tol, &bound)) return;
-  double dz = fabs(z[0] - z[1]);
-  ok(20 * p.newton[0] <= 19 * p.newton[1] && p.sweeps[0] <= p.sweeps[1] && dz <= bound,
-     "driving buggy, %d steps: %.2f Newton iterations a step from the last answers "
-     "extrapolated, %.2f from the warm start alone (%ld and %ld sweeps); chassis heights "
-     "%.2g m apart (bound %.2g)", N, (double)p.newton[0] / N, (double)p.newton[1] / N,
-     p.sweeps[0], p.sweeps[1], dz, bound);
-}
-
 /* How far a step's impulses are from their laws at the step's end
  * velocities (DESIGN 3.1 for the soil points, written out with soil.c's
  * functions apart from the solver's code; the PD rows' clamped affine
@@ -365,6 +289,87 @@ static double law_departure(const ssModel *m, const ssData *d)
   return lmax > 0 ? dmax / lmax : 0;
 }
 
+/* What drive_two_ways records of each way's steps: Newton iterations,
+ * sweeps, steps ended by the linear end; and over the steps without
+ * points in impulse form and without sweeps (checked), the largest
+ * law_departure (worst). */
+typedef struct Ways {
+  long newton[2], sweeps[2];
+  int linear[2], checked[2];
+  double worst[2];
+} Ways;
+
+/* The driving buggy (scenes/buggy.xml) after 1000 steps, then N steps
+ * twice from that state (its checkpoint): way k (0, 1) with the solver's
+ * reference flag set as set_way(d, k) sets it, each converged step
+ * counted into *w; way_z[k] the chassis height after way k.  Two ways of
+ * solving the same steps that must agree: both ways every step's
+ * impulses are converged answers, within 1e3 tol of each other relative
+ * (the bound of test_plate.c's newton_case), so the chassis heights part
+ * by at most sum_k k eps g dt^2 = N^2/2 1e3 tol g dt^2, returned in
+ * *bound (tol, the scene's solver tolerance, in *tol).  0 (with a failed
+ * test line) where the scene does not load, a step fails or does not
+ * converge. */
+static int drive_two_ways(int N, void (*set_way)(ssData *d, int way), Ways *w,
+                          double way_z[2], double *tol, double *bound)
+{
+  ssModel *m;
+  ssData *d;
+  ssError e;
+  memset(w, 0, sizeof *w);
+  if (!load("scenes/buggy.xml", &m, &d)) return 0;
+  const double dt = m->opt.timestep;
+  *tol = m->opt.solver_tolerance;
+  *bound = 0.5 * N * N * 1e3 * *tol * 9.81 * dt * dt;
+  unsigned char *buf = NULL;
+  size_t len = 0;
+  int good = run(m, d, 1000, NULL) && ss_checkpoint_save_buffer(m, d, &buf, &len, &e) == SS_OK;
+  int chassis = body(m, "chassis");
+  for (int k = 0; k < 2 && good; k++) {
+    good = ss_checkpoint_load_buffer(m, d, buf, len, &e) == SS_OK;
+    set_way(d, k);
+    for (int i = 0; i < N && good; i++) {
+      good = run(m, d, 1, NULL) && d->stats.converged;
+      if (!good) break;
+      w->newton[k] += d->stats.newton;
+      w->sweeps[k] += d->stats.sweeps;
+      w->linear[k] += d->stats.newton_linear;
+      if (d->stats.newton_sticking == 0 && d->stats.sweeps == 0) {
+        w->worst[k] = fmax(w->worst[k], law_departure(m, d));
+        w->checked[k]++;
+      }
+    }
+    way_z[k] = d->body_xpos[3 * chassis + 2];
+  }
+  if (!good) ok(0, "driving buggy: %d steps both ways from step 1000", N);
+  free(buf);
+  ss_data_free(d);
+  ss_model_free(m);
+  return good;
+}
+
+/* The Newton phase's start (newton.c, predict): the driving buggy's last
+ * two answers extrapolated, against the warm start alone
+ * (solver_no_predict), 200 steps each way from step 1000 (the steady
+ * drive; steps 800-1000, over a bump of the suspension's, gain little).
+ * Fewer Newton iterations (2.23 against 2.57 a step; at least 5 % fewer
+ * asked), no more sweeps, and the same motion (drive_two_ways' bound). */
+static void predict_way(ssData *d, int way) { d->solver_no_predict = way; }
+
+static void test_predictor(void)
+{
+  const int N = 200;
+  Ways p;
+  double z[2], tol, bound;
+  if (!drive_two_ways(N, predict_way, &p, z, &tol, &bound)) return;
+  double dz = fabs(z[0] - z[1]);
+  ok(20 * p.newton[0] <= 19 * p.newton[1] && p.sweeps[0] <= p.sweeps[1] && dz <= bound,
+     "driving buggy, %d steps: %.2f Newton iterations a step from the last answers "
+     "extrapolated, %.2f from the warm start alone (%ld and %ld sweeps); chassis heights "
+     "%.2g m apart (bound %.2g)", N, (double)p.newton[0] / N, (double)p.newton[1] / N,
+     p.sweeps[0], p.sweeps[1], dz, bound);
+}
+
 /* The Newton phase's linear end (newton.c, apply_linear): the step
  * expected to end a solve is applied by the laws' linear model at its
  * start, not evaluated at its end first.  The driving buggy, 200 steps
@@ -376,31 +381,14 @@ static double law_departure(const ssModel *m, const ssData *d)
  * exponentials agree with soil.c's to a few ulp, so 2 tol); no more
  * Newton iterations (5 % slack for the paths parting at round-off); the
  * same motion (drive_two_ways' bound). */
-typedef struct LinearWays {
-  long newton[2];
-  int linear[2], checked[2];
-  double worst[2];
-} LinearWays;
-
 static void linear_way(ssData *d, int way) { d->solver_no_linear_end = way; }
-
-static void linear_step(const ssModel *m, const ssData *d, int way, void *ctx)
-{
-  LinearWays *l = ctx;
-  l->newton[way] += d->stats.newton;
-  l->linear[way] += d->stats.newton_linear;
-  if (d->stats.newton_sticking == 0 && d->stats.sweeps == 0) {
-    l->worst[way] = fmax(l->worst[way], law_departure(m, d));
-    l->checked[way]++;
-  }
-}
 
 static void test_linear_end(void)
 {
   const int N = 200;
-  LinearWays l = {{0, 0}, {0, 0}, {0, 0}, {0, 0}};
+  Ways l;
   double z[2], tol, bound;
-  if (!drive_two_ways(N, linear_way, linear_step, &l, z, &tol, &bound)) return;
+  if (!drive_two_ways(N, linear_way, &l, z, &tol, &bound)) return;
   double dz = fabs(z[0] - z[1]);
   ok(l.linear[0] >= N / 2 && l.linear[1] == 0 && l.checked[0] >= N / 2 &&
          l.checked[1] >= N / 2 && l.worst[0] <= 2 * tol && l.worst[1] <= 2 * tol &&
