@@ -533,8 +533,10 @@ ssStatus ss_soil_set_state(const ssModel *m, ssData *d, int hfield,
 ssStatus ss_soil_reset(const ssModel *m, ssData *d, int hfield, ssError *err);
 /* Undeformed heights (nx*ny), valid for rigid maps too. */
 const double *ss_hfield_heights(const ssModel *m, int hfield);
-/* Height edits: allowed on rigid maps, SS_ERR_STATE on soil beds. */
-ssStatus ss_hfield_set_heights(ssModel *m, int hfield, const double *h,
+/* Height edits: z holds nx*ny heights (as ss_hfield_heights returns
+ * them); allowed on rigid maps, SS_ERR_STATE on soil beds, SS_ERR_VALUE
+ * (nothing changed) where one is not finite. */
+ssStatus ss_hfield_set_heights(ssModel *m, int hfield, const double *z,
                                ssError *err);
 /* Recompute hfield_zrange after the heights changed (builders call it). */
 void ss_hfield_update_range(ssModel *m, int hfield);
