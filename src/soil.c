@@ -7,30 +7,30 @@
 
 ssSoilMaterial ss_soil_material_default(void)
 {
-  ssSoilMaterial s;
-  s.bekker_kc = 0.0;
-  s.bekker_kphi = 4.0e4;
-  s.sinkage_exponent = 1.1;
-  s.elastic_stiffness = 2.0e6;
-  s.damping = 2000;
-  s.cohesion = 100;
-  s.friction_coefficient = 0.6;
-  s.shear_displacement = 0.01;
-  return s;
+  ssSoilMaterial mat;
+  mat.bekker_kc = 0.0;
+  mat.bekker_kphi = 4.0e4;
+  mat.sinkage_exponent = 1.1;
+  mat.elastic_stiffness = 2.0e6;
+  mat.damping = 2000;
+  mat.cohesion = 100;
+  mat.friction_coefficient = 0.6;
+  mat.shear_displacement = 0.01;
+  return mat;
 }
 
-ssStatus ss_soil_material_validate(const ssSoilMaterial *s, ssError *err)
+ssStatus ss_soil_material_validate(const ssSoilMaterial *mat, ssError *err)
 {
   /* field, value, lower bound, strict (> rather than >=) */
   struct { const char *name; double v; int strict; } f[] = {
-    {"bekker_kc", s->bekker_kc, 0},
-    {"bekker_kphi", s->bekker_kphi, 0},
-    {"sinkage_exponent", s->sinkage_exponent, 1},
-    {"elastic_stiffness", s->elastic_stiffness, 1},
-    {"damping", s->damping, 0},
-    {"cohesion", s->cohesion, 0},
-    {"friction_coefficient", s->friction_coefficient, 0},
-    {"shear_displacement", s->shear_displacement, 0},
+    {"bekker_kc", mat->bekker_kc, 0},
+    {"bekker_kphi", mat->bekker_kphi, 0},
+    {"sinkage_exponent", mat->sinkage_exponent, 1},
+    {"elastic_stiffness", mat->elastic_stiffness, 1},
+    {"damping", mat->damping, 0},
+    {"cohesion", mat->cohesion, 0},
+    {"friction_coefficient", mat->friction_coefficient, 0},
+    {"shear_displacement", mat->shear_displacement, 0},
   };
   for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) {
     double v = f[i].v;
@@ -39,90 +39,90 @@ ssStatus ss_soil_material_validate(const ssSoilMaterial *s, ssError *err)
                           "soil %s = %g is invalid: must be finite and %s 0",
                           f[i].name, v, f[i].strict ? ">" : ">=");
   }
-  if (!(s->bekker_kc > 0) && !(s->bekker_kphi > 0))
+  if (!(mat->bekker_kc > 0) && !(mat->bekker_kphi > 0))
     return ss_error_set(err, SS_ERR_VALUE, NULL, 0,
                         "soil bekker_kc = %g and bekker_kphi = %g are invalid: "
-                        "at least one must be > 0", s->bekker_kc, s->bekker_kphi);
+                        "at least one must be > 0", mat->bekker_kc, mat->bekker_kphi);
   return SS_OK;
 }
 
 /* modulus of the envelope for width b: k_c / b + k_phi */
-static double modulus(const ssSoilMaterial *s, double b)
+static double modulus(const ssSoilMaterial *mat, double b)
 {
-  return (b > 0 ? s->bekker_kc / b : 0) + s->bekker_kphi;
+  return (b > 0 ? mat->bekker_kc / b : 0) + mat->bekker_kphi;
 }
 
-double ss_soil_envelope(const ssSoilMaterial *s, double b, double z)
+double ss_soil_envelope(const ssSoilMaterial *mat, double b, double s)
 {
-  if (!(z > 0)) return 0;
-  double n = s->sinkage_exponent;
-  return modulus(s, b) * (n == 1.0 ? z : pow(z, n));
+  if (!(s > 0)) return 0;
+  double n = mat->sinkage_exponent;
+  return modulus(mat, b) * (n == 1.0 ? s : pow(s, n));
 }
 
-double ss_soil_envelope_slope(const ssSoilMaterial *s, double b, double z)
+double ss_soil_envelope_slope(const ssSoilMaterial *mat, double b, double s)
 {
-  double n = s->sinkage_exponent;
-  if (n == 1.0) return modulus(s, b);
-  if (!(z > 0)) return n < 1 ? INFINITY : 0;
-  return modulus(s, b) * n * pow(z, n - 1);
+  double n = mat->sinkage_exponent;
+  if (n == 1.0) return modulus(mat, b);
+  if (!(s > 0)) return n < 1 ? INFINITY : 0;
+  return modulus(mat, b) * n * pow(s, n - 1);
 }
 
-double ss_soil_elastic(const ssSoilMaterial *s, double z, double z_p)
+double ss_soil_elastic(const ssSoilMaterial *mat, double s, double s_p)
 {
-  return s->elastic_stiffness * (z - z_p);
+  return mat->elastic_stiffness * (s - s_p);
 }
 
-double ss_soil_pressure(const ssSoilMaterial *s, double b, double z, double z_p)
+double ss_soil_pressure(const ssSoilMaterial *mat, double b, double s, double s_p)
 {
-  if (!(z > z_p)) return 0;
-  double pe = ss_soil_elastic(s, z, z_p), py = ss_soil_envelope(s, b, z);
+  if (!(s > s_p)) return 0;
+  double pe = ss_soil_elastic(mat, s, s_p), py = ss_soil_envelope(mat, b, s);
   return pe < py ? pe : py;
 }
 
-/* the update on the envelope value py at z > z_p */
-static double plastic_update(const ssSoilMaterial *s, double z, double z_p, double py)
+/* the update on the envelope value py at s > s_p */
+static double plastic_update(const ssSoilMaterial *mat, double s, double s_p, double py)
 {
-  double pe = ss_soil_elastic(s, z, z_p), p = pe < py ? pe : py;
-  double zp = z - p / s->elastic_stiffness;
-  /* on the elastic branch z - p/K_e reproduces z_p up to round-off */
-  return zp > z_p ? zp : z_p;
+  double pe = ss_soil_elastic(mat, s, s_p), p = pe < py ? pe : py;
+  double sp = s - p / mat->elastic_stiffness;
+  /* on the elastic branch s - p/K_e reproduces s_p up to round-off */
+  return sp > s_p ? sp : s_p;
 }
 
-double ss_soil_plastic_update(const ssSoilMaterial *s, double b, double z,
-                              double z_p)
+double ss_soil_plastic_update(const ssSoilMaterial *mat, double b, double s,
+                              double s_p)
 {
-  if (!(z > z_p)) return z_p;
-  return plastic_update(s, z, z_p, ss_soil_envelope(s, b, z));
+  if (!(s > s_p)) return s_p;
+  return plastic_update(mat, s, s_p, ss_soil_envelope(mat, b, s));
 }
 
-double ss_soil_plastic_update_pow(const ssSoilMaterial *s, double b, double z,
-                                  double z_p, double zn1)
+double ss_soil_plastic_update_pow(const ssSoilMaterial *mat, double b, double s,
+                                  double s_p, double sn1)
 {
-  if (!(z > z_p)) return z_p;
-  return plastic_update(s, z, z_p, modulus(s, b) * (z * zn1));
+  if (!(s > s_p)) return s_p;
+  return plastic_update(mat, s, s_p, modulus(mat, b) * (s * sn1));
 }
 
-double ss_soil_viscous(const ssSoilMaterial *s, double sdot)
+double ss_soil_viscous(const ssSoilMaterial *mat, double sdot)
 {
-  return sdot > 0 ? s->damping * sdot : 0;
+  return sdot > 0 ? mat->damping * sdot : 0;
 }
 
-double ss_soil_shear_strength(const ssSoilMaterial *s, double p_n)
+double ss_soil_shear_strength(const ssSoilMaterial *mat, double p_n)
 {
-  return s->cohesion + s->friction_coefficient * (p_n > 0 ? p_n : 0);
+  return mat->cohesion + mat->friction_coefficient * (p_n > 0 ? p_n : 0);
 }
 
-double ss_soil_shear_limit(const ssSoilMaterial *s, double p_n, double j)
+double ss_soil_shear_limit(const ssSoilMaterial *mat, double p_n, double j)
 {
-  double tf = ss_soil_shear_strength(s, p_n);
-  if (!(s->shear_displacement > 0)) return tf;
-  return tf * -expm1(-(j > 0 ? j : 0) / s->shear_displacement);
+  double tf = ss_soil_shear_strength(mat, p_n);
+  if (!(mat->shear_displacement > 0)) return tf;
+  return tf * -expm1(-(j > 0 ? j : 0) / mat->shear_displacement);
 }
 
-double ss_soil_shear_limit_slope(const ssSoilMaterial *s, double p_n, double j)
+double ss_soil_shear_limit_slope(const ssSoilMaterial *mat, double p_n, double j)
 {
-  if (!(s->shear_displacement > 0)) return 0;
-  double tf = ss_soil_shear_strength(s, p_n);
-  return tf * exp(-(j > 0 ? j : 0) / s->shear_displacement) /
-         s->shear_displacement;
+  if (!(mat->shear_displacement > 0)) return 0;
+  double tf = ss_soil_shear_strength(mat, p_n);
+  return tf * exp(-(j > 0 ? j : 0) / mat->shear_displacement) /
+         mat->shear_displacement;
 }

@@ -11,11 +11,11 @@ ssStatus ss_terrain_contacts(const ssModel *m, ssData *d, ssError *err);
 /* After the solve: update sinkage, plastic sinkage and shear of every soil
  * vertex touched (DESIGN 3.1, last paragraph), and step statistics. */
 void ss_terrain_update(const ssModel *m, ssData *d);
-/* ss_soil_plastic_update (soil.c) with z^(n-1) given (zn1), the envelope
- * formed as the law forms it, (k_c/b + k_phi) z z^(n-1): the soil update
+/* ss_soil_plastic_update (soil.c) with s^(n-1) given (sn1), the envelope
+ * formed as the law forms it, (k_c/b + k_phi) s s^(n-1): the soil update
  * takes the power from its bed's table (solver.h) */
-double ss_soil_plastic_update_pow(const ssSoilMaterial *mat, double b, double z,
-                                  double z_p, double zn1);
+double ss_soil_plastic_update_pow(const ssSoilMaterial *mat, double b, double s,
+                                  double s_p, double sn1);
 /* Bed-frame <-> world transforms of height map h for the current pose. */
 void ss_hfield_frame(const ssData *d, int h, double R[9], double p[3]);
 
