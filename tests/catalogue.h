@@ -56,8 +56,16 @@ static void catalogue_check(const char *dir, const char *ext,
   while ((de = readdir(dp))) {
     size_t l = strlen(de->d_name);
     if (l <= el || strcmp(de->d_name + l - el, ext)) continue;
-    names = realloc(names, (size_t)(n + 1) * sizeof *names);
-    names[n++] = strdup(de->d_name);
+    char **grown = realloc(names, (size_t)(n + 1) * sizeof *names);
+    char *name = strdup(de->d_name);
+    if (!grown || !name) {
+      free(name);
+      if (grown) names = grown;
+      ok(0, "out of memory listing the bad-%s catalogue", what);
+      break;
+    }
+    names = grown;
+    names[n++] = name;
   }
   closedir(dp);
   qsort(names, (size_t)n, sizeof *names, catalogue_cmp);
