@@ -36,16 +36,12 @@ static void tmp_path(char *buf, size_t size, const char *name)
   snprintf(buf, size, "%s/%s", tmpdir, name);
 }
 
+/* scenes/NAME of the source tree (worlds.c) */
 static int load_scene(const char *name, ssModel **m, ssData **d)
 {
-  char path[1024];
-  ssError e;
-  snprintf(path, sizeof path, "%s/scenes/%s", srcdir(), name);
-  if (ss_scene_load(path, m, d, &e) != SS_OK) {
-    diag("cannot load %s: %s:%d: %s", path, e.file, e.line, e.message);
-    return 0;
-  }
-  return 1;
+  char rel[512];
+  snprintf(rel, sizeof rel, "scenes/%s", name);
+  return load_scene_file(rel, m, d);
 }
 
 static int run(const ssModel *m, ssData *d, int steps)
