@@ -79,27 +79,11 @@ double ss_soil_pressure(const ssSoilMaterial *mat, double b, double s, double s_
   return pe < py ? pe : py;
 }
 
-/* the update on the envelope value py at s > s_p */
-static double plastic_update(const ssSoilMaterial *mat, double s, double s_p, double py)
-{
-  double pe = ss_soil_elastic(mat, s, s_p), p = pe < py ? pe : py;
-  double sp = s - p / mat->elastic_stiffness;
-  /* on the elastic branch s - p/K_e reproduces s_p up to round-off */
-  return sp > s_p ? sp : s_p;
-}
-
 double ss_soil_plastic_update(const ssSoilMaterial *mat, double b, double s,
                               double s_p)
 {
   if (!(s > s_p)) return s_p;
-  return plastic_update(mat, s, s_p, ss_soil_envelope(mat, b, s));
-}
-
-double ss_soil_plastic_update_pow(const ssSoilMaterial *mat, double b, double s,
-                                  double s_p, double sn1)
-{
-  if (!(s > s_p)) return s_p;
-  return plastic_update(mat, s, s_p, modulus(mat, b) * (s * sn1));
+  return ss_soil_plastic_from(mat, s, s_p, ss_soil_envelope(mat, b, s));
 }
 
 double ss_soil_viscous(const ssSoilMaterial *mat, double sdot)

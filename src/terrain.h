@@ -11,11 +11,28 @@ ssStatus ss_terrain_contacts(const ssModel *m, ssData *d, ssError *err);
 /* After the solve: update sinkage, plastic sinkage and shear of every soil
  * vertex touched (DESIGN 3.1, last paragraph), and step statistics. */
 void ss_terrain_update(const ssModel *m, ssData *d);
+/* The permanent sinkage after reaching s > s_p where the envelope there
+ * is py: max(s_p, s - min(p_e, py)/K_e) (on the elastic branch s - p/K_e
+ * reproduces s_p up to round-off).  Inline: the soil update calls it for
+ * every loaded point (ss_soil_plastic_update in soil.c shares it). */
+static inline double ss_soil_plastic_from(const ssSoilMaterial *mat, double s, double s_p,
+                                          double py)
+{
+  double pe = mat->elastic_stiffness * (s - s_p), p = pe < py ? pe : py;
+  double sp = s - p / mat->elastic_stiffness;
+  return sp > s_p ? sp : s_p;
+}
+
 /* ss_soil_plastic_update (soil.c) with s^(n-1) given (sn1), the envelope
  * formed as the law forms it, (k_c/b + k_phi) s s^(n-1): the soil update
  * takes the power from its bed's table (solver.h) */
-double ss_soil_plastic_update_pow(const ssSoilMaterial *mat, double b, double s,
-                                  double s_p, double sn1);
+static inline double ss_soil_plastic_update_pow(const ssSoilMaterial *mat, double b, double s,
+                                                double s_p, double sn1)
+{
+  if (!(s > s_p)) return s_p;
+  double k = (b > 0 ? mat->bekker_kc / b : 0) + mat->bekker_kphi;
+  return ss_soil_plastic_from(mat, s, s_p, k * (s * sn1));
+}
 /* Bed-frame <-> world transforms of height map h for the current pose. */
 void ss_hfield_frame(const ssData *d, int h, double R[9], double p[3]);
 
