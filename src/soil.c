@@ -46,25 +46,19 @@ ssStatus ss_soil_material_validate(const ssSoilMaterial *mat, ssError *err)
   return SS_OK;
 }
 
-/* modulus of the envelope for width b: k_c / b + k_phi */
-static double modulus(const ssSoilMaterial *mat, double b)
-{
-  return (b > 0 ? mat->bekker_kc / b : 0) + mat->bekker_kphi;
-}
-
 double ss_soil_envelope(const ssSoilMaterial *mat, double b, double s)
 {
   if (!(s > 0)) return 0;
   double n = mat->sinkage_exponent;
-  return modulus(mat, b) * (n == 1.0 ? s : pow(s, n));
+  return ss_soil_modulus(mat, b) * (n == 1.0 ? s : pow(s, n));
 }
 
 double ss_soil_envelope_slope(const ssSoilMaterial *mat, double b, double s)
 {
   double n = mat->sinkage_exponent;
-  if (n == 1.0) return modulus(mat, b);
+  if (n == 1.0) return ss_soil_modulus(mat, b);
   if (!(s > 0)) return n < 1 ? INFINITY : 0;
-  return modulus(mat, b) * n * pow(s, n - 1);
+  return ss_soil_modulus(mat, b) * n * pow(s, n - 1);
 }
 
 double ss_soil_elastic(const ssSoilMaterial *mat, double s, double s_p)

@@ -11,6 +11,12 @@ ssStatus ss_terrain_contacts(const ssModel *m, ssData *d, ssError *err);
 /* After the solve: update sinkage, plastic sinkage and shear of every soil
  * vertex touched (DESIGN 3.1, last paragraph), and step statistics. */
 void ss_terrain_update(const ssModel *m, ssData *d);
+/* the envelope's modulus for width b: k_c / b + k_phi */
+static inline double ss_soil_modulus(const ssSoilMaterial *mat, double b)
+{
+  return (b > 0 ? mat->bekker_kc / b : 0) + mat->bekker_kphi;
+}
+
 /* The permanent sinkage after reaching s > s_p where the envelope there
  * is py: max(s_p, s - min(p_e, py)/K_e) (on the elastic branch s - p/K_e
  * reproduces s_p up to round-off).  Inline: the soil update calls it for
@@ -30,8 +36,7 @@ static inline double ss_soil_plastic_update_pow(const ssSoilMaterial *mat, doubl
                                                 double s_p, double sn1)
 {
   if (!(s > s_p)) return s_p;
-  double k = (b > 0 ? mat->bekker_kc / b : 0) + mat->bekker_kphi;
-  return ss_soil_plastic_from(mat, s, s_p, k * (s * sn1));
+  return ss_soil_plastic_from(mat, s, s_p, ss_soil_modulus(mat, b) * (s * sn1));
 }
 /* Bed-frame <-> world transforms of height map h for the current pose. */
 void ss_hfield_frame(const ssData *d, int h, double R[9], double p[3]);
