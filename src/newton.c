@@ -1478,7 +1478,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     P->g0 = c->g0;
     P->sp = c->sp;
     P->S = c->area * m->opt.timestep;
-    P->k = (c->width > 0 && mat->bekker_kc != 0 ? mat->bekker_kc / c->width : 0) + mat->bekker_kphi;
+    P->k = ss_soil_modulus(mat, c->width);
     P->tf0 = P->S * mat->cohesion;
     P->x0 = mat->shear_displacement > 0 ? c->j / mat->shear_displacement : 0;
     P->pw.s = 0;

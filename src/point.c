@@ -673,8 +673,7 @@ void ss_point_setup(const ssSoilMaterial *mat, const ssPowTable *tab, double dt,
   L->dt = dt;
   L->g0 = c->g0;
   L->sp = c->sp;
-  L->k = (c->width > 0 && mat->bekker_kc != 0 ? mat->bekker_kc / c->width : 0) +
-         mat->bekker_kphi;
+  L->k = ss_soil_modulus(mat, c->width);
   L->n = mat->sinkage_exponent;
   L->m1 = m1;
   L->Ke = mat->elastic_stiffness;

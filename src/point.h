@@ -10,6 +10,14 @@
 #include "soilsim.h"
 #include "ss_math.h"
 
+/* The Bekker envelope's modulus k_c/b + k_phi for width b, as every user
+ * of the law forms it (the sweeps' and the Newton phase's set-up, the soil
+ * update, soil.c): no division where k_c = 0 (the same value) */
+static inline double ss_soil_modulus(const ssSoilMaterial *mat, double b)
+{
+  return (b > 0 && mat->bekker_kc != 0 ? mat->bekker_kc / b : 0) + mat->bekker_kphi;
+}
+
 /* A soil point's law (DESIGN 3.1) as its solve uses it (solver.c): set up
  * once per step from the contact and its material, plus the values the
  * solve reuses between visits -- the last power s^(n-1) and the last

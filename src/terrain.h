@@ -5,18 +5,13 @@
 #define SS_TERRAIN_H
 
 #include "soilsim.h"
+#include "point.h"
 
 /* Build d->contact for the current positions (d->ncontact). */
 ssStatus ss_terrain_contacts(const ssModel *m, ssData *d, ssError *err);
 /* After the solve: update sinkage, plastic sinkage and shear of every soil
  * vertex touched (DESIGN 3.1, last paragraph), and step statistics. */
 void ss_terrain_update(const ssModel *m, ssData *d);
-/* the envelope's modulus for width b: k_c / b + k_phi */
-static inline double ss_soil_modulus(const ssSoilMaterial *mat, double b)
-{
-  return (b > 0 ? mat->bekker_kc / b : 0) + mat->bekker_kphi;
-}
-
 /* The permanent sinkage after reaching s > s_p where the envelope there
  * is py: max(s_p, s - min(p_e, py)/K_e) (on the elastic branch s - p/K_e
  * reproduces s_p up to round-off).  Inline: the soil update calls it for
@@ -30,7 +25,7 @@ static inline double ss_soil_plastic_from(const ssSoilMaterial *mat, double s, d
 }
 
 /* ss_soil_plastic_update (soil.c) with s^(n-1) given (sn1), the envelope
- * formed as the law forms it, (k_c/b + k_phi) s s^(n-1): the soil update
+ * formed as the law forms it, ss_soil_modulus s s^(n-1): the soil update
  * takes the power from its bed's table (solver.h) */
 static inline double ss_soil_plastic_update_pow(const ssSoilMaterial *mat, double b, double s,
                                                 double s_p, double sn1)
