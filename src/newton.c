@@ -1482,12 +1482,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     P->tf0 = P->S * mat->cohesion;
     P->x0 = mat->shear_displacement > 0 ? c->j / mat->shear_displacement : 0;
     P->pw.s = 0;
-    /* the mobilisation's memo starts at x = 0 (m = 0, e = 1) where the
-     * point has next to no shear displacement (a settled body's), so that
-     * its first x comes by the series, not from libm */
-    P->mob.x = P->x0 <= SS_EXP_SERIES_MAX ? 0 : -1;
-    P->mob.m = 0;
-    P->mob.e = 1;
+    P->mob = ss_exp_memo_start(P->x0);
     P->imp = 0;
   }
   int n = 6 * ngroup + nrow;

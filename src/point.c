@@ -294,10 +294,7 @@ static void mobil_init(Mobil *J, double j, double K, double dt)
   J->r = dt * iK;
   J->x0 = (j > 0 ? j : 0) * iK;
   J->m0 = J->r > 0 ? (J->x0 > 0 ? -1 : 0) : 1;
-  /* at x = 0 the point is free: m = 0, e = 1 */
-  J->last.x = J->x0 > 0 ? -1 : 0;
-  J->last.m = 0;
-  J->last.e = 1;
+  J->last = ss_exp_memo_start(J->x0);
 }
 
 /* m at zero slip, for the stick test (m(sigma) >= m0 bounds it for free) */

@@ -325,6 +325,16 @@ typedef struct ssExpMemo {
   double x, m, e;
 } ssExpMemo;
 
+/* A point's memo before its first x: at x = 0 (m = 0, e = 1) where its
+ * x0 (j/K_j, the least x it will be asked for) is within the series'
+ * reach of 0, so that its first x comes by the series, not from libm (a
+ * settled body's points, x0 about 1e-14); else none (x < 0) */
+static inline ssExpMemo ss_exp_memo_start(double x0)
+{
+  ssExpMemo c = {x0 <= SS_EXP_SERIES_MAX ? 0 : -1, 0, 1};
+  return c;
+}
+
 /* c moved to x: by the series when x is within SS_EXP_SERIES_MAX of c.x,
  * else from libm */
 static inline ssExpMemo ss_exp_memo_move(ssExpMemo c, double x)
