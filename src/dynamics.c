@@ -177,6 +177,27 @@ double ss_dyn_geom_speed(const ssModel *m, const ssData *d, int g,
   return ss_v3_norm(v) + ss_v3_norm(w) * radius;
 }
 
+double ss_dyn_geom_approach(const ssModel *m, const ssData *d, int g,
+                            double radius, const double n[3])
+{
+  int b = m->geom_body[g], s = m->body_sys[b];
+  if (!m->sys_nv[s] || !d->sys_active[s]) return 0;
+  const double *c = d->geom_xpos + 3 * g;
+  double v[3], w[3], wn[3];
+  ss_dyn_point_velocity(m, d, b, c, v);
+  if (m->sys_type[s] == SS_SYS_ARTICULATED) {
+    double sv[6];
+    ss_art_link_velocity(m, d, b, sv);
+    ss_v3_copy(w, sv);
+  } else {
+    ss_v3_copy(w, d->qvel + m->sys_vadr[s] + 3);
+  }
+  /* a point c + r (|r| <= radius) moves along n at v.n + (w x r).n =
+   * v.n + r.(n x w) */
+  ss_v3_cross(wn, n, w);
+  return fabs(ss_v3_dot(v, n)) + radius * ss_v3_norm(wn);
+}
+
 void ss_dyn_integrate(const ssModel *m, ssData *d)
 {
   const double dt = m->opt.timestep;

@@ -33,6 +33,11 @@ double ss_dyn_geom_radius(const ssModel *m, int g);
  * radius about the geom centre). */
 double ss_dyn_geom_speed(const ssModel *m, const ssData *d, int g,
                          double radius);
+/* A bound on the speed along the unit direction n of any point of geom g
+ * (radius as above): |v_c . n| + radius |n x omega|, v_c the velocity of
+ * the geom centre.  At most ss_dyn_geom_speed's bound. */
+double ss_dyn_geom_approach(const ssModel *m, const ssData *d, int g,
+                            double radius, const double n[3]);
 /* Positions from velocities (semi-implicit Euler); quaternions exact. */
 void ss_dyn_integrate(const ssModel *m, ssData *d);
 /* First system whose coordinates are non-finite or whose velocities are

@@ -104,12 +104,19 @@ static int mesh_depth(const ssModel *m, const ssData *d, int g,
 
 /* How far a collider can travel towards a support in one step plus the
  * configured margin: points closer than this become contacts, so no
- * contact is missed by the implicit end-of-step solve. */
-static double geom_margin(const ssModel *m, const ssData *d, int g, int sys)
+ * contact is missed by the implicit end-of-step solve.  n: the direction
+ * the gaps are measured along (a soil bed's z), where the reach is the
+ * speed of the collider's points along it; NULL (a rigid height map, whose
+ * normal varies): their speed in any direction. */
+static double geom_margin(const ssModel *m, const ssData *d, int g, int sys,
+                          const double *n)
 {
   double reach = m->opt.contact_margin;
-  if (sys >= 0 && m->sys_nv[sys] > 0)
-    reach += m->opt.timestep * ss_dyn_geom_speed(m, d, g, ss_dyn_geom_radius(m, g));
+  if (sys >= 0 && m->sys_nv[sys] > 0) {
+    double rad = ss_dyn_geom_radius(m, g);
+    reach += m->opt.timestep * (n ? ss_dyn_geom_approach(m, d, g, rad, n)
+                                  : ss_dyn_geom_speed(m, d, g, rad));
+  }
   return reach;
 }
 
@@ -144,7 +151,8 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
   shape_in_frame(m, d, g, R, p, &s);
   double lo[3], hi[3];
   ss_shape_aabb(&s, lo, hi);
-  double margin = geom_margin(m, d, g, sys);
+  double nz[3] = {R[2], R[5], R[8]};
+  double margin = geom_margin(m, d, g, sys, nz);
   double ztop = m->hfield_zrange[2 * h + 1];
   if (lo[2] > ztop + margin) return SS_OK;
   /* no bed vertex lies above the bed's top (plastic sinkage only lowers
@@ -305,7 +313,7 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
   shape_in_frame(m, d, g, R, p, &s);
   double lo[3], hi[3];
   ss_shape_aabb(&s, lo, hi);
-  double margin = geom_margin(m, d, g, sys);
+  double margin = geom_margin(m, d, g, sys, NULL);
   double top = h >= 0 ? m->hfield_zrange[2 * h + 1] : 0;
   if (lo[2] > top + margin) return SS_OK;
 

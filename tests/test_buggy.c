@@ -2,12 +2,14 @@
  * (assets/buggy, scenes/buggy*.xml): statics on rigid ground, loop
  * closure, a 20 s drive on soil (speed, slip, ruts, recovery after
  * removal), steering and determinism. */
+#include "dynamics.h"
 #include "soilsim.h"
 #include "solver.h"
 #include "ss_math.h"
 #include "tap.h"
 #include "worlds.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -605,6 +607,54 @@ static void test_determinism(void)
   remove(out[1]);
 }
 
+/* the soil reach (terrain.c) of an articulated link's geoms: any point
+ * within the geom's bounding radius moves along the bed normal n at most
+ * ss_dyn_geom_approach, and some point on that sphere moves at it (r along
+ * n x omega), with the link's velocity from the joints' (arbitrary
+ * velocities here); never more than the speed bound in any direction */
+static void test_reach(void)
+{
+  ssModel *m;
+  ssData *d;
+  if (!load("scenes/buggy.xml", &m, &d)) return;
+  int s = ss_model_find_sys(m, "buggy");
+  unsigned x = 12345;
+  for (int k = m->sys_vadr[s]; k < m->sys_vadr[s] + m->sys_nv[s]; k++) {
+    x = x * 1103515245u + 12345u;
+    d->qvel[k] = ((x >> 8) & 0xffff) / 32768.0 - 1;
+  }
+  ss_forward(m, d);
+  const double n[3] = {0, 0, 1};
+  int bad = 0, checked = 0;
+  double worst = 0;
+  for (int g = 0; g < m->ngeom; g++) {
+    if (m->body_sys[m->geom_body[g]] != s) continue;
+    double rad = ss_dyn_geom_radius(m, g), a = ss_dyn_geom_approach(m, d, g, rad, n);
+    double top = 0;
+    const int N = 4000;
+    for (int i = 0; i < N; i++) {
+      /* a Fibonacci sphere of radius rad about the geom centre */
+      double z = 1 - (2 * i + 1.0) / N, rho = sqrt(1 - z * z), phi = 2.399963229728653 * i;
+      double p[3] = {rad * rho * cos(phi), rad * rho * sin(phi), rad * z}, v[3];
+      ss_v3_add(p, p, d->geom_xpos + 3 * g);
+      ss_dyn_point_velocity(m, d, m->geom_body[g], p, v);
+      top = fmax(top, fabs(ss_v3_dot(v, n)));
+    }
+    checked++;
+    double rel = (a - top) / a;
+    worst = fmax(worst, rel);
+    if (!(top <= a * (1 + 1e-12) && rel < 2e-3 && a <= ss_dyn_geom_speed(m, d, g, rad)))
+      bad++;
+  }
+  ok(checked > 0 && bad == 0,
+     "reach: on %d geoms of the moving buggy no point within the bounding radius "
+     "outruns the approach bound, which is met to %.1e (sampled) and is below "
+     "the speed bound",
+     checked, worst);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 int main(void)
 {
   test_statics();
@@ -617,5 +667,6 @@ int main(void)
   test_warm_deferred();
   test_newton_sticking();
   test_drive();
+  test_reach();
   return done_testing();
 }

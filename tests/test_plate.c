@@ -316,6 +316,50 @@ static void test_drag(void)
   free_world(&v);
 }
 
+/* A soil point becomes a contact when the collider can reach it within
+ * the step plus contact_margin (1 cm): the reach is the speed of the
+ * collider's points along the bed's normal, |v.n| + r |n x omega|, not their
+ * speed in any direction.  A ball 1.2 cm above the bed: sliding at 5 m/s
+ * it reaches no point (a reach of |v| dt would take 0.5 cm more, and
+ * points with them); falling at 5 m/s, or spinning at 80 rad/s about a
+ * level axis (its front moves down at 8 m/s), it does. */
+static void test_reach(void)
+{
+  const double r = 0.1, gap = 0.012;
+  const struct {
+    const char *what;
+    double v[3], w[3];
+    int reach;
+  } c[] = {
+      {"sliding level", {5, 0, 0}, {0, 0, 0}, 0},
+      {"spinning about the vertical", {0, 0, 0}, {0, 0, 80}, 0},
+      {"falling", {0, 0, -5}, {0, 0, 0}, 1},
+      {"spinning about a level axis", {0, 0, 0}, {0, 80, 0}, 1},
+  };
+  for (int k = 0; k < 4; k++) {
+    ssError e;
+    ssModel *m = ss_model_new();
+    add_soil_bed(m, 1.0, 0.02);
+    ssBodyDef b = ss_body_def_default();
+    b.name = "ball";
+    b.shape = SS_GEOM_SPHERE;
+    b.size[0] = r;
+    b.mass = 1;
+    ss_v3_set(b.pos, 0, 0, r + gap);
+    memcpy(b.lin_vel, c[k].v, sizeof b.lin_vel);
+    memcpy(b.ang_vel, c[k].w, sizeof b.ang_vel);
+    ss_model_add_body(m, &b, &e);
+    ssData *d = ss_data_new(m);
+    ssStatus st = ss_step(m, d, &e);
+    ok(st == SS_OK && (d->stats.soil_contacts > 0) == c[k].reach &&
+           d->stats.soil_normal_force == 0,
+       "reach: a ball %s 1.2 cm above the bed %s (%d points)", c[k].what,
+       c[k].reach ? "reaches points" : "reaches none", d->stats.soil_contacts);
+    ss_data_free(d);
+    ss_model_free(m);
+  }
+}
+
 /* rigid ground: rest, friction and restitution from the material pairs */
 static void test_rigid(void)
 {
@@ -773,6 +817,7 @@ int main(void)
   test_impact_and_lift();
   test_drag();
   test_rigid();
+  test_reach();
   test_warm_trend();
   test_newton();
   test_settled_cache();
