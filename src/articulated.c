@@ -35,6 +35,15 @@ struct ssArtWork {
   double *Y;             /* (nb x nv x 6) projected responses P M'^-1 J_b^T */
   double *Lam;           /* (nb x 36) J_b Y_b */
   unsigned char *Yok;    /* (nb) Y_b valid for this step */
+  /* the Newton phase's factored route to the same responses
+   * (ss_art_link_pair): b's path dofs, descending, and on them X_b = T J_b^T
+   * and X_b / D (M'^-1 = T^T D^-1 T, T the LTDL's first sweep), and
+   * W_b = L_A^-1 K M'^-1 J_b^T (nr x 6, A = L_A L_A^T) */
+  int *path, *npath;     /* (nb x nv), (nb) */
+  double *Xp, *XD;       /* (nb x nv x 6), rows on the path */
+  double *Wp;            /* (nb x nr x 6) */
+  unsigned char *Xok;    /* (nb) valid for this step */
+  double *fsum;          /* (nv) sum of J_b^T F_b (ss_art_force_add) */
   int rank_deficient;    /* rows dropped in the last factorization */
 };
 
@@ -117,6 +126,8 @@ void ss_art_work_free(ssArtWork *w)
   free(w->M); free(w->L); free(w->rhs); free(w->x); free(w->y);
   free(w->K); free(w->phi); free(w->MiKT); free(w->A); free(w->Z); free(w->row_on);
   free(w->Y); free(w->Lam); free(w->Yok);
+  free(w->path); free(w->npath); free(w->Xp); free(w->XD); free(w->Wp); free(w->Xok);
+  free(w->fsum);
   free(w);
 }
 
@@ -154,6 +165,17 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
   w->Y = calloc(nb * nv * 6, sizeof(double));
   w->Lam = calloc(nb * 36, sizeof(double));
   w->Yok = calloc(nb, 1);
+  w->path = calloc(nb * nv, sizeof(int));
+  w->npath = calloc(nb ? nb : 1, sizeof(int));
+  w->Xp = calloc(nb * nv * 6, sizeof(double));
+  w->XD = calloc(nb * nv * 6, sizeof(double));
+  w->Wp = calloc(nb * nr * 6, sizeof(double));
+  w->Xok = calloc(nb ? nb : 1, 1);
+  w->fsum = calloc(nv, sizeof(double));
+  if (!w->path || !w->npath || !w->Xp || !w->XD || !w->Wp || !w->Xok || !w->fsum) {
+    ss_art_work_free(w);
+    return NULL;
+  }
   if (!w->eq || !w->dof_body || !w->dof_parent || !w->S || !w->vel || !w->acc ||
       !w->frc || !w->I6 || !w->Ic || !w->M || !w->L || !w->rhs || !w->x || !w->y ||
       !w->K || !w->phi || !w->MiKT || !w->A || !w->Z || !w->row_on || !w->Y || !w->Lam ||
@@ -485,7 +507,7 @@ static void factor_closures(ssArtWork *w)
 /* Z <- A^-1 Z over the active rows (dropped rows give 0), for m columns
  * at once, Z (nr x m, row i = closure row i); each column sees the same
  * operations in the same order whatever m */
-static inline void closure_solve(const ssArtWork *w, double *Z, int m)
+static inline void closure_forward(const ssArtWork *w, double *Z, int m)
 {
   int nr = w->nrow;
   const double *A = w->A;
@@ -501,6 +523,13 @@ static inline void closure_solve(const ssArtWork *w, double *Z, int m)
     }
     ss_row_div(zi, A[i * nr + i], m);
   }
+}
+
+static inline void closure_solve(const ssArtWork *w, double *Z, int m)
+{
+  int nr = w->nrow;
+  const double *A = w->A;
+  closure_forward(w, Z, m);
   for (int i = nr - 1; i >= 0; i--) {
     double *zi = Z + (size_t)m * i;
     if (!w->row_on[i]) {
@@ -709,6 +738,7 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
     project(w, u);
   }
   memset(w->Yok, 0, (size_t)w->nb);
+  memset(w->Xok, 0, (size_t)w->nb);
   return SS_OK;
 }
 
@@ -790,6 +820,103 @@ void ss_art_link_block(const ssModel *m, ssData *d, int b, const double **Y,
   body_response(m, w, lb);
   *Y = w->Y + (size_t)lb * w->nv * 6;
   *Lam = w->Lam + 36 * lb;
+}
+
+/* The Newton phase's route to the links' responses, which never forms
+ * Y_b (nv x 6, its L^-1 sweep fills the whole tree):
+ *   J_a P M'^-1 J_b^T = (T J_a^T)^T D^-1 (T J_b^T) - (L_A^-1 Z_a)^T (L_A^-1 Z_b)
+ * with M' = T^T D T-style LTDL factors (ltdl_solve: T its first sweep,
+ * towards the root, which keeps J_b^T on b's path), Z_b = K M'^-1 J_b^T =
+ * (J_b MiKT)^T and A = L_A L_A^T (dropped rows give 0).  X_b = T J_b^T and
+ * W_b = L_A^-1 Z_b are formed once per step and link (link_reduced); a
+ * pair's block then sums over the dofs the two paths share and the
+ * closure rows. */
+static void link_reduced(const ssModel *m, ssArtWork *w, int lb)
+{
+  if (w->Xok[lb]) return;
+  int n = w->nv, nr = w->nrow, b = w->b0 + lb;
+  int *path = w->path + (size_t)lb * n, np = 0;
+  double *X = w->Xp + (size_t)lb * n * 6, *XD = w->XD + (size_t)lb * n * 6;
+  /* b's path dofs, descending: the last dof of the nearest body with any,
+   * then its LTDL parents */
+  int a = b;
+  while (a >= 0 && !m->body_ndof[a]) a = m->body_parent[a];
+  if (a >= 0 && m->body_sys[a] == w->sys)
+    for (int k = m->body_dofadr[a] - w->v0 + m->body_ndof[a] - 1; k >= 0; k = w->dof_parent[k])
+      path[np++] = k;
+  w->npath[lb] = np;
+  for (int i = 0; i < np; i++) memcpy(X + 6 * path[i], w->S + 6 * path[i], 6 * sizeof(double));
+  const double *H = w->L;
+  for (int i = 0; i < np; i++) {
+    int k = path[i];
+    const double *xk = X + 6 * k;
+    for (int j = w->dof_parent[k]; j >= 0; j = w->dof_parent[j])
+      ss_row_add_scaled(X + 6 * j, -H[k * n + j], xk, 6);
+  }
+  for (int i = 0; i < np; i++) {
+    int k = path[i];
+    for (int c = 0; c < 6; c++) XD[6 * k + c] = X[6 * k + c] / H[k * n + k];
+  }
+  if (nr) {
+    double *Wb = w->Wp + (size_t)lb * nr * 6;
+    memset(Wb, 0, 6 * (size_t)nr * sizeof(double));
+    for (int i = 0; i < np; i++) {
+      int k = path[i];
+      const double *Sk = w->S + 6 * k, *Mk = w->MiKT + (size_t)k * nr;
+      for (int r = 0; r < nr; r++) ss_row_add_scaled(Wb + 6 * r, Mk[r], Sk, 6);
+    }
+    closure_forward(w, Wb, 6);
+  }
+  w->Xok[lb] = 1;
+}
+
+void ss_art_link_pair(const ssModel *m, ssData *d, int a, int b, double *out, int ldo)
+{
+  ssArtWork *w = d->art[m->body_sys[a]];
+  int la = a - w->b0, lb = b - w->b0, n = w->nv, nr = w->nrow;
+  link_reduced(m, w, la);
+  link_reduced(m, w, lb);
+  const int *pa = w->path + (size_t)la * n, *pb = w->path + (size_t)lb * n;
+  int na = w->npath[la], nb = w->npath[lb], i = 0, j = 0;
+  /* the shared part of two paths to the root is the tail of both */
+  while (i < na && j < nb && pa[i] != pb[j]) {
+    if (pa[i] > pb[j]) i++;
+    else j++;
+  }
+  const double *Xa = w->Xp + (size_t)la * n * 6, *XDb = w->XD + (size_t)lb * n * 6;
+  double acc[36] = {0};
+  for (; i < na; i++) {
+    const double *x = Xa + 6 * pa[i], *y = XDb + 6 * pa[i];
+    for (int r = 0; r < 6; r++) ss_row_add_scaled(acc + 6 * r, x[r], y, 6);
+  }
+  if (nr) {
+    const double *Wa = w->Wp + (size_t)la * nr * 6, *Wb = w->Wp + (size_t)lb * nr * 6;
+    for (int k = 0; k < nr; k++)
+      for (int r = 0; r < 6; r++) ss_row_add_scaled(acc + 6 * r, -Wa[6 * k + r], Wb + 6 * k, 6);
+  }
+  for (int r = 0; r < 6; r++) memcpy(out + (size_t)ldo * r, acc + 6 * r, 6 * sizeof(double));
+}
+
+void ss_art_force_add(const ssModel *m, ssData *d, int b, const double F[6])
+{
+  ssArtWork *w = d->art[m->body_sys[b]];
+  for (int a = b; a >= 0; a = m->body_parent[a]) {
+    int nd = m->body_ndof[a];
+    if (!nd) continue;
+    int k0 = m->body_dofadr[a] - w->v0;
+    for (int k = k0; k < k0 + nd; k++) w->fsum[k] += dot6(w->S + 6 * k, F);
+  }
+}
+
+void ss_art_force_apply(const ssModel *m, ssData *d, int sys, double *u)
+{
+  ssArtWork *w = d->art[sys];
+  int n = w->nv;
+  double *x = w->fsum;
+  ltdl_solve(w, x, 1);
+  project(w, x);
+  for (int k = 0; k < n; k++) u[k] += x[k];
+  memset(x, 0, (size_t)n * sizeof(double));
 }
 
 void ss_art_contact_rows(const double p[3], const double frame[9], double X[18])

@@ -76,6 +76,16 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int sys,
  * block Lam = J_b Y, the link's spatial velocity per unit spatial impulse. */
 void ss_art_link_block(const ssModel *m, ssData *d, int b, const double **Y,
                        const double **Lam);
+/* The block J_a Y_b (6 x 6, row i at out + ldo i) between links a and b of
+ * one system, from the factors without forming Y_b (the Newton phase's
+ * route: each link's path reduced once per step); the same as J_a of
+ * ss_art_link_block's Y_b to round-off. */
+void ss_art_link_pair(const ssModel *m, ssData *d, int a, int b, double *out, int ldo);
+/* Spatial impulses on links of one system, summed (J_b^T F_b, add), then
+ * applied at once (apply: u += P M'^-1 sum, u the system's velocities),
+ * which is sum Y_b F_b with one solve instead of Y_b's six. */
+void ss_art_force_add(const ssModel *m, ssData *d, int b, const double F[6]);
+void ss_art_force_apply(const ssModel *m, ssData *d, int sys, double *u);
 /* Spatial velocity J_b u of link b (world, about the origin: omega; v_O). */
 void ss_art_link_velocity(const ssModel *m, const ssData *d, int b,
                           double V[6]);

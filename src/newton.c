@@ -1165,6 +1165,24 @@ static void lam_matrix(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork
   for (int gc = 0; gc < s->ngroup + s->nrow; gc++) {
     const double *Y;
     int sys, vadr, nv, ncol, col0, stride;
+    if (gc < s->ngroup && w->grp[gc].link >= 0) {
+      /* a link's column block: its pairs with the links of its system from
+       * the factors (ss_art_link_pair), each formed once and mirrored (Lam
+       * = J P M'^-1 J^T is symmetric); its rows' entries are mirrored from
+       * the rows' columns below */
+      const NGroup *Gc = w->grp + gc;
+      for (int gr = 0; gr <= gc; gr++) {
+        const NGroup *G = w->grp + gr;
+        if (G->sys != Gc->sys) continue;
+        double *out = w->Lam + (size_t)(6 * gr) * n + 6 * gc;
+        ss_art_link_pair(m, d, G->link, Gc->link, out, n);
+        if (gr == gc) continue;
+        for (int a = 0; a < 6; a++)
+          for (int b = 0; b < 6; b++)
+            w->Lam[(size_t)(6 * gc + b) * n + 6 * gr + a] = out[(size_t)a * n + b];
+      }
+      continue;
+    }
     if (gc < s->ngroup) {
       Y = group_block(m, d, w->grp + gc);
       sys = w->grp[gc].sys;
@@ -1208,6 +1226,15 @@ static void lam_matrix(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork
         w->Lam[(size_t)(6 * s->ngroup + r) * n + col0 + k] =
             d->jac[c->jadr + dof] * Y[stride * dof + k];
     }
+    if (gc >= s->ngroup) {
+      /* the row's entries in the links' columns: J_r Y_b = (J_b W_r)^T */
+      int rr = 6 * s->ngroup + (gc - s->ngroup);
+      for (int gr = 0; gr < s->ngroup; gr++) {
+        if (w->grp[gr].sys != sys || w->grp[gr].link < 0) continue;
+        for (int a = 0; a < 6; a++)
+          w->Lam[(size_t)rr * n + 6 * gr + a] = w->Lam[(size_t)(6 * gr + a) * n + rr];
+      }
+    }
   }
 }
 
@@ -1232,7 +1259,20 @@ static void apply_at(const ssModel *m, ssData *d, const Setup *s, const ssNewton
   for (int i = 0; i < s->first_row; i++)
     memcpy(d->contact[i].lambda, lam + 3 * i, 3 * sizeof(double));
   memcpy(d->qvel, d->qvel_free, (size_t)m->nv * sizeof(double));
+  /* the links' impulses, a system at a time: summed on their paths, then
+   * one solve (ss_art_force_apply) */
   for (int g = 0; g < s->ngroup; g++) {
+    const NGroup *G = w->grp + g;
+    if (G->link < 0) continue;
+    int first = 1;
+    for (int e = 0; e < g && first; e++) first = w->grp[e].link < 0 || w->grp[e].sys != G->sys;
+    if (!first) continue;
+    for (int e = g; e < s->ngroup; e++)
+      if (w->grp[e].link >= 0 && w->grp[e].sys == G->sys) ss_art_force_add(m, d, w->grp[e].link, F + 6 * e);
+    ss_art_force_apply(m, d, G->sys, d->qvel + m->sys_vadr[G->sys]);
+  }
+  for (int g = 0; g < s->ngroup; g++) {
+    if (w->grp[g].link >= 0) continue;
     const double *Y = group_block(m, d, w->grp + g), *Fg = F + 6 * g;
     int sys = w->grp[g].sys;
     double *u = d->qvel + m->sys_vadr[sys];

@@ -778,10 +778,81 @@ static void test_link_motion_cols(void)
   ss_model_free(m);
 }
 
+/* The Newton phase's factored responses against the full ones: for every
+ * pair of links of the buggy (four double-wishbone loops, a steering
+ * linkage), J_a Y_b by ss_art_link_pair against J_a of ss_art_link_block's
+ * Y_b, and a sum of impulses applied at once (ss_art_force_apply) against
+ * sum Y_b F_b.  Both are the same quantities by other sums: round-off,
+ * 1e-12 of the largest entry. */
+static void test_link_pair(void)
+{
+  ssModel *m;
+  ssData *d;
+  if (!load_scene_file("scenes/buggy.xml", &m, &d)) {
+    ok(0, "buggy.xml loads");
+    return;
+  }
+  ssError e;
+  /* two steps on, then the next step's factors (its free velocity), as the
+   * contact solve sees them */
+  int good = ss_step(m, d, &e) == SS_OK && ss_step(m, d, &e) == SS_OK;
+  ss_forward(m, d);
+  good = good && ss_dyn_free_velocity(m, d, &e) == SS_OK;
+  int s = ss_model_find_sys(m, "buggy"), b0 = m->sys_bodyadr[s], nb = m->sys_nbody[s];
+  int nv = m->sys_nv[s], pairs = 0;
+  double worst = 0, big = 0, uworst = 0, ubig = 0;
+  double *u1 = calloc((size_t)nv, sizeof *u1), *u2 = calloc((size_t)nv, sizeof *u2);
+  for (int a = b0; good && a < b0 + nb; a++)
+    for (int b = b0; b < b0 + nb; b++) {
+      double P[36], Q[36];
+      const double *Yb, *Lam;
+      ss_art_link_pair(m, d, a, b, P, 6);
+      ss_art_link_block(m, d, b, &Yb, &Lam);
+      ss_art_link_motion_cols(m, d, a, Yb, 6, 6, Q, 6);
+      for (int i = 0; i < 36; i++) {
+        worst = fmax(worst, fabs(P[i] - Q[i]));
+        big = fmax(big, fabs(Q[i]));
+      }
+      pairs++;
+    }
+  /* impulses on every link: once summed and solved, once through each Y_b */
+  unsigned long long r = 7;
+  for (int b = b0; good && u1 && u2 && b < b0 + nb; b++) {
+    double F[6];
+    for (int i = 0; i < 6; i++) {
+      r = r * 6364136223846793005ull + 1442695040888963407ull;
+      F[i] = (double)(r >> 11) / 9007199254740992.0 - 0.5;
+    }
+    ss_art_force_add(m, d, b, F);
+    const double *Yb, *Lam;
+    ss_art_link_block(m, d, b, &Yb, &Lam);
+    for (int k = 0; k < nv; k++)
+      for (int i = 0; i < 6; i++) u2[k] += Yb[6 * k + i] * F[i];
+  }
+  if (good && u1 && u2) {
+    ss_art_force_apply(m, d, s, u1);
+    for (int k = 0; k < nv; k++) {
+      uworst = fmax(uworst, fabs(u1[k] - u2[k]));
+      ubig = fmax(ubig, fabs(u2[k]));
+    }
+  }
+  ok(good && pairs == nb * nb && big > 0 && worst <= 1e-12 * big,
+     "link pairs from the factors: J_a Y_b of all %d pairs of the buggy's links "
+     "to %.1e of the largest entry", pairs, big > 0 ? worst / big : 0);
+  ok(good && u1 && u2 && ubig > 0 && uworst <= 1e-12 * ubig,
+     "impulses on all links applied by one solve: sum Y_b F_b to %.1e of the "
+     "largest velocity", ubig > 0 ? uworst / ubig : 0);
+  free(u1);
+  free(u2);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 int main(void)
 {
   test_row_lanes();
   test_link_motion_cols();
+  test_link_pair();
   test_pendulum();
   test_fourbar();
   test_pd_and_springs();
