@@ -1155,9 +1155,11 @@ static int switch_all(ssNewtonWork *w, const Setup *s)
 /* ---------------------------------------------------------------------- */
 /* set-up                                                                  */
 
-/* Lam = J Y over the unknowns: column block of each group (the six columns
- * of its link's Y_b) and each row (its W column), read by every unknown of
- * the same system through its J */
+/* Lam = J P M'^-1 J^T over the unknowns.  Links' blocks from the factors
+ * (ss_art_link_pair), one per pair, mirrored; a free body's from its Y
+ * (body_block); each row's column from its W, read by every unknown of
+ * the same system through its J, and its entries in the links' columns
+ * mirrored from there. */
 static void lam_matrix(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork *w)
 {
   int n = s->n;
@@ -1251,7 +1253,8 @@ static void unknowns_of(const ssModel *m, const ssData *d, const Setup *s,
 }
 
 /* the impulses at y into the contacts, and the velocities they give:
- * u = u_free + sum Y_b F_b + sum W_r lambda_r */
+ * u = u_free + P M'^-1 sum J_b^T F_b (links: ss_art_force_apply, one solve
+ * per system) + sum Y_b F_b (free bodies) + sum W_r lambda_r */
 static void apply_at(const ssModel *m, ssData *d, const Setup *s, const ssNewtonWork *w,
                      const double *lam, const double *F)
 {
