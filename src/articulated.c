@@ -44,6 +44,9 @@ struct ssArtWork {
   double *Wp;            /* (nb x nr x 6) */
   unsigned char *Xok;    /* (nb) valid for this step */
   double *fsum;          /* (nv) sum of J_b^T F_b (ss_art_force_add) */
+  int *dpath, *dnp;      /* the same for single dofs (a joint row's e_k): */
+  double *Xd, *XDd, *Wd; /* (nv x nv), (nv), (nv x nv) twice, (nv x nr) */
+  unsigned char *dok;    /* (nv) */
   int rank_deficient;    /* rows dropped in the last factorization */
 };
 
@@ -127,7 +130,8 @@ void ss_art_work_free(ssArtWork *w)
   free(w->K); free(w->phi); free(w->MiKT); free(w->A); free(w->Z); free(w->row_on);
   free(w->Y); free(w->Lam); free(w->Yok);
   free(w->path); free(w->npath); free(w->Xp); free(w->XD); free(w->Wp); free(w->Xok);
-  free(w->fsum);
+  free(w->fsum); free(w->dpath); free(w->dnp); free(w->Xd); free(w->XDd); free(w->Wd);
+  free(w->dok);
   free(w);
 }
 
@@ -172,7 +176,14 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
   w->Wp = calloc(nb * nr * 6, sizeof(double));
   w->Xok = calloc(nb ? nb : 1, 1);
   w->fsum = calloc(nv, sizeof(double));
-  if (!w->path || !w->npath || !w->Xp || !w->XD || !w->Wp || !w->Xok || !w->fsum) {
+  w->dpath = calloc(nv * nv, sizeof(int));
+  w->dnp = calloc(nv, sizeof(int));
+  w->Xd = calloc(nv * nv, sizeof(double));
+  w->XDd = calloc(nv * nv, sizeof(double));
+  w->Wd = calloc(nv * nr, sizeof(double));
+  w->dok = calloc(nv, 1);
+  if (!w->path || !w->npath || !w->Xp || !w->XD || !w->Wp || !w->Xok || !w->fsum ||
+      !w->dpath || !w->dnp || !w->Xd || !w->XDd || !w->Wd || !w->dok) {
     ss_art_work_free(w);
     return NULL;
   }
@@ -739,6 +750,7 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
   }
   memset(w->Yok, 0, (size_t)w->nb);
   memset(w->Xok, 0, (size_t)w->nb);
+  memset(w->dok, 0, (size_t)n);
   return SS_OK;
 }
 
@@ -831,70 +843,130 @@ void ss_art_link_block(const ssModel *m, ssData *d, int b, const double **Y,
  * W_b = L_A^-1 Z_b are formed once per step and link (link_reduced); a
  * pair's block then sums over the dofs the two paths share and the
  * closure rows. */
-static void link_reduced(const ssModel *m, ssArtWork *w, int lb)
+/* A link (six columns, J_b^T = its path's S rows) or a dof k (one column,
+ * e_k) as the factored route sees it: its path dofs, descending, X and X/D
+ * on them (row k at k ncol), and W (nr x ncol) */
+typedef struct Probe {
+  const int *path;
+  int np, ncol;
+  const double *X, *XD, *W;
+} Probe;
+
+/* X = T J^T, X/D and W = L_A^-1 K M'^-1 J^T of a probe whose path starts at
+ * dof top (J's rows: S on the path for a link, e_top for a dof) */
+static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, double *X,
+                   double *XD, double *W)
 {
-  if (w->Xok[lb]) return;
-  int n = w->nv, nr = w->nrow, b = w->b0 + lb;
-  int *path = w->path + (size_t)lb * n, np = 0;
-  double *X = w->Xp + (size_t)lb * n * 6, *XD = w->XD + (size_t)lb * n * 6;
-  /* b's path dofs, descending: the last dof of the nearest body with any,
-   * then its LTDL parents */
-  int a = b;
-  while (a >= 0 && !m->body_ndof[a]) a = m->body_parent[a];
-  if (a >= 0 && m->body_sys[a] == w->sys)
-    for (int k = m->body_dofadr[a] - w->v0 + m->body_ndof[a] - 1; k >= 0; k = w->dof_parent[k])
-      path[np++] = k;
-  w->npath[lb] = np;
-  for (int i = 0; i < np; i++) memcpy(X + 6 * path[i], w->S + 6 * path[i], 6 * sizeof(double));
+  int n = w->nv, nr = w->nrow, np = 0;
+  for (int k = top; k >= 0; k = w->dof_parent[k]) path[np++] = k;
+  *npath = np;
+  for (int i = 0; i < np; i++) {
+    int k = path[i];
+    if (ncol == 6) memcpy(X + 6 * k, w->S + 6 * k, 6 * sizeof(double));
+    else X[k] = k == top;
+  }
   const double *H = w->L;
   for (int i = 0; i < np; i++) {
     int k = path[i];
-    const double *xk = X + 6 * k;
+    const double *xk = X + (size_t)ncol * k;
     for (int j = w->dof_parent[k]; j >= 0; j = w->dof_parent[j])
-      ss_row_add_scaled(X + 6 * j, -H[k * n + j], xk, 6);
+      ss_row_add_scaled(X + (size_t)ncol * j, -H[k * n + j], xk, ncol);
   }
   for (int i = 0; i < np; i++) {
     int k = path[i];
-    for (int c = 0; c < 6; c++) XD[6 * k + c] = X[6 * k + c] / H[k * n + k];
+    for (int c = 0; c < ncol; c++) XD[ncol * k + c] = X[ncol * k + c] / H[k * n + k];
   }
-  if (nr) {
-    double *Wb = w->Wp + (size_t)lb * nr * 6;
-    memset(Wb, 0, 6 * (size_t)nr * sizeof(double));
+  if (!nr) return;
+  if (ncol == 6) {
+    memset(W, 0, 6 * (size_t)nr * sizeof(double));
     for (int i = 0; i < np; i++) {
       int k = path[i];
       const double *Sk = w->S + 6 * k, *Mk = w->MiKT + (size_t)k * nr;
-      for (int r = 0; r < nr; r++) ss_row_add_scaled(Wb + 6 * r, Mk[r], Sk, 6);
+      for (int r = 0; r < nr; r++) ss_row_add_scaled(W + 6 * r, Mk[r], Sk, 6);
     }
-    closure_forward(w, Wb, 6);
+  } else {
+    memcpy(W, w->MiKT + (size_t)top * nr, (size_t)nr * sizeof(double));
   }
-  w->Xok[lb] = 1;
+  closure_forward(w, W, ncol);
+}
+
+static Probe link_probe(const ssModel *m, ssArtWork *w, int b)
+{
+  int lb = b - w->b0, n = w->nv, nr = w->nrow;
+  Probe p = {w->path + (size_t)lb * n, 0, 6, w->Xp + (size_t)lb * n * 6,
+             w->XD + (size_t)lb * n * 6, w->Wp + (size_t)lb * nr * 6};
+  if (!w->Xok[lb]) {
+    /* b's path starts at the last dof of the nearest body with any */
+    int a = b, top = -1;
+    while (a >= 0 && !m->body_ndof[a]) a = m->body_parent[a];
+    if (a >= 0 && m->body_sys[a] == w->sys) top = m->body_dofadr[a] - w->v0 + m->body_ndof[a] - 1;
+    reduce(w, top, 6, w->path + (size_t)lb * n, w->npath + lb, w->Xp + (size_t)lb * n * 6,
+           w->XD + (size_t)lb * n * 6, w->Wp + (size_t)lb * nr * 6);
+    w->Xok[lb] = 1;
+  }
+  p.np = w->npath[lb];
+  return p;
+}
+
+static Probe dof_probe(ssArtWork *w, int k)
+{
+  int n = w->nv, nr = w->nrow;
+  Probe p = {w->dpath + (size_t)k * n, 0, 1, w->Xd + (size_t)k * n, w->XDd + (size_t)k * n,
+             w->Wd + (size_t)k * nr};
+  if (!w->dok[k]) {
+    reduce(w, k, 1, w->dpath + (size_t)k * n, w->dnp + k, w->Xd + (size_t)k * n,
+           w->XDd + (size_t)k * n, w->Wd + (size_t)k * nr);
+    w->dok[k] = 1;
+  }
+  p.np = w->dnp[k];
+  return p;
+}
+
+/* J_a P M'^-1 J_b^T (ca x cb, row i at out + ldo i; ca, cb: a's and b's
+ * column counts, constants at each call so that the row updates unroll) */
+static inline __attribute__((always_inline)) void
+probe_pair(const ssArtWork *w, Probe a, Probe b, int ca, int cb, double *out, int ldo)
+{
+  int i = 0, j = 0, nr = w->nrow;
+  /* the shared part of two paths to the root is the tail of both */
+  while (i < a.np && j < b.np && a.path[i] != b.path[j]) {
+    if (a.path[i] > b.path[j]) i++;
+    else j++;
+  }
+  double acc[36] = {0};
+  for (; i < a.np; i++) {
+    const double *x = a.X + ca * a.path[i], *y = b.XD + cb * a.path[i];
+    for (int r = 0; r < ca; r++) ss_row_add_scaled(acc + cb * r, x[r], y, cb);
+  }
+  for (int k = 0; k < nr; k++)
+    for (int r = 0; r < ca; r++) ss_row_add_scaled(acc + cb * r, -a.W[ca * k + r], b.W + cb * k, cb);
+  for (int r = 0; r < ca; r++) memcpy(out + (size_t)ldo * r, acc + cb * r, cb * sizeof(double));
 }
 
 void ss_art_link_pair(const ssModel *m, ssData *d, int a, int b, double *out, int ldo)
 {
   ssArtWork *w = d->art[m->body_sys[a]];
-  int la = a - w->b0, lb = b - w->b0, n = w->nv, nr = w->nrow;
-  link_reduced(m, w, la);
-  link_reduced(m, w, lb);
-  const int *pa = w->path + (size_t)la * n, *pb = w->path + (size_t)lb * n;
-  int na = w->npath[la], nb = w->npath[lb], i = 0, j = 0;
-  /* the shared part of two paths to the root is the tail of both */
-  while (i < na && j < nb && pa[i] != pb[j]) {
-    if (pa[i] > pb[j]) i++;
-    else j++;
-  }
-  const double *Xa = w->Xp + (size_t)la * n * 6, *XDb = w->XD + (size_t)lb * n * 6;
-  double acc[36] = {0};
-  for (; i < na; i++) {
-    const double *x = Xa + 6 * pa[i], *y = XDb + 6 * pa[i];
-    for (int r = 0; r < 6; r++) ss_row_add_scaled(acc + 6 * r, x[r], y, 6);
-  }
-  if (nr) {
-    const double *Wa = w->Wp + (size_t)la * nr * 6, *Wb = w->Wp + (size_t)lb * nr * 6;
-    for (int k = 0; k < nr; k++)
-      for (int r = 0; r < 6; r++) ss_row_add_scaled(acc + 6 * r, -Wa[6 * k + r], Wb + 6 * k, 6);
-  }
-  for (int r = 0; r < 6; r++) memcpy(out + (size_t)ldo * r, acc + 6 * r, 6 * sizeof(double));
+  probe_pair(w, link_probe(m, w, a), link_probe(m, w, b), 6, 6, out, ldo);
+}
+
+void ss_art_link_dof_pair(const ssModel *m, ssData *d, int b, int dof, double out[6])
+{
+  ssArtWork *w = d->art[m->body_sys[b]];
+  probe_pair(w, link_probe(m, w, b), dof_probe(w, dof - w->v0), 6, 1, out, 1);
+}
+
+double ss_art_dof_pair(ssData *d, int sys, int dof1, int dof2)
+{
+  ssArtWork *w = d->art[sys];
+  double g;
+  probe_pair(w, dof_probe(w, dof1 - w->v0), dof_probe(w, dof2 - w->v0), 1, 1, &g, 1);
+  return g;
+}
+
+void ss_art_dof_force_add(ssData *d, int sys, int dof, double f)
+{
+  ssArtWork *w = d->art[sys];
+  w->fsum[dof - w->v0] += f;
 }
 
 void ss_art_force_add(const ssModel *m, ssData *d, int b, const double F[6])
@@ -939,22 +1011,27 @@ void ss_art_contact_response(const ssModel *m, ssData *d, int b,
     for (int j = 0; j < 3; j++) G[3 * i + j] = dot6(X + 6 * i, LX + 6 * j);
 }
 
-void ss_art_dof_jacobian(const ssModel *m, ssData *d, int s, int dof,
-                         double *J, double *W, double G[9])
+void ss_art_dof_row(ssData *d, int s, int dof, double sign, double *J, double G[9])
+{
+  ssArtWork *w = d->art[s];
+  int n = w->nv;
+  memset(J, 0, 3 * (size_t)n * sizeof(double));
+  J[dof - w->v0] = sign;
+  memset(G, 0, 9 * sizeof(double));
+  G[0] = ss_art_dof_pair(d, s, dof, dof);
+}
+
+void ss_art_dof_response(ssData *d, int s, int dof, double sign, double *W)
 {
   ssArtWork *w = d->art[s];
   int n = w->nv, k = dof - w->v0;
-  memset(J, 0, 3 * (size_t)n * sizeof(double));
-  J[k] = 1;
   double *col = w->x;
   memset(col, 0, (size_t)n * sizeof(double));
   col[k] = 1;
   ltdl_solve(w, col, 1);
   project(w, col);
   memset(W, 0, 3 * (size_t)n * sizeof(double));
-  for (int i = 0; i < n; i++) W[3 * i] = col[i];
-  memset(G, 0, 9 * sizeof(double));
-  G[0] = col[k];
+  for (int i = 0; i < n; i++) W[3 * i] = sign * col[i];
 }
 
 void ss_art_link_velocity(const ssModel *m, const ssData *d, int b,
@@ -1481,7 +1558,7 @@ ssStatus ss_art_rows(const ssModel *m, ssData *d, ssError *err)
     c->row_a = dt * (g[0] * (t[0] - q) + g[1] * t[1]);
     c->row_b = dt * (g[1] + dt * g[0]);
     c->row_bound = g[2] > 0 ? g[2] * dt : INFINITY;
-    ss_art_dof_jacobian(m, d, s, dof, d->jac + c->jadr, d->jac + c->jadr + 3 * nv, c->G);
+    ss_art_dof_row(d, s, dof, 1, d->jac + c->jadr, c->G);
   }
   for (int b = 0; b < m->nbody; b++) {
     int s = m->body_sys[b];
@@ -1507,14 +1584,7 @@ ssStatus ss_art_rows(const ssModel *m, ssData *d, ssError *err)
       c->dof = m->body_dofadr[b];
       c->g0 = gap;
       c->vn_target = gap >= 0 ? -gap / dt : -m->opt.rigid_erp * gap / dt;
-      double *J = d->jac + c->jadr, *W = J + 3 * nv;
-      ss_art_dof_jacobian(m, d, s, c->dof, J, W, c->G);
-      if (side == 1) {
-        for (int i = 0; i < nv; i++) {
-          J[i] = -J[i];
-          W[3 * i] = -W[3 * i];
-        }
-      }
+      ss_art_dof_row(d, s, c->dof, side == 1 ? -1 : 1, d->jac + c->jadr, c->G);
     }
   }
   return SS_OK;

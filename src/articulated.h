@@ -110,9 +110,19 @@ void ss_art_contact_rows(const double p[3], const double frame[9], double X[18])
  * them: the solver forms them when sweeps follow the Newton phase. */
 void ss_art_contact_response(const ssModel *m, ssData *d, int b,
                              const double X[18], double LX[18], double G[9]);
-/* Row of one degree of freedom (PD, limits): J = e_k, W = P M'^-1 e_k. */
-void ss_art_dof_jacobian(const ssModel *m, ssData *d, int sys, int dof,
-                         double *J, double *W, double G[9]);
+/* Row of one degree of freedom (PD, limits): J = sign e_k (3 nv, the rows
+ * after the first zero) and G = J P M'^-1 J^T (its first entry; from the
+ * factors).  Its response W = P M'^-1 J^T (nv x 3, the columns after the
+ * first zero) is formed apart, only where the sweeps or an applied warm
+ * start need it (ss_art_dof_response). */
+void ss_art_dof_row(ssData *d, int sys, int dof, double sign, double *J, double G[9]);
+void ss_art_dof_response(ssData *d, int sys, int dof, double sign, double *W);
+/* The factored route for joint rows (see ss_art_link_pair): J_b P M'^-1 e_dof
+ * (6), e_dof1^T P M'^-1 e_dof2, and an impulse f along dof added to the
+ * sum that ss_art_force_apply applies. */
+void ss_art_link_dof_pair(const ssModel *m, ssData *d, int b, int dof, double out[6]);
+double ss_art_dof_pair(ssData *d, int sys, int dof1, int dof2);
+void ss_art_dof_force_add(ssData *d, int sys, int dof, double f);
 /* Velocity of a world point on body b. */
 void ss_art_point_velocity(const ssModel *m, const ssData *d, int b,
                            const double p[3], double v[3]);

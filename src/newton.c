@@ -1155,87 +1155,58 @@ static int switch_all(ssNewtonWork *w, const Setup *s)
 /* ---------------------------------------------------------------------- */
 /* set-up                                                                  */
 
-/* Lam = J P M'^-1 J^T over the unknowns.  Links' blocks from the factors
- * (ss_art_link_pair), one per pair, mirrored; a free body's from its Y
- * (body_block); each row's column from its W, read by every unknown of
- * the same system through its J, and its entries in the links' columns
- * mirrored from there. */
+/* Lam = J P M'^-1 J^T over the unknowns, symmetric: each pair of links of
+ * a system and each pair of a link or row with a joint row from the
+ * factors (ss_art_link_pair, ss_art_link_dof_pair, ss_art_dof_pair),
+ * formed once and mirrored; a free body's block from its Y (body_block:
+ * nothing else shares its system). */
 static void lam_matrix(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork *w)
 {
-  int n = s->n;
+  int n = s->n, ng = s->ngroup;
   memset(w->Lam, 0, (size_t)n * n * sizeof(double));
-  for (int gc = 0; gc < s->ngroup + s->nrow; gc++) {
-    const double *Y;
-    int sys, vadr, nv, ncol, col0, stride;
-    if (gc < s->ngroup && w->grp[gc].link >= 0) {
-      /* a link's column block: its pairs with the links of its system from
-       * the factors (ss_art_link_pair), each formed once and mirrored (Lam
-       * = J P M'^-1 J^T is symmetric); its rows' entries are mirrored from
-       * the rows' columns below */
-      const NGroup *Gc = w->grp + gc;
-      for (int gr = 0; gr <= gc; gr++) {
-        const NGroup *G = w->grp + gr;
-        if (G->sys != Gc->sys) continue;
-        double *out = w->Lam + (size_t)(6 * gr) * n + 6 * gc;
-        ss_art_link_pair(m, d, G->link, Gc->link, out, n);
-        if (gr == gc) continue;
-        for (int a = 0; a < 6; a++)
-          for (int b = 0; b < 6; b++)
-            w->Lam[(size_t)(6 * gc + b) * n + 6 * gr + a] = out[(size_t)a * n + b];
+  for (int gc = 0; gc < ng; gc++) {
+    const NGroup *Gc = w->grp + gc;
+    if (Gc->link < 0) {
+      double *out = w->Lam + (size_t)(6 * gc) * n + 6 * gc;
+      for (int k = 0; k < 6; k++) {
+        double V[6];
+        for (int i = 0; i < 6; i++) w->col[i] = Gc->Yb[6 * i + k];
+        group_motion(m, d, Gc, w->col, V);
+        for (int a = 0; a < 6; a++) out[(size_t)a * n + k] = V[a];
       }
       continue;
     }
-    if (gc < s->ngroup) {
-      Y = group_block(m, d, w->grp + gc);
-      sys = w->grp[gc].sys;
-      vadr = m->sys_vadr[sys];
-      nv = m->sys_nv[sys];
-      ncol = 6;
-      col0 = 6 * gc;
-      stride = 6;
-    } else {
-      const ssContact *c = d->contact + s->first_row + (gc - s->ngroup);
-      Y = d->jac + c->jadr + 3 * c->nv;
-      sys = c->sys;
-      vadr = c->vadr;
-      nv = c->nv;
-      ncol = 1;
-      col0 = 6 * s->ngroup + (gc - s->ngroup);
-      stride = 3;
-    }
-    for (int gr = 0; gr < s->ngroup; gr++) {
+    for (int gr = 0; gr <= gc; gr++) {
       const NGroup *G = w->grp + gr;
-      if (G->sys != sys) continue;
-      double *out = w->Lam + (size_t)(6 * gr) * n + col0;
-      if (G->link >= 0) {
-        /* a link's block at once (the group_motion of each column, bit
-         * for bit), straight from Y's rows on the link's path */
-        ss_art_link_motion_cols(m, d, G->link, Y, stride, ncol, out, n);
-        continue;
-      }
-      for (int k = 0; k < ncol; k++) {
-        double V[6];
-        for (int i = 0; i < nv; i++) w->col[i] = Y[stride * i + k];
-        group_motion(m, d, G, w->col, V);
-        for (int a = 0; a < 6; a++) out[(size_t)a * n + k] = V[a];
-      }
+      if (G->sys != Gc->sys || G->link < 0) continue;
+      double *out = w->Lam + (size_t)(6 * gr) * n + 6 * gc;
+      ss_art_link_pair(m, d, G->link, Gc->link, out, n);
+      if (gr == gc) continue;
+      for (int a = 0; a < 6; a++)
+        for (int b = 0; b < 6; b++)
+          w->Lam[(size_t)(6 * gc + b) * n + 6 * gr + a] = out[(size_t)a * n + b];
     }
-    for (int r = 0; r < s->nrow; r++) {
-      const ssContact *c = d->contact + s->first_row + r;
-      if (c->sys != sys) continue;
-      int dof = c->dof - vadr;
-      for (int k = 0; k < ncol; k++)
-        w->Lam[(size_t)(6 * s->ngroup + r) * n + col0 + k] =
-            d->jac[c->jadr + dof] * Y[stride * dof + k];
+  }
+  /* a joint row's J is sign e_dof (sign +-1: exact) */
+  for (int r = 0; r < s->nrow; r++) {
+    const ssContact *c = d->contact + s->first_row + r;
+    int rr = 6 * ng + r;
+    double sr = d->jac[c->jadr + (c->dof - c->vadr)];
+    for (int g = 0; g < ng; g++) {
+      const NGroup *G = w->grp + g;
+      if (G->sys != c->sys || G->link < 0) continue;
+      double v[6];
+      ss_art_link_dof_pair(m, d, G->link, c->dof, v);
+      for (int a = 0; a < 6; a++)
+        w->Lam[(size_t)(6 * g + a) * n + rr] = w->Lam[(size_t)rr * n + 6 * g + a] = sr * v[a];
     }
-    if (gc >= s->ngroup) {
-      /* the row's entries in the links' columns: J_r Y_b = (J_b W_r)^T */
-      int rr = 6 * s->ngroup + (gc - s->ngroup);
-      for (int gr = 0; gr < s->ngroup; gr++) {
-        if (w->grp[gr].sys != sys || w->grp[gr].link < 0) continue;
-        for (int a = 0; a < 6; a++)
-          w->Lam[(size_t)rr * n + 6 * gr + a] = w->Lam[(size_t)(6 * gr + a) * n + rr];
-      }
+    for (int q = 0; q <= r; q++) {
+      const ssContact *e = d->contact + s->first_row + q;
+      if (e->sys != c->sys) continue;
+      int qq = 6 * ng + q;
+      double sq = d->jac[e->jadr + (e->dof - e->vadr)];
+      w->Lam[(size_t)qq * n + rr] = w->Lam[(size_t)rr * n + qq] =
+          sr * sq * ss_art_dof_pair(d, c->sys, e->dof, c->dof);
     }
   }
 }
@@ -1252,9 +1223,18 @@ static void unknowns_of(const ssModel *m, const ssData *d, const Setup *s,
   }
 }
 
+/* the articulated system of group or row k (the rows after the groups),
+ * or -1 for a free body's group */
+static int art_sys(const ssData *d, const Setup *s, const ssNewtonWork *w, int k)
+{
+  if (k >= s->ngroup) return d->contact[s->first_row + k - s->ngroup].sys;
+  return w->grp[k].link >= 0 ? w->grp[k].sys : -1;
+}
+
 /* the impulses at y into the contacts, and the velocities they give:
- * u = u_free + P M'^-1 sum J_b^T F_b (links: ss_art_force_apply, one solve
- * per system) + sum Y_b F_b (free bodies) + sum W_r lambda_r */
+ * u = u_free + P M'^-1 (sum J_b^T F_b + sum J_r^T lambda_r) (links and
+ * joint rows: ss_art_force_apply, one solve per system) + sum Y_b F_b
+ * (free bodies) */
 static void apply_at(const ssModel *m, ssData *d, const Setup *s, const ssNewtonWork *w,
                      const double *lam, const double *F)
 {
@@ -1262,17 +1242,21 @@ static void apply_at(const ssModel *m, ssData *d, const Setup *s, const ssNewton
   for (int i = 0; i < s->first_row; i++)
     memcpy(d->contact[i].lambda, lam + 3 * i, 3 * sizeof(double));
   memcpy(d->qvel, d->qvel_free, (size_t)m->nv * sizeof(double));
-  /* the links' impulses, a system at a time: summed on their paths, then
-   * one solve (ss_art_force_apply) */
-  for (int g = 0; g < s->ngroup; g++) {
-    const NGroup *G = w->grp + g;
-    if (G->link < 0) continue;
-    int first = 1;
-    for (int e = 0; e < g && first; e++) first = w->grp[e].link < 0 || w->grp[e].sys != G->sys;
-    if (!first) continue;
-    for (int e = g; e < s->ngroup; e++)
-      if (w->grp[e].link >= 0 && w->grp[e].sys == G->sys) ss_art_force_add(m, d, w->grp[e].link, F + 6 * e);
-    ss_art_force_apply(m, d, G->sys, d->qvel + m->sys_vadr[G->sys]);
+  /* the links' and joint rows' impulses, summed on their paths, then one
+   * solve a system (ss_art_force_apply) */
+  int nr = s->nrow;
+  for (int g = 0; g < s->ngroup; g++)
+    if (w->grp[g].link >= 0) ss_art_force_add(m, d, w->grp[g].link, F + 6 * g);
+  for (int r = 0; r < nr; r++) {
+    ssContact *c = d->contact + s->first_row + r;
+    double l = F[6 * s->ngroup + r];
+    c->lambda[0] = l;
+    ss_art_dof_force_add(d, c->sys, c->dof, d->jac[c->jadr + (c->dof - c->vadr)] * l);
+  }
+  for (int k = 0; k < s->ngroup + nr; k++) {
+    int sys = art_sys(d, s, w, k), first = sys >= 0;
+    for (int e = 0; e < k && first; e++) first = art_sys(d, s, w, e) != sys;
+    if (first) ss_art_force_apply(m, d, sys, d->qvel + m->sys_vadr[sys]);
   }
   for (int g = 0; g < s->ngroup; g++) {
     if (w->grp[g].link >= 0) continue;
@@ -1284,13 +1268,6 @@ static void apply_at(const ssModel *m, ssData *d, const Setup *s, const ssNewton
       u[k] += yk[0] * Fg[0] + yk[1] * Fg[1] + yk[2] * Fg[2] + yk[3] * Fg[3] + yk[4] * Fg[4] +
               yk[5] * Fg[5];
     }
-  }
-  for (int r = 0; r < s->nrow; r++) {
-    ssContact *c = d->contact + s->first_row + r;
-    const double *W = d->jac + c->jadr + 3 * c->nv;
-    double *u = d->qvel + c->vadr, l = F[6 * s->ngroup + r];
-    c->lambda[0] = l;
-    for (int k = 0; k < c->nv; k++) u[k] += W[3 * k] * l;
   }
 }
 

@@ -154,22 +154,34 @@ contact_velocity(const ssModel *m, const ssData *d, const ssContact *c, double v
 /* A joint row (PD, limit) has one row: J's first row and W's first column
  * (the other two are zero), so its visit reads and moves only that one;
  * that row is +-1 at the joint's dof and zero elsewhere
- * (ss_art_dof_jacobian), so J u is one product. */
+ * (ss_art_dof_row), so J u is one product. */
 static double row_velocity(const ssData *d, const ssContact *c)
 {
   int k = c->dof - c->vadr;
   return d->jac[c->jadr + k] * d->qvel[c->dof];
 }
 
-static void row_apply(ssData *d, const ssContact *c, double dl)
+/* a joint row's W, formed at its first use in the step (ss_art_dof_row
+ * leaves it out: the Newton phase does not need it) */
+static const double *row_response(ssData *d, ssContact *c)
 {
-  const double *W = d->jac + c->jadr + 3 * c->nv;
+  double *W = d->jac + c->jadr + 3 * c->nv;
+  if (!c->w_ready) {
+    ss_art_dof_response(d, c->sys, c->dof, d->jac[c->jadr + (c->dof - c->vadr)], W);
+    c->w_ready = 1;
+  }
+  return W;
+}
+
+static void row_apply(ssData *d, ssContact *c, double dl)
+{
+  const double *W = row_response(d, c);
   double *u = d->qvel + c->vadr;
   for (int i = 0; i < c->nv; i++) u[i] += W[3 * i] * dl;
 }
 
 /* u += W dl, the full velocity update of one contact */
-static void apply_impulse(const ssModel *m, ssData *d, const ssContact *c,
+static void apply_impulse(const ssModel *m, ssData *d, ssContact *c,
                           const double dl[3])
 {
   if (c->link >= 0) {
@@ -180,7 +192,9 @@ static void apply_impulse(const ssModel *m, ssData *d, const ssContact *c,
     link_apply(d, c, Y, w);
     return;
   }
-  const double *W = d->jac + c->jadr + 3 * c->nv;
+  const double *W = c->type == SS_CONTACT_PD || c->type == SS_CONTACT_LIMIT
+                         ? row_response(d, c)
+                         : d->jac + c->jadr + 3 * c->nv;
   double *u = d->qvel + c->vadr;
   if (c->nv == 6) {
     for (int i = 0; i < 6; i++)

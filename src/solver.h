@@ -58,6 +58,8 @@ struct ssContact {
                         so that this step's change can be formed */
   int cache_ready;   /* soil: cache holds a set-up law (ss_point_setup); 0:
                         empty, whatever its bytes */
+  int w_ready;       /* joint row: its W formed (ss_art_dof_response, at
+                        its first use); 0: not yet */
   /* From here on ss_contact_new leaves the fields as they were (it zeroes
    * those above): each is written before it is read.  pos and frame: by
    * the soil and rigid contacts' creators, and read only for those

@@ -824,6 +824,16 @@ static void test_link_pair(void)
       F[i] = (double)(r >> 11) / 9007199254740992.0 - 0.5;
     }
     ss_art_force_add(m, d, b, F);
+    /* and an impulse along the link's own dofs, as a joint row's */
+    if (m->body_ndof[b]) {
+      int dof = m->body_dofadr[b];
+      double W[3 * 64];
+      if (nv <= 64) {
+        ss_art_dof_force_add(d, s, dof, F[0]);
+        ss_art_dof_response(d, s, dof, 1, W);
+        for (int k = 0; k < nv; k++) u2[k] += W[3 * k] * F[0];
+      }
+    }
     const double *Yb, *Lam;
     ss_art_link_block(m, d, b, &Yb, &Lam);
     for (int k = 0; k < nv; k++)
@@ -836,12 +846,40 @@ static void test_link_pair(void)
       ubig = fmax(ubig, fabs(u2[k]));
     }
   }
+  /* the joint rows' entries: each dof against the full response column */
+  double rworst = 0, rbig = 0;
+  int rows = 0;
+  double *W = malloc((size_t)nv * 3 * sizeof *W);
+  for (int k = 0; good && W && k < nv; k++) {
+    int dof = m->sys_vadr[s] + k;
+    ss_art_dof_response(d, s, dof, 1, W);
+    for (int k2 = 0; k2 < nv; k2++) {
+      double g = ss_art_dof_pair(d, s, m->sys_vadr[s] + k2, dof);
+      rworst = fmax(rworst, fabs(g - W[3 * k2]));
+      rbig = fmax(rbig, fabs(W[3 * k2]));
+    }
+    for (int b = b0; b < b0 + nb; b++) {
+      double P[6], Q[6];
+      ss_art_link_dof_pair(m, d, b, dof, P);
+      ss_art_link_motion_cols(m, d, b, W, 3, 1, Q, 1);
+      for (int i = 0; i < 6; i++) {
+        rworst = fmax(rworst, fabs(P[i] - Q[i]));
+        rbig = fmax(rbig, fabs(Q[i]));
+      }
+    }
+    rows++;
+  }
+  free(W);
+  ok(good && rows == nv && rbig > 0 && rworst <= 1e-12 * rbig,
+     "joint rows from the factors: e_j P M'^-1 e_k and J_b P M'^-1 e_k for all %d dofs "
+     "against the response columns to %.1e of the largest entry",
+     rows, rbig > 0 ? rworst / rbig : 0);
   ok(good && pairs == nb * nb && big > 0 && worst <= 1e-12 * big,
      "link pairs from the factors: J_a Y_b of all %d pairs of the buggy's links "
      "to %.1e of the largest entry", pairs, big > 0 ? worst / big : 0);
   ok(good && u1 && u2 && ubig > 0 && uworst <= 1e-12 * ubig,
-     "impulses on all links applied by one solve: sum Y_b F_b to %.1e of the "
-     "largest velocity", ubig > 0 ? uworst / ubig : 0);
+     "impulses on all links and dofs applied by one solve: sum Y_b F_b + W_k f_k "
+     "to %.1e of the largest velocity", ubig > 0 ? uworst / ubig : 0);
   free(u1);
   free(u2);
   ss_data_free(d);
