@@ -37,16 +37,18 @@ struct ssArtWork {
   unsigned char *Yok;    /* (nb) Y_b valid for this step */
   /* the Newton phase's factored route to the same responses
    * (ss_art_link_pair): b's path dofs, descending, and on them X_b = T J_b^T
-   * and X_b / D (M'^-1 = T^T D^-1 T, T the LTDL's first sweep), and
-   * W_b = L_A^-1 K M'^-1 J_b^T (nr x 6, A = L_A L_A^T) */
+   * and X_b / D (M'^-1 = T^T D^-1 T, T = L^-T the tree solve's first
+   * sweep), and W_b = L_A^-1 K M'^-1 J_b^T (nr x 6, A = L_A L_A^T) */
   int *path, *npath;     /* (nb x nv), (nb) */
   double *Xp, *XD;       /* (nb x nv x 6), rows on the path */
   double *Wp;            /* (nb x nr x 6) */
   unsigned char *Xok;    /* (nb) valid for this step */
   double *fsum;          /* (nv) sum of J_b^T F_b (ss_art_force_add) */
-  int *dpath, *dnp;      /* the same for single dofs (a joint row's e_k): */
-  double *Xd, *XDd, *Wd; /* (nv x nv), (nv), (nv x nv) twice, (nv x nr) */
-  unsigned char *dok;    /* (nv) */
+  /* the same for single dofs (a joint row's e_k): dpath, Xd and XDd (nv x
+   * nv), dnp and dok (nv), Wd (nv x nr) */
+  int *dpath, *dnp;
+  double *Xd, *XDd, *Wd;
+  unsigned char *dok;
   int rank_deficient;    /* rows dropped in the last factorization */
 };
 
@@ -834,21 +836,24 @@ void ss_art_link_block(const ssModel *m, ssData *d, int b, const double **Y,
   *Lam = w->Lam + 36 * lb;
 }
 
-/* The Newton phase's route to the links' responses, which never forms
- * Y_b (nv x 6, its L^-1 sweep fills the whole tree):
+/* The Newton phase's route to the links' and joint rows' responses, which
+ * never forms Y_b (nv x 6, whose sweep away from the root fills the whole
+ * tree):
  *   J_a P M'^-1 J_b^T = (T J_a^T)^T D^-1 (T J_b^T) - (L_A^-1 Z_a)^T (L_A^-1 Z_b)
- * with M' = T^T D T-style LTDL factors (ltdl_solve: T its first sweep,
- * towards the root, which keeps J_b^T on b's path), Z_b = K M'^-1 J_b^T =
- * (J_b MiKT)^T and A = L_A L_A^T (dropped rows give 0).  X_b = T J_b^T and
- * W_b = L_A^-1 Z_b are formed once per step and link (link_reduced); a
+ * with the tree factors M' = L^T D L (ltdl_factor), T = L^-T the solve's
+ * first sweep (ltdl_solve), towards the root, which keeps J_b^T on b's
+ * path, so M'^-1 = T^T D^-1 T; Z_b = K M'^-1 J_b^T = (J_b MiKT)^T and
+ * A = L_A L_A^T (dropped rows give 0).  X_b = T J_b^T and W_b = L_A^-1 Z_b
+ * are formed once per step and link or dof (link_probe, dof_probe); a
  * pair's block then sums over the dofs the two paths share and the
- * closure rows. */
+ * closure rows (probe_pair). */
+
 /* A link (six columns, J_b^T = its path's S rows) or a dof k (one column,
  * e_k) as the factored route sees it: its path dofs, descending, X and X/D
- * on them (row k at k ncol), and W (nr x ncol) */
+ * on them (row k at k ncol, ncol its columns), and W (nr x ncol) */
 typedef struct Probe {
   const int *path;
-  int np, ncol;
+  int np;
   const double *X, *XD, *W;
 } Probe;
 
@@ -893,7 +898,7 @@ static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, doubl
 static Probe link_probe(const ssModel *m, ssArtWork *w, int b)
 {
   int lb = b - w->b0, n = w->nv, nr = w->nrow;
-  Probe p = {w->path + (size_t)lb * n, 0, 6, w->Xp + (size_t)lb * n * 6,
+  Probe p = {w->path + (size_t)lb * n, 0, w->Xp + (size_t)lb * n * 6,
              w->XD + (size_t)lb * n * 6, w->Wp + (size_t)lb * nr * 6};
   if (!w->Xok[lb]) {
     /* b's path starts at the last dof of the nearest body with any */
@@ -911,7 +916,7 @@ static Probe link_probe(const ssModel *m, ssArtWork *w, int b)
 static Probe dof_probe(ssArtWork *w, int k)
 {
   int n = w->nv, nr = w->nrow;
-  Probe p = {w->dpath + (size_t)k * n, 0, 1, w->Xd + (size_t)k * n, w->XDd + (size_t)k * n,
+  Probe p = {w->dpath + (size_t)k * n, 0, w->Xd + (size_t)k * n, w->XDd + (size_t)k * n,
              w->Wd + (size_t)k * nr};
   if (!w->dok[k]) {
     reduce(w, k, 1, w->dpath + (size_t)k * n, w->dnp + k, w->Xd + (size_t)k * n,

@@ -379,15 +379,6 @@ static void body_block(const ssModel *m, const ssData *d, int b, double Y[36])
   }
 }
 
-/* the group's response Y (nv x 6, rows of its system's velocities) */
-static const double *group_block(const ssModel *m, ssData *d, const NGroup *G)
-{
-  if (G->link < 0) return G->Yb;
-  const double *Y, *Lb;
-  ss_art_link_block(m, d, G->link, &Y, &Lb);
-  return Y;
-}
-
 /* A link's or body's response to the group's points in the group's frame,
  * Lam' = T Lam T^T (y' = T y, F = T^T F'), for the stick test: a point at
  * r has tangential rows x_1 = (r x e_1; e_1), x_2 = (r x e_2; e_2) there,
@@ -1260,7 +1251,7 @@ static void apply_at(const ssModel *m, ssData *d, const Setup *s, const ssNewton
   }
   for (int g = 0; g < s->ngroup; g++) {
     if (w->grp[g].link >= 0) continue;
-    const double *Y = group_block(m, d, w->grp + g), *Fg = F + 6 * g;
+    const double *Y = w->grp[g].Yb, *Fg = F + 6 * g;
     int sys = w->grp[g].sys;
     double *u = d->qvel + m->sys_vadr[sys];
     for (int k = 0; k < m->sys_nv[sys]; k++) {
