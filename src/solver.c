@@ -13,6 +13,7 @@
 #include "sort_runs.h"
 #include "ss_math.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -37,40 +38,40 @@ static void limit_row(ssContact *c, const double v0[3])
   c->lambda[0] = l > 0 ? l : 0;
 }
 
-/* the zeroed head of a new contact is copied from here: GCC lowers a
- * memset of its 176 bytes to `rep stos`, whose start-up costs about three
- * times the eleven loads and stores of this copy (10 ns a contact on the
- * benchmark machine, some 7 % of a settled plate point's step) */
-static const ssContact contact_zero;
+/* the zeroed head of a new contact is copied from here (ss_contact_add):
+ * GCC lowers a memset of its 176 bytes to `rep stos`, whose start-up costs
+ * about three times the eleven loads and stores of this copy (10 ns a
+ * contact on the benchmark machine, some 7 % of a settled plate point's
+ * step) */
+const ssContact ss_contact_zero;
 
-ssContact *ss_contact_new(ssData *d, long njac)
+int ss_contact_reserve(ssData *d, int count, long njac)
 {
-  if (d->ncontact == d->cap_contact) {
-    int c = d->cap_contact ? 2 * d->cap_contact : 256;
+  if (count <= 0) return 1;
+  if (d->ncontact > d->cap_contact - count) {
+    if (count > INT_MAX / 2 - d->ncontact) return 0;
+    int c = d->cap_contact ? d->cap_contact : 256;
+    while (c < d->ncontact + count) c *= 2;
     ssContact *p = realloc(d->contact, (size_t)c * sizeof *p);
-    if (!p) return NULL;
+    if (!p) return 0;
     d->contact = p;
     d->cap_contact = c;
   }
-  ssContact *c = d->contact + d->ncontact;
-  long jadr = d->ncontact ? d->contact[d->ncontact - 1].jadr +
-                                d->contact[d->ncontact - 1].jlen
-                          : 0;
-  size_t need = (size_t)jadr + (size_t)njac;
+  size_t need = (size_t)ss_contact_jac_end(d) + (size_t)count * (size_t)njac;
   if (need > d->cap_jac) {
     size_t cap = d->cap_jac ? 2 * d->cap_jac : 4096;
     while (cap < need) cap *= 2;
     double *q = realloc(d->jac, cap * sizeof(double));
-    if (!q) return NULL;
+    if (!q) return 0;
     d->jac = q;
     d->cap_jac = cap;
   }
-  memcpy(c, &contact_zero, offsetof(ssContact, pos));
-  c->link = -1;
-  c->jadr = jadr;
-  c->jlen = njac;
-  d->ncontact++;
-  return c;
+  return 1;
+}
+
+ssContact *ss_contact_new(ssData *d, long njac)
+{
+  return ss_contact_reserve(d, 1, njac) ? ss_contact_add(d, njac) : NULL;
 }
 
 /* ---------------------------------------------------------------------- */

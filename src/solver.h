@@ -21,6 +21,9 @@
 #include "soilsim.h"
 #include "point.h"
 
+#include <stddef.h>
+#include <string.h>
+
 typedef enum ssContactType {
   SS_CONTACT_SOIL = 0, /* one soil quadrature point (DESIGN 3.1) */
   SS_CONTACT_RIGID,    /* Coulomb cone with restitution */
@@ -112,6 +115,27 @@ int ss_solver_warm_cmp(const ssWarmEntry *a, const ssWarmEntry *b);
  * with njac doubles of Jacobian storage in d->jac (6 nv for J and W, 36
  * for a link contact's X and LX); NULL when out of memory. */
 ssContact *ss_contact_new(ssData *d, long njac);
+/* The same in two parts, for a loop that makes many: room for count more
+ * contacts of njac doubles each (0 when out of memory), then each one
+ * taken without a check (ss_contact_add, at most count of them). */
+int ss_contact_reserve(ssData *d, int count, long njac);
+extern const ssContact ss_contact_zero;
+/* end of the Jacobian storage in use */
+static inline long ss_contact_jac_end(const ssData *d)
+{
+  return d->ncontact ? d->contact[d->ncontact - 1].jadr + d->contact[d->ncontact - 1].jlen : 0;
+}
+static inline ssContact *ss_contact_add(ssData *d, long njac)
+{
+  ssContact *c = d->contact + d->ncontact;
+  long jadr = ss_contact_jac_end(d);
+  memcpy(c, &ss_contact_zero, offsetof(ssContact, pos));
+  c->link = -1;
+  c->jadr = jadr;
+  c->jlen = njac;
+  d->ncontact++;
+  return c;
+}
 
 /* Solve all contacts in d->contact; d->qvel holds the free velocity on entry
  * and the end-of-step velocity on return.  Fills d->stats.  The warm-start

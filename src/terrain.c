@@ -219,6 +219,9 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       in1 = fmin(a1, b1) - 1e-9 * dx;
     }
     int band_ready = 0;
+    /* room for the row's points at once (ss_contact_add below) */
+    if (!ss_contact_reserve(d, i1 - i0 + 1, njac))
+      return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
     for (int i = i0; i <= i1; i++) {
       double x = x0 + i * dx;
       double cx0 = i == 0 ? x : x - 0.5 * dx, cx1 = i == nx - 1 ? x : x + 0.5 * dx;
@@ -249,8 +252,7 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       double floor_z = z0[k] - sp[k];
       double g0 = zl - floor_z;
       if (g0 > margin) continue;
-      ssContact *c = ss_contact_new(d, njac);
-      if (!c) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
+      ssContact *c = ss_contact_add(d, njac);
       c->type = SS_CONTACT_SOIL;
       c->geom = g;
       c->hfield = h;

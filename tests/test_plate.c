@@ -6,6 +6,7 @@
 #include "tap.h"
 #include "worlds.h"
 
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -358,6 +359,44 @@ static void test_reach(void)
     ss_data_free(d);
     ss_model_free(m);
   }
+}
+
+/* Contact storage: room for a row of points at once (ss_contact_reserve),
+ * then each taken without a check (ss_contact_add): the Jacobian blocks
+ * follow one another, every new contact's head is zeroed over whatever
+ * the array held, and a request that cannot be met is refused with the
+ * contacts as they were. */
+static void test_contact_storage(void)
+{
+  ssModel *m;
+  ssData *d;
+  ssError e;
+  if (!plate_world(11, 1.0, 0, 0, NULL, &m, &d, &e)) {
+    ok(0, "plate world: %s", e.message);
+    return;
+  }
+  int good = ss_contact_reserve(d, 700, 36) && d->cap_contact >= 700;
+  if (good) memset(d->contact, 0xa5, (size_t)d->cap_contact * sizeof *d->contact);
+  d->ncontact = 0;
+  for (int round = 0; good && round < 3; round++) {
+    good = ss_contact_reserve(d, 300, 36);
+    for (int k = 0; good && k < 300; k++) {
+      int n = d->ncontact;
+      ssContact *c = ss_contact_add(d, 36);
+      good = c == d->contact + n && c->jadr == 36L * n && c->jlen == 36 && c->link == -1 &&
+             c->lambda[0] == 0 && c->lambda[2] == 0 && c->cache_ready == 0 &&
+             c->w_ready == 0 && c->type == 0;
+    }
+  }
+  int n = d->ncontact;
+  const ssContact *before = d->contact;
+  int refused = !ss_contact_reserve(d, INT_MAX, 36) && d->ncontact == n && d->contact == before;
+  ok(good && n == 900 && d->cap_jac >= 900 * 36 && refused,
+     "contact storage: 900 contacts in rows of 300, Jacobian blocks in order and "
+     "heads zeroed; an impossible request refused, the contacts kept");
+  d->ncontact = 0;
+  ss_data_free(d);
+  ss_model_free(m);
 }
 
 /* rigid ground: rest, friction and restitution from the material pairs */
@@ -818,6 +857,7 @@ int main(void)
   test_drag();
   test_rigid();
   test_reach();
+  test_contact_storage();
   test_warm_trend();
   test_newton();
   test_settled_cache();
