@@ -1055,28 +1055,7 @@ void ss_art_link_motion_cols(const ssModel *m, const ssData *d, int b, const dou
                              int ldu, int ncol, double *out, int ldo)
 {
   const ssArtWork *w = d->art[m->body_sys[b]];
-  /* two columns at a time, their six sums in registers (SSE2 pairs, the
-   * same products and sums as the scalar loop for the last odd one) */
-  int c = 0;
-  for (; c + 2 <= ncol; c += 2) {
-    ssV2 acc[6] = {{0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}};
-    for (int a = b; a >= 0; a = m->body_parent[a]) {
-      int nd = m->body_ndof[a];
-      if (!nd) continue;
-      int k0 = m->body_dofadr[a] - w->v0;
-      for (int k = k0; k < k0 + nd; k++) {
-        ssV2 u;
-        memcpy(&u, U + (size_t)ldu * k + c, sizeof u);
-        const double *S = w->S + 6 * k;
-        for (int i = 0; i < 6; i++) {
-          ssV2 sv = {S[i], S[i]};
-          acc[i] += sv * u;
-        }
-      }
-    }
-    for (int i = 0; i < 6; i++) memcpy(out + (size_t)ldo * i + c, &acc[i], sizeof acc[i]);
-  }
-  for (; c < ncol; c++) {
+  for (int c = 0; c < ncol; c++) {
     double V[6] = {0, 0, 0, 0, 0, 0};
     for (int a = b; a >= 0; a = m->body_parent[a]) {
       int nd = m->body_ndof[a];

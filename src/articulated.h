@@ -94,9 +94,8 @@ void ss_art_link_velocity(const ssModel *m, const ssData *d, int b,
 void ss_art_link_motion(const ssModel *m, const ssData *d, int b,
                         const double *u, double V[6]);
 /* The same for the ncol columns of U (the system's velocities, row k = dof
- * k at U + ldu k), into out (6 x ncol, row i at out + ldo i); each column
- * is summed in the same order whatever ncol, so it is bit for bit the
- * ss_art_link_motion of that column (which is this with one column) */
+ * k at U + ldu k), into out (6 x ncol, row i at out + ldo i): column by
+ * column, ss_art_link_motion being this with one */
 void ss_art_link_motion_cols(const ssModel *m, const ssData *d, int b, const double *U,
                              int ldu, int ncol, double *out, int ldo);
 /* Contact rows of a world point p with contact frame `frame` (rows n, t1,

@@ -736,48 +736,6 @@ static void test_row_lanes(void)
      "(%d of %d entries differ over %d rows)", differ, entries, rows);
 }
 
-/* A link's motion of several columns at once (ss_art_link_motion_cols,
- * the Newton phase's Lam) against ss_art_link_motion column by column, bit
- * for bit: every link of the buggy, 1 to 7 columns at strides up to 9. */
-static void test_link_motion_cols(void)
-{
-  ssModel *m;
-  ssData *d;
-  if (!load_scene_file("scenes/buggy.xml", &m, &d)) {
-    ok(0, "buggy.xml loads");
-    return;
-  }
-  ssError e;
-  int good = ss_step(m, d, &e) == SS_OK, s = ss_model_find_sys(m, "buggy");
-  int nv = m->sys_nv[s], differ = 0, cases = 0;
-  double *U = malloc((size_t)nv * 9 * sizeof *U), *col = malloc((size_t)nv * sizeof *col);
-  unsigned long long r = 99;
-  for (int i = 0; U && i < nv * 9; i++) {
-    r = r * 6364136223846793005ull + 1442695040888963407ull;
-    U[i] = (double)(r >> 11) / 9007199254740992.0 - 0.5;
-  }
-  for (int b = m->sys_bodyadr[s]; good && U && col && b < m->sys_bodyadr[s] + m->sys_nbody[s]; b++)
-    for (int ncol = 1; ncol <= 7; ncol++)
-      for (int ld = ncol; ld <= 9; ld += 2) {
-        double out[6 * 8];
-        ss_art_link_motion_cols(m, d, b, U, ld, ncol, out, 8);
-        for (int c = 0; c < ncol; c++) {
-          double V[6];
-          for (int k = 0; k < nv; k++) col[k] = U[(size_t)ld * k + c];
-          ss_art_link_motion(m, d, b, col, V);
-          for (int i = 0; i < 6; i++) differ += memcmp(&V[i], &out[8 * i + c], sizeof V[i]) != 0;
-        }
-        cases++;
-      }
-  ok(good && U && col && cases > 100 && differ == 0,
-     "a link's motion of several columns at once: each column's bit for bit "
-     "(%d cases, %d values differ)", cases, differ);
-  free(U);
-  free(col);
-  ss_data_free(d);
-  ss_model_free(m);
-}
-
 /* The Newton phase's factored responses against the full ones: for every
  * pair of links of the buggy (four double-wishbone loops, a steering
  * linkage), J_a Y_b by ss_art_link_pair against J_a of ss_art_link_block's
@@ -889,7 +847,6 @@ static void test_link_pair(void)
 int main(void)
 {
   test_row_lanes();
-  test_link_motion_cols();
   test_link_pair();
   test_pendulum();
   test_fourbar();
