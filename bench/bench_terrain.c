@@ -76,6 +76,7 @@ static int csv_row(const Opt *o, const char *kind, double ms, double ns_point,
 
 typedef struct Run {
   double seconds, sweeps, newton, points, sinkage, soil_normal, dt;
+  double stage[6]; /* mean wall time a step of each stage (ssStepStats) */
   int ok;
 } Run;
 
@@ -181,8 +182,10 @@ static Run run_body(const Opt *o)
     sweeps += d->stats.sweeps;
     newton += d->stats.newton;
     points += d->stats.soil_loaded;
+    for (int i = 0; i < 6; i++) r.stage[i] += d->stats.time_stage[i];
   }
   r.seconds = now() - t0;
+  for (int i = 0; i < 6; i++) r.stage[i] /= o->steps;
   r.sweeps = (double)sweeps / o->steps;
   r.newton = (double)newton / o->steps;
   r.points = (double)points / o->steps;
@@ -228,6 +231,16 @@ static int bench_bodies(const Opt *o)
     printf("  real-time factor %.3f\n", last.dt / (1e-3 * med));
   else
     printf("  sinkage %.4f mm (analytic 8.175, error %+.3f %%)\n", last.sinkage * 1e3, 100 * err);
+  /* where the time goes, from the step's own stage clocks (the last
+   * repeat's mean): a profile without a profiler */
+  static const char *stage_name[6] = {"kinematics", "free velocity", "contacts",
+                                      "solve", "cache + soil update", "integration"};
+  double total = 0;
+  for (int i = 0; i < 6; i++) total += last.stage[i];
+  printf("  stages (last repeat, us/step and share):");
+  for (int i = 0; i < 6; i++)
+    printf(" %s %.1f (%.0f %%)%s", stage_name[i], 1e6 * last.stage[i],
+           total > 0 ? 100 * last.stage[i] / total : 0, i < 5 ? "," : "\n");
   if (!csv_row(o, o->sweeps_only ? "body_sweeps_only" : "body", med, ns_point, last.sweeps,
                last.newton, err))
     return 1;

@@ -44,6 +44,10 @@ verified --body=rigid --warmup=1400 --steps=100 --repeats=1 --bed-scale=10 --ver
 run --bench deformable_terrain -- --body=buggy --steps=2 --repeats=1 --verify
 check 'the buggy with --verify: runs, and says that nothing is checked' \
   'rc_is 0 && out_has "real-time factor" && out_has "verify: none for the buggy"'
+check 'a body run splits its step by stage' \
+  'out_has "stages (last repeat, us/step and share): kinematics" &&
+   out_has ", free velocity " && out_has ", contacts " && out_has ", solve " &&
+   out_has ", cache + soil update " && out_has ", integration "'
 
 # bad options: refused before any run (each returns at once), exit 2 for
 # usage and 1 for a file that cannot be used
