@@ -123,6 +123,15 @@ static int sys_closures(const ssModel *m, int s, int *eq, int *rows)
   return n;
 }
 
+/* the last dof (index in the system) of body a or of its nearest ancestor
+ * that has one, -1 if none: where a solve's sweep from a towards the root
+ * starts (the LTDL parent of a child's first dof, a link's path) */
+static int last_dof(const ssModel *m, const ssArtWork *w, int a)
+{
+  while (a >= 0 && !m->body_ndof[a]) a = m->body_parent[a];
+  return a >= 0 ? m->body_dofadr[a] - w->v0 + m->body_ndof[a] - 1 : -1;
+}
+
 void ss_art_work_free(ssArtWork *w)
 {
   if (!w) return;
@@ -203,12 +212,7 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
     int b = w->b0 + lb, nd = m->body_ndof[b];
     if (!nd) continue;
     int k0 = m->body_dofadr[b] - w->v0;
-    int par = -1;
-    for (int a = m->body_parent[b]; a >= 0; a = m->body_parent[a])
-      if (m->body_ndof[a]) {
-        par = m->body_dofadr[a] - w->v0 + m->body_ndof[a] - 1;
-        break;
-      }
+    int par = last_dof(m, w, m->body_parent[b]);
     for (int k = 0; k < nd; k++) {
       w->dof_body[k0 + k] = lb;
       w->dof_parent[k0 + k] = k ? k0 + k - 1 : par;
@@ -901,11 +905,7 @@ static Probe link_probe(const ssModel *m, ssArtWork *w, int b)
   Probe p = {w->path + (size_t)lb * n, 0, w->Xp + (size_t)lb * n * 6,
              w->XD + (size_t)lb * n * 6, w->Wp + (size_t)lb * nr * 6};
   if (!w->Xok[lb]) {
-    /* b's path starts at the last dof of the nearest body with any */
-    int a = b, top = -1;
-    while (a >= 0 && !m->body_ndof[a]) a = m->body_parent[a];
-    if (a >= 0 && m->body_sys[a] == w->sys) top = m->body_dofadr[a] - w->v0 + m->body_ndof[a] - 1;
-    reduce(w, top, 6, w->path + (size_t)lb * n, w->npath + lb, w->Xp + (size_t)lb * n * 6,
+    reduce(w, last_dof(m, w, b), 6, w->path + (size_t)lb * n, w->npath + lb, w->Xp + (size_t)lb * n * 6,
            w->XD + (size_t)lb * n * 6, w->Wp + (size_t)lb * nr * 6);
     w->Xok[lb] = 1;
   }
