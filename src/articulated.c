@@ -523,7 +523,8 @@ static void factor_closures(ssArtWork *w)
 
 /* Z <- A^-1 Z over the active rows (dropped rows give 0), for m columns
  * at once, Z (nr x m, row i = closure row i); each column sees the same
- * operations in the same order whatever m */
+ * operations in the same order whatever m: closure_solve, in its two
+ * halves, Z <- L_A^-1 Z (forward) and Z <- L_A^-T Z (backward), A = L_A L_A^T */
 static inline void closure_forward(const ssArtWork *w, double *Z, int m)
 {
   int nr = w->nrow;
@@ -542,11 +543,10 @@ static inline void closure_forward(const ssArtWork *w, double *Z, int m)
   }
 }
 
-static inline void closure_solve(const ssArtWork *w, double *Z, int m)
+static inline void closure_backward(const ssArtWork *w, double *Z, int m)
 {
   int nr = w->nrow;
   const double *A = w->A;
-  closure_forward(w, Z, m);
   for (int i = nr - 1; i >= 0; i--) {
     double *zi = Z + (size_t)m * i;
     if (!w->row_on[i]) {
@@ -559,6 +559,12 @@ static inline void closure_solve(const ssArtWork *w, double *Z, int m)
     }
     ss_row_div(zi, A[i * nr + i], m);
   }
+}
+
+static inline void closure_solve(const ssArtWork *w, double *Z, int m)
+{
+  closure_forward(w, Z, m);
+  closure_backward(w, Z, m);
 }
 
 /* x (already M'^-1 b) <- P x: remove the part that violates K x = 0 */
@@ -760,86 +766,6 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
   return SS_OK;
 }
 
-/* Y_b = P M'^-1 J_b^T (nv x 6) and Lam_b = J_b Y_b, once per step.  The
- * projection P = I - M'^-1 K^T A^-1 K (project) is applied to the six
- * columns at once, and K M'^-1 J_b^T = (J_b MiKT)^T (M' is symmetric)
- * reads only the rows of MiKT on b's path. */
-static void body_response(const ssModel *m, ssArtWork *w, int lb)
-{
-  if (w->Yok[lb]) return;
-  int n = w->nv, nr = w->nrow, b = w->b0 + lb;
-  double *Y = w->Y + (size_t)lb * n * 6;
-  /* J_b^T: the motion subspaces of b's path, the six columns solved at once */
-  memset(Y, 0, (size_t)n * 6 * sizeof(double));
-  for (int a = b; a >= 0; a = m->body_parent[a]) {
-    int nd = m->body_ndof[a];
-    if (!nd) continue;
-    int k0 = m->body_dofadr[a] - w->v0;
-    memcpy(Y + 6 * k0, w->S + 6 * k0, 6 * (size_t)nd * sizeof(double));
-  }
-  ltdl_solve(w, Y, 6);
-  if (nr) {
-    /* Z = (J_b MiKT)^T, row i = closure row i; then Y -= MiKT A^-1 Z */
-    double *Z = w->Z;
-    memset(Z, 0, 6 * (size_t)nr * sizeof(double));
-    for (int a = b; a >= 0; a = m->body_parent[a]) {
-      int nd = m->body_ndof[a];
-      if (!nd) continue;
-      int k0 = m->body_dofadr[a] - w->v0;
-      for (int k = k0; k < k0 + nd; k++) {
-        const double *Sk = w->S + 6 * k, *Mk = w->MiKT + (size_t)k * nr;
-        for (int i = 0; i < nr; i++) ss_row_add_scaled(Z + 6 * i, Mk[i], Sk, 6);
-      }
-    }
-    closure_solve(w, Z, 6);
-    /* each row's sum t = (MiKT Z)_k in registers, three pairs (the same
-     * products and sums, in order, as six-wide row updates of t) */
-    for (int k = 0; k < n; k++) {
-      const double *Mk = w->MiKT + (size_t)k * nr;
-      ssV2 t0 = {0, 0}, t1 = {0, 0}, t2 = {0, 0}, z0, z1, z2, y;
-      for (int i = 0; i < nr; i++) {
-        ssV2 mv = {Mk[i], Mk[i]};
-        memcpy(&z0, Z + 6 * i, sizeof z0);
-        memcpy(&z1, Z + 6 * i + 2, sizeof z1);
-        memcpy(&z2, Z + 6 * i + 4, sizeof z2);
-        t0 += mv * z0;
-        t1 += mv * z1;
-        t2 += mv * z2;
-      }
-      double *yk = Y + 6 * k;
-      memcpy(&y, yk, sizeof y);
-      y -= t0;
-      memcpy(yk, &y, sizeof y);
-      memcpy(&y, yk + 2, sizeof y);
-      y -= t1;
-      memcpy(yk + 2, &y, sizeof y);
-      memcpy(&y, yk + 4, sizeof y);
-      y -= t2;
-      memcpy(yk + 4, &y, sizeof y);
-    }
-  }
-  double *Lam = w->Lam + 36 * lb;
-  memset(Lam, 0, 36 * sizeof(double));
-  for (int a = b; a >= 0; a = m->body_parent[a]) {
-    int nd = m->body_ndof[a];
-    if (!nd) continue;
-    int k0 = m->body_dofadr[a] - w->v0;
-    for (int k = k0; k < k0 + nd; k++)
-      for (int r = 0; r < 6; r++) ss_row_add_scaled(Lam + 6 * r, w->S[6 * k + r], Y + 6 * k, 6);
-  }
-  w->Yok[lb] = 1;
-}
-
-void ss_art_link_block(const ssModel *m, ssData *d, int b, const double **Y,
-                       const double **Lam)
-{
-  ssArtWork *w = d->art[m->body_sys[b]];
-  int lb = b - w->b0;
-  body_response(m, w, lb);
-  *Y = w->Y + (size_t)lb * w->nv * 6;
-  *Lam = w->Lam + 36 * lb;
-}
-
 /* The Newton phase's route to the links' and joint rows' responses, which
  * never forms Y_b (nv x 6, whose sweep away from the root fills the whole
  * tree):
@@ -925,6 +851,78 @@ static Probe dof_probe(ssArtWork *w, int k)
   }
   p.np = w->dnp[k];
   return p;
+}
+
+/* Y_b = P M'^-1 J_b^T (nv x 6) and Lam_b = J_b Y_b, once per step.  The
+ * projection P = I - M'^-1 K^T A^-1 K (project) is applied to the six
+ * columns at once, and K M'^-1 J_b^T = (J_b MiKT)^T (M' is symmetric)
+ * reads only the rows of MiKT on b's path. */
+static void body_response(const ssModel *m, ssArtWork *w, int lb)
+{
+  if (w->Yok[lb]) return;
+  int n = w->nv, nr = w->nrow, b = w->b0 + lb;
+  double *Y = w->Y + (size_t)lb * n * 6;
+  /* J_b^T: the motion subspaces of b's path, the six columns solved at once */
+  memset(Y, 0, (size_t)n * 6 * sizeof(double));
+  for (int a = b; a >= 0; a = m->body_parent[a]) {
+    int nd = m->body_ndof[a];
+    if (!nd) continue;
+    int k0 = m->body_dofadr[a] - w->v0;
+    memcpy(Y + 6 * k0, w->S + 6 * k0, 6 * (size_t)nd * sizeof(double));
+  }
+  ltdl_solve(w, Y, 6);
+  if (nr) {
+    /* Z = A^-1 (J_b MiKT)^T, row i = closure row i, from the link's
+     * W = L_A^-1 (J_b MiKT)^T (link_probe); then Y -= MiKT Z */
+    double *Z = w->Z;
+    memcpy(Z, link_probe(m, w, b).W, 6 * (size_t)nr * sizeof(double));
+    closure_backward(w, Z, 6);
+    /* each row's sum t = (MiKT Z)_k in registers, three pairs (the same
+     * products and sums, in order, as six-wide row updates of t) */
+    for (int k = 0; k < n; k++) {
+      const double *Mk = w->MiKT + (size_t)k * nr;
+      ssV2 t0 = {0, 0}, t1 = {0, 0}, t2 = {0, 0}, z0, z1, z2, y;
+      for (int i = 0; i < nr; i++) {
+        ssV2 mv = {Mk[i], Mk[i]};
+        memcpy(&z0, Z + 6 * i, sizeof z0);
+        memcpy(&z1, Z + 6 * i + 2, sizeof z1);
+        memcpy(&z2, Z + 6 * i + 4, sizeof z2);
+        t0 += mv * z0;
+        t1 += mv * z1;
+        t2 += mv * z2;
+      }
+      double *yk = Y + 6 * k;
+      memcpy(&y, yk, sizeof y);
+      y -= t0;
+      memcpy(yk, &y, sizeof y);
+      memcpy(&y, yk + 2, sizeof y);
+      y -= t1;
+      memcpy(yk + 2, &y, sizeof y);
+      memcpy(&y, yk + 4, sizeof y);
+      y -= t2;
+      memcpy(yk + 4, &y, sizeof y);
+    }
+  }
+  double *Lam = w->Lam + 36 * lb;
+  memset(Lam, 0, 36 * sizeof(double));
+  for (int a = b; a >= 0; a = m->body_parent[a]) {
+    int nd = m->body_ndof[a];
+    if (!nd) continue;
+    int k0 = m->body_dofadr[a] - w->v0;
+    for (int k = k0; k < k0 + nd; k++)
+      for (int r = 0; r < 6; r++) ss_row_add_scaled(Lam + 6 * r, w->S[6 * k + r], Y + 6 * k, 6);
+  }
+  w->Yok[lb] = 1;
+}
+
+void ss_art_link_block(const ssModel *m, ssData *d, int b, const double **Y,
+                       const double **Lam)
+{
+  ssArtWork *w = d->art[m->body_sys[b]];
+  int lb = b - w->b0;
+  body_response(m, w, lb);
+  *Y = w->Y + (size_t)lb * w->nv * 6;
+  *Lam = w->Lam + 36 * lb;
 }
 
 /* J_a P M'^-1 J_b^T (ca x cb, row i at out + ldo i; ca, cb: a's and b's
