@@ -23,7 +23,7 @@ ssOption ss_option_default(void)
   o.solver_tolerance = 1e-9;
   o.scalar_tolerance = 1e-12;
   o.terrain_warm_start = 1;
-  o.contact_margin = 0.01;
+  o.contact_margin = 0.002;
   o.rigid_erp = 0.2;
   return o;
 }

@@ -140,7 +140,12 @@ typedef struct ssOption {
   double solver_tolerance;   /* relative impulse change that ends the sweeps */
   double scalar_tolerance;   /* residual tolerance of the per-point solves */
   int terrain_warm_start;    /* 1: start from the cached tractions */
-  double contact_margin;     /* (m) points closer than this become contacts */
+  double contact_margin;     /* (m) points closer than this beyond the
+                                collider's reach in the step (its speed
+                                towards the support times dt) become
+                                contacts; default 0.002: what the reach
+                                cannot see, a velocity change within the
+                                step (2 m/s at dt = 1 ms) */
   double rigid_erp;          /* fraction of rigid penetration removed per step */
 } ssOption;
 

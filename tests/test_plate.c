@@ -318,7 +318,7 @@ static void test_drag(void)
 }
 
 /* A soil point becomes a contact when the collider can reach it within
- * the step plus contact_margin (1 cm): the reach is the speed of the
+ * the step plus contact_margin (set to 1 cm here): the reach is the speed of the
  * collider's points along the bed's normal, |v.n| + r |n x omega|, not their
  * speed in any direction.  A ball 1.2 cm above the bed: sliding at 5 m/s
  * it reaches no point (a reach of |v| dt would take 0.5 cm more, and
@@ -340,6 +340,7 @@ static void test_reach(void)
   for (int k = 0; k < 4; k++) {
     ssError e;
     ssModel *m = ss_model_new();
+    m->opt.contact_margin = 0.01;
     add_soil_bed(m, 1.0, 0.02);
     ssBodyDef b = ss_body_def_default();
     b.name = "ball";
