@@ -517,13 +517,13 @@ static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint 
   if (!(T > 0)) return LOADED;
   double Tg = T * P->gtt;
   if (!(sigma > 0) || Tg > STICK_RATIO * sigma) return STICKS;
-  double t1 = v1 / sigma, t2 = v2 / sigma;
+  double is = 1 / sigma, t1 = v1 * is, t2 = v2 * is;
   lam[1] = -T * t1;
   lam[2] = -T * t2;
   if (K) {
     /* d lambda_t / d v_t = -(T/sigma)(I - t t^T) - tf m' t t^T, and
      * d lambda_t / d v_n through tf = A dt c + mu lambda_n */
-    double a = T / sigma, b = tf * e * M->rj, tn = M->mu * mob * K[0];
+    double a = T * is, b = tf * e * M->rj, tn = M->mu * mob * K[0];
     K[1] = -t1 * tn;
     K[2] = -t2 * tn;
     K[3] = -a * (1 - t1 * t1) - b * t1 * t1;
