@@ -142,9 +142,11 @@ typedef struct ssOption {
   int terrain_warm_start;    /* 1: start from the cached tractions */
   double contact_margin;     /* (m) points closer than this beyond the
                                 collider's reach in the step (its speed
-                                towards the support times dt) become
-                                contacts; default 0.002: what the reach
-                                cannot see, a velocity change within the
+                                towards the support at the free velocity,
+                                all forces but the contacts' applied,
+                                times dt) become contacts; default 0.002:
+                                what the reach cannot see, the contacts'
+                                own change of that velocity within the
                                 step (2 m/s at dt = 1 ms) */
   double rigid_erp;          /* fraction of rigid penetration removed per step */
 } ssOption;

@@ -104,7 +104,11 @@ static int mesh_depth(const ssModel *m, const ssData *d, int g,
 
 /* How far a collider can travel towards a support in one step plus the
  * configured margin: points closer than this become contacts, so no
- * contact is missed by the implicit end-of-step solve.  n: the direction
+ * contact is missed by the implicit end-of-step solve.  The speed is the
+ * free velocity's (contacts are made after it: gravity and every force
+ * but the contacts' are in it), so the margin is left only the change
+ * the contacts' own impulses make within the step (contact_margin,
+ * soilsim.h).  n: the direction
  * the gaps are measured along (a soil bed's z), where the reach is the
  * speed of the collider's points along it; NULL (a rigid height map, whose
  * normal varies): their speed in any direction. */
