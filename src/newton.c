@@ -128,6 +128,7 @@ typedef struct NGroup {
   double R[9];        /* contact frame rows n, t1, t2 (world) */
   double o[3];        /* origin of the points' r (world) */
   const ssPowTable *pt; /* its bed's table of s^(n-1), or NULL */
+  double ik;          /* 1 / K_j of its material, 0 for K_j = 0 */
 } NGroup;
 
 /* One evaluation's sums over a group's points, in its frame about o */
@@ -1474,6 +1475,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
       G->bed = c->hfield;
       G->mat = &m->hfield_soilmat[c->hfield];
       G->pt = ss_solver_pow_table(m, d, c->hfield);
+      G->ik = G->mat->shear_displacement > 0 ? 1 / G->mat->shear_displacement : 0;
       memcpy(G->R, c->frame, sizeof G->R);
       memcpy(G->o, c->pos, sizeof G->o);
       if (c->link < 0) body_block(m, d, G->body, G->Yb);
@@ -1491,7 +1493,9 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     P->S = c->area * m->opt.timestep;
     P->k = ss_soil_modulus(mat, c->width);
     P->tf0 = P->S * mat->cohesion;
-    P->x0 = mat->shear_displacement > 0 ? c->j / mat->shear_displacement : 0;
+    /* x0 = j / K_j as the sweeps' law forms it (point.c, mobil_init):
+     * the same bits, and no division a point */
+    P->x0 = (c->j > 0 ? c->j : 0) * G->ik;
     P->pw.s = 0;
     P->mob = ss_exp_memo_start(P->x0);
     P->imp = 0;
