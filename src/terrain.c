@@ -198,6 +198,12 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
   double width = ss_shape_width(&s, up);
   double frame[9];
   frame_from_bed(R, frame);
+  /* a bed not turned (most: R from the unit quaternion is exactly I): a
+   * point's world position is its bed position moved, without the
+   * product by R's ones and zeros (which gives the same sums, up to the
+   * sign of a zero) */
+  static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  int turned = memcmp(R, I3, sizeof I3) != 0;
   long njac = contact_jlen(m, sys);
   const double *z0 = m->hfield_data + adr;
   const double *sp = d->soil_plastic + adr, *jj = d->soil_shear + adr;
@@ -261,9 +267,15 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       c->geom = g;
       c->hfield = h;
       c->vertex = adr + k;
-      double pl[3] = {qx, qy, zl};
-      ss_m3_mulv(c->pos, R, pl);
-      ss_v3_add(c->pos, c->pos, p);
+      if (turned) {
+        double pl[3] = {qx, qy, zl};
+        ss_m3_mulv(c->pos, R, pl);
+        ss_v3_add(c->pos, c->pos, p);
+      } else {
+        c->pos[0] = qx + p[0];
+        c->pos[1] = qy + p[1];
+        c->pos[2] = zl + p[2];
+      }
       memcpy(c->frame, frame, sizeof frame);
       c->area = area;
       c->width = width;

@@ -103,6 +103,36 @@ static double max_outside(const World *w, const double *arr, double cx,
   return mx;
 }
 
+/* A bed turned about its normal and moved (its pose in ssData): the soil
+ * points come from the collider in the bed's frame and go back to the
+ * world through the pose (terrain.c; an unturned bed skips the product by
+ * R), so the plate set on it at the same turn settles as on the unturned
+ * bed, to 8.175 mm, its points' positions under the plate in the world. */
+static void test_turned_bed(void)
+{
+  const double yaw = 0.5, s_ref = 8.175e-3, pos[3] = {0.3, -0.2, 0.01};
+  World w = make_world(plate_soil(), 1.2, 0.02, 0.4, 0.6, 20, pos[0], pos[1], yaw, pos[2]);
+  double axis[3] = {0, 0, 1};
+  ss_quat_from_axis_angle(w.d->hfield_quat + 4 * w.bed, axis, yaw);
+  memcpy(w.d->hfield_pos + 3 * w.bed, pos, sizeof pos);
+  int good = run(&w, 1500);
+  double sink = -(w.d->qpos[2] - 0.025 - pos[2]), worst = 0;
+  for (int i = 0; good && i < w.d->ncontact; i++) {
+    /* each point in the plate's footprint (world), on the bed's plane */
+    const double *c = w.d->contact[i].pos;
+    double x = c[0] - w.d->qpos[0], y = c[1] - w.d->qpos[1];
+    double u = cos(yaw) * x + sin(yaw) * y, v = -sin(yaw) * x + cos(yaw) * y;
+    worst = fmax(worst, fmax(fabs(u) - 0.2, fabs(v) - 0.3));
+    worst = fmax(worst, fabs(c[2] - (pos[2] - sink)) - 1e-3);
+  }
+  ok(good && fabs(sink - s_ref) <= 0.005 * s_ref &&
+         fabs(w.d->stats.soil_contact_area - 0.24) <= 1e-9 && w.d->ncontact > 0 && worst <= 1e-9,
+     "a bed turned by %g rad and moved: plate sinkage %.4f mm (want %.3f), loaded area %.6f "
+     "m^2, %d points within the plate's footprint in the world (worst %.2g m out)",
+     yaw, 1e3 * sink, 1e3 * s_ref, w.d->stats.soil_contact_area, w.d->ncontact, worst);
+  free_world(&w);
+}
+
 /* DESIGN 2.7: 20 kg, 0.4 x 0.6 m -> 8.175 mm; rut after lifting 7.766 mm */
 static void test_analytic_plate(void)
 {
@@ -852,6 +882,7 @@ static void test_power_table(void)
 int main(void)
 {
   test_analytic_plate();
+  test_turned_bed();
   test_envelope_shapes();
   test_reload();
   test_impact_and_lift();
