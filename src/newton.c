@@ -129,6 +129,8 @@ typedef struct NGroup {
   double o[3];        /* origin of the points' r (world) */
   const ssPowTable *pt; /* its bed's table of s^(n-1), or NULL */
   double ik;          /* 1 / K_j of its material, 0 for K_j = 0 */
+  int axes;           /* R is an unturned bed's axes (ssContact.bed_axes):
+                         r = R (p - o) a permutation */
 } NGroup;
 
 /* One evaluation's sums over a group's points, in its frame about o */
@@ -1477,6 +1479,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
       G->pt = ss_solver_pow_table(m, d, c->hfield);
       G->ik = G->mat->shear_displacement > 0 ? 1 / G->mat->shear_displacement : 0;
       memcpy(G->R, c->frame, sizeof G->R);
+      G->axes = c->bed_axes;
       memcpy(G->o, c->pos, sizeof G->o);
       if (c->link < 0) body_block(m, d, G->body, G->Yb);
     } else if (memcmp(G->R, c->frame, sizeof G->R)) {
@@ -1487,7 +1490,13 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     const ssSoilMaterial *mat = G->mat;
     double rel[3];
     ss_v3_sub(rel, c->pos, G->o);
-    ss_m3_mulv(P->r, G->R, rel);
+    if (G->axes) {
+      P->r[0] = rel[2];
+      P->r[1] = rel[0];
+      P->r[2] = rel[1];
+    } else {
+      ss_m3_mulv(P->r, G->R, rel);
+    }
     P->g0 = c->g0;
     P->sp = c->sp;
     P->S = c->area * m->opt.timestep;

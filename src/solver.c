@@ -96,8 +96,7 @@ static void rows_impulse(const double *X, const double dl[3], double w[6])
  * is only for the sweeps): X^T dl = (p x f; f), f = frame^T dl */
 static inline void link_impulse(const ssContact *c, const double dl[3], double w[6])
 {
-  const double *fr = c->frame;
-  for (int k = 0; k < 3; k++) w[3 + k] = fr[k] * dl[0] + fr[3 + k] * dl[1] + fr[6 + k] * dl[2];
+  ss_contact_frame_tmulv(c, w + 3, dl);
   ss_v3_cross(w, c->pos, w + 3);
 }
 
@@ -108,7 +107,7 @@ static inline void link_point_velocity(const ssContact *c, const double V[6], do
   double w[3];
   ss_v3_cross(w, V, c->pos);
   ss_v3_add(w, w, V + 3);
-  ss_m3_mulv(v, c->frame, w);
+  ss_contact_frame_mulv(c, v, w);
 }
 
 /* u += Y w over the system's velocities */
@@ -140,7 +139,7 @@ contact_velocity(const ssModel *m, const ssData *d, const ssContact *c, double v
     ss_v3_sub(r, c->pos, d->body_xipos + 3 * m->geom_body[c->geom]);
     ss_v3_cross(w, u + 3, r);
     ss_v3_add(w, w, u);
-    ss_m3_mulv(v, c->frame, w);
+    ss_contact_frame_mulv(c, v, w);
     return;
   }
   /* a joint row: J (3 x nv) stored */
@@ -404,9 +403,8 @@ warm_one(const ssModel *m, ssData *d, ssContact *c, const ssWarmEntry *e, int cr
     }
     /* J^T lambda = (f; r x f), f = frame^T lambda, r from the centre of
      * mass (J is formed only for the sweeps) */
-    const double *fr = c->frame, *l = c->lambda;
     double f[3], r[3], t[3];
-    for (int k = 0; k < 3; k++) f[k] = fr[k] * l[0] + fr[3 + k] * l[1] + fr[6 + k] * l[2];
+    ss_contact_frame_tmulv(c, f, c->lambda);
     ss_v3_sub(r, c->pos, d->body_xipos + 3 * b);
     ss_v3_cross(t, r, f);
     for (int k = 0; k < 3; k++) {

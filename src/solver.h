@@ -63,6 +63,9 @@ struct ssContact {
                         empty, whatever its bytes */
   int w_ready;       /* joint row: its W formed (ss_art_dof_response, at
                         its first use); 0: not yet */
+  int bed_axes;      /* soil: frame is an unturned bed's (rows z, x, y,
+                        exactly), so products by it are permutations
+                        (ss_contact_frame_mulv, _tmulv); 0: any frame */
   /* From here on ss_contact_new leaves the fields as they were (it zeroes
    * those above): each is written before it is read.  pos and frame: by
    * the soil and rigid contacts' creators, and read only for those
@@ -125,6 +128,31 @@ static inline long ss_contact_jac_end(const ssData *d)
 {
   return d->ncontact ? d->contact[d->ncontact - 1].jadr + d->contact[d->ncontact - 1].jlen : 0;
 }
+/* v = frame w and f = frame^T l of contact c: on an unturned bed's axes
+ * (bed_axes) the permutations themselves, the same values as the products
+ * by the frame's ones and zeros (up to the sign of a zero) */
+static inline void ss_contact_frame_mulv(const ssContact *c, double v[3], const double w[3])
+{
+  if (c->bed_axes) {
+    v[0] = w[2];
+    v[1] = w[0];
+    v[2] = w[1];
+    return;
+  }
+  ss_m3_mulv(v, c->frame, w);
+}
+static inline void ss_contact_frame_tmulv(const ssContact *c, double f[3], const double l[3])
+{
+  if (c->bed_axes) {
+    f[0] = l[1];
+    f[1] = l[2];
+    f[2] = l[0];
+    return;
+  }
+  const double *fr = c->frame;
+  for (int k = 0; k < 3; k++) f[k] = fr[k] * l[0] + fr[3 + k] * l[1] + fr[6 + k] * l[2];
+}
+
 static inline ssContact *ss_contact_add(ssData *d, long njac)
 {
   ssContact *c = d->contact + d->ncontact;

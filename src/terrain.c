@@ -277,6 +277,7 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
         c->pos[2] = zl + p[2];
       }
       memcpy(c->frame, frame, sizeof frame);
+      c->bed_axes = !turned;
       c->area = area;
       c->width = width;
       c->g0 = g0;
