@@ -827,30 +827,26 @@ static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, doubl
 
 static Probe link_probe(const ssModel *m, ssArtWork *w, int b)
 {
-  int lb = b - w->b0, n = w->nv, nr = w->nrow;
-  Probe p = {w->path + (size_t)lb * n, 0, w->Xp + (size_t)lb * n * 6,
-             w->XD + (size_t)lb * n * 6, w->Wp + (size_t)lb * nr * 6};
+  size_t lb = (size_t)(b - w->b0), n = (size_t)w->nv, nr = (size_t)w->nrow;
+  int *path = w->path + lb * n;
+  double *X = w->Xp + lb * n * 6, *XD = w->XD + lb * n * 6, *W = w->Wp + lb * nr * 6;
   if (!w->Xok[lb]) {
-    reduce(w, last_dof(m, w, b), 6, w->path + (size_t)lb * n, w->npath + lb, w->Xp + (size_t)lb * n * 6,
-           w->XD + (size_t)lb * n * 6, w->Wp + (size_t)lb * nr * 6);
+    reduce(w, last_dof(m, w, b), 6, path, w->npath + lb, X, XD, W);
     w->Xok[lb] = 1;
   }
-  p.np = w->npath[lb];
-  return p;
+  return (Probe){path, w->npath[lb], X, XD, W};
 }
 
 static Probe dof_probe(ssArtWork *w, int k)
 {
-  int n = w->nv, nr = w->nrow;
-  Probe p = {w->dpath + (size_t)k * n, 0, w->Xd + (size_t)k * n, w->XDd + (size_t)k * n,
-             w->Wd + (size_t)k * nr};
+  size_t n = (size_t)w->nv, nr = (size_t)w->nrow;
+  int *path = w->dpath + (size_t)k * n;
+  double *X = w->Xd + (size_t)k * n, *XD = w->XDd + (size_t)k * n, *W = w->Wd + (size_t)k * nr;
   if (!w->dok[k]) {
-    reduce(w, k, 1, w->dpath + (size_t)k * n, w->dnp + k, w->Xd + (size_t)k * n,
-           w->XDd + (size_t)k * n, w->Wd + (size_t)k * nr);
+    reduce(w, k, 1, path, w->dnp + k, X, XD, W);
     w->dok[k] = 1;
   }
-  p.np = w->dnp[k];
-  return p;
+  return (Probe){path, w->dnp[k], X, XD, W};
 }
 
 /* Y_b = P M'^-1 J_b^T (nv x 6) and Lam_b = J_b Y_b, once per step.  The

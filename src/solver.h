@@ -149,8 +149,7 @@ static inline void ss_contact_frame_tmulv(const ssContact *c, double f[3], const
     f[2] = l[0];
     return;
   }
-  const double *fr = c->frame;
-  for (int k = 0; k < 3; k++) f[k] = fr[k] * l[0] + fr[3 + k] * l[1] + fr[6 + k] * l[2];
+  ss_m3_mulvT(f, c->frame, l);
 }
 
 static inline ssContact *ss_contact_add(ssData *d, long njac)

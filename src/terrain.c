@@ -108,10 +108,10 @@ static int mesh_depth(const ssModel *m, const ssData *d, int g,
  * free velocity's (contacts are made after it: gravity and every force
  * but the contacts' are in it), so the margin is left only the change
  * the contacts' own impulses make within the step (contact_margin,
- * soilsim.h).  n: the direction
- * the gaps are measured along (a soil bed's z), where the reach is the
- * speed of the collider's points along it; NULL (a rigid height map, whose
- * normal varies): their speed in any direction. */
+ * soilsim.h).  n: the direction the gaps are measured along (a soil bed's
+ * z), where the reach is the speed of the collider's points along it;
+ * NULL (a rigid height map, whose normal varies): their speed in any
+ * direction. */
 static double geom_margin(const ssModel *m, const ssData *d, int g, int sys,
                           const double *n)
 {
