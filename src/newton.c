@@ -129,6 +129,8 @@ typedef struct NGroup {
   double o[3];        /* origin of the points' r (world) */
   const ssPowTable *pt; /* its bed's table of s^(n-1), or NULL */
   double ik;          /* 1 / K_j of its material, 0 for K_j = 0 */
+  double kb, kk;      /* the last width b its points had and the modulus
+                         ss_soil_modulus(mat, b) (kb NAN: none yet) */
   int axes;           /* R is an unturned bed's axes (ssContact.bed_axes):
                          r = R (p - o) a permutation */
 } NGroup;
@@ -1478,6 +1480,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
       G->mat = &m->hfield_soilmat[c->hfield];
       G->pt = ss_solver_pow_table(m, d, c->hfield);
       G->ik = G->mat->shear_displacement > 0 ? 1 / G->mat->shear_displacement : 0;
+      G->kb = NAN;
       memcpy(G->R, c->frame, sizeof G->R);
       G->axes = c->bed_axes;
       memcpy(G->o, c->pos, sizeof G->o);
@@ -1500,7 +1503,13 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     P->g0 = c->g0;
     P->sp = c->sp;
     P->S = c->area * m->opt.timestep;
-    P->k = ss_soil_modulus(mat, c->width);
+    /* the points of one collider share its width: its modulus (a
+     * division) is formed once, the same bits */
+    if (!(c->width == G->kb)) {
+      G->kb = c->width;
+      G->kk = ss_soil_modulus(mat, c->width);
+    }
+    P->k = G->kk;
     P->tf0 = P->S * mat->cohesion;
     /* x0 = j / K_j as the sweeps' law forms it (point.c, mobil_init):
      * the same bits, and no division a point */

@@ -24,14 +24,15 @@ static inline double ss_soil_plastic_from(const ssSoilMaterial *mat, double s, d
   return sp > s_p ? sp : s_p;
 }
 
-/* ss_soil_plastic_update (soil.c) with s^(n-1) given (sn1), the envelope
- * formed as the law forms it, ss_soil_modulus s s^(n-1): the soil update
- * takes the power from its bed's table (solver.h) */
-static inline double ss_soil_plastic_update_pow(const ssSoilMaterial *mat, double b, double s,
+/* ss_soil_plastic_update (soil.c) with s^(n-1) given (sn1) and the
+ * modulus k = ss_soil_modulus(mat, b) (point.h), the envelope formed as
+ * the law forms it, k s s^(n-1): the soil update takes the power from its
+ * bed's table (solver.h) and the modulus once per width */
+static inline double ss_soil_plastic_update_pow(const ssSoilMaterial *mat, double k, double s,
                                                 double s_p, double sn1)
 {
   if (!(s > s_p)) return s_p;
-  return ss_soil_plastic_from(mat, s, s_p, ss_soil_modulus(mat, b) * (s * sn1));
+  return ss_soil_plastic_from(mat, s, s_p, k * (s * sn1));
 }
 /* Bed-frame <-> world transforms of height map h for the current pose. */
 void ss_hfield_frame(const ssData *d, int h, double R[9], double p[3]);

@@ -231,7 +231,7 @@ static void test_pow_table(void)
   for (int i = 0; i < 1000; i++) {
     double z = 1e-4 + 0.1 * i / 1000.0, zp = i % 2 ? z * (1 - 1e-5 * (i % 7)) : 0.5 * z;
     double a = ss_soil_plastic_update(&m, 0.3, z, zp);
-    double b = ss_soil_plastic_update_pow(&m, 0.3, z, zp, ss_pow_tab(&t, z));
+    double b = ss_soil_plastic_update_pow(&m, ss_soil_modulus(&m, 0.3), z, zp, ss_pow_tab(&t, z));
     double r = fabs(a - b) / z;
     if (r > worst) worst = r;
     branches |= a > zp ? 1 : 2;
