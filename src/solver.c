@@ -504,12 +504,18 @@ static int cached(const ssContact *c)
          (c->type == SS_CONTACT_SOIL && c->lambda[0] > 0);
 }
 
-/* Sort the n cache entries of a by key (cmp_warm), b being as large;
- * returns whichever of a and b ends holding them.  The contacts come in a
- * few ascending runs (one per bed, then the joint rows), so neighbouring
- * runs are merged pairwise until one is left: a few passes, no general
- * sort, none where the entries came sorted. */
-static int warm_less(const ssWarmEntry *a, const ssWarmEntry *b) { return cmp_warm(a, b) < 0; }
+/* Sort the n cache entries of a by key (warm_key: cmp_warm's order in one
+ * comparison), b being as large; returns whichever of a and b ends
+ * holding them.  The contacts come in a few ascending runs (one per bed,
+ * then the joint rows: the PD rows in the model's order, then the
+ * limits), so neighbouring runs are merged pairwise until one is left: a
+ * few passes, no general sort, none where the entries came sorted, and a
+ * short tail (the buggy's one PD row out of dof order) inserted in place
+ * (sort_runs.h). */
+static int warm_less(const ssWarmEntry *a, const ssWarmEntry *b)
+{
+  return entry_key(a) < entry_key(b);
+}
 SS_SORT_RUNS(sort_runs, ssWarmEntry, warm_less)
 
 /* A collider whose loaded soil points all slip slower than CREEP_SLIP

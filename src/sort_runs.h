@@ -8,15 +8,23 @@
  *
  * which sorts the n elements of v, with the scratch t of n elements, by
  * less(const T *a, const T *b) (a strict order), and returns whichever of v
- * and t ends holding them (v when they were sorted already).  Each pass
- * finds the runs -- non-decreasing, or strictly decreasing and then
- * reversed in place -- and merges them pairwise, taking the left element
- * on ties: the sort is stable, so its result is the one stable order,
- * whatever the runs.  Linear for input already sorted, a few passes for a
+ * and t ends holding them (v when they were sorted already, or all but a
+ * short tail: SS_SORT_RUNS_TAIL).  Each pass finds the runs -- non-
+ * decreasing, or strictly decreasing and then reversed in place -- and
+ * merges them pairwise, taking the left element on ties: the sort is
+ * stable, so its result is the one stable order, whatever the runs.  Linear for input already sorted, a few passes for a
  * few runs; no allocation and no call through a pointer per comparison
  * (the element type and comparison are the caller's, inlined). */
 #ifndef SS_SORT_RUNS_H
 #define SS_SORT_RUNS_H
+
+#include <string.h>
+
+/* a first run followed by at most this many elements: those are inserted
+ * into it in place (a binary search and a move each) instead of merged
+ * through the scratch (every element copied): the joint rows after a
+ * step's soil points, where one PD row's dof comes before another's */
+#define SS_SORT_RUNS_TAIL 8
 
 #define SS_SORT_RUNS(name, T, less)                                            \
   static int name##_run(T *v, int i, int n)                                    \
@@ -36,7 +44,24 @@
   }                                                                            \
   static T *name(T *v, T *t, int n)                                            \
   {                                                                            \
-    if (name##_run(v, 0, n) >= n) return v;                                    \
+    int e0 = name##_run(v, 0, n);                                              \
+    if (e0 >= n) return v;                                                     \
+    if (n - e0 <= SS_SORT_RUNS_TAIL) {                                         \
+      /* a sorted run and a short tail: each tail element inserted in      */ \
+      /* place after the last element not greater than it (stable)         */ \
+      for (int k = e0; k < n; k++) {                                           \
+        T x = v[k];                                                            \
+        int lo = 0, hi = k;                                                    \
+        while (lo < hi) {                                                      \
+          int mid = lo + (hi - lo) / 2;                                        \
+          if (less(&x, &v[mid])) hi = mid;                                     \
+          else lo = mid + 1;                                                   \
+        }                                                                      \
+        memmove(v + lo + 1, v + lo, (size_t)(k - lo) * sizeof *v);            \
+        v[lo] = x;                                                             \
+      }                                                                        \
+      return v;                                                                \
+    }                                                                          \
     for (;;) {                                                                 \
       int runs = 0;                                                            \
       for (int i = 0; i < n; runs++) {                                         \

@@ -948,6 +948,33 @@ static void test_sort_runs(void)
     cases++;
   }
   ok(bad == 0, "SS_SORT_RUNS: %d of %d inputs (runs up and down, ties) in the stable order", cases - bad, cases);
+  /* a sorted run with ties, then a tail of 1 to SS_SORT_RUNS_TAIL + 2
+   * keys (ties with the run and among themselves, below and above it):
+   * the stable order, and in place where the tail is inserted */
+  bad = cases = 0;
+  for (int c = 0; c < 300; c++) {
+    int tail = c % (SS_SORT_RUNS_TAIL + 2) + 1, n = tail + 1 + (c * 7) % (N - tail);
+    for (int i = 0; i < n; i++) {
+      seed = seed * 1664525u + 1013904223u;
+      int r = (int)(seed >> 24);
+      v[i] = (SortItem){i < n - tail ? i / 3 : r % (n / 3 + 3) - 1, i};
+    }
+    memcpy(want, v, sizeof(SortItem) * (size_t)n);
+    for (int i = 1; i < n; i++)
+      for (int j = i; j > 0 && want[j].key < want[j - 1].key; j--) {
+        SortItem s = want[j];
+        want[j] = want[j - 1];
+        want[j - 1] = s;
+      }
+    int e0 = 1;
+    while (e0 < n && v[e0 - 1].key <= v[e0].key) e0++;
+    SortItem *r = sort_items(v, t, n);
+    int same = 1;
+    for (int i = 0; i < n; i++) same &= r[i].key == want[i].key && r[i].pos == want[i].pos;
+    if (!same || (n - e0 <= SS_SORT_RUNS_TAIL && r != v)) bad++;
+    cases++;
+  }
+  ok(bad == 0, "SS_SORT_RUNS: %d of %d runs with a short tail in the stable order, in place", cases - bad, cases);
   SortItem one[1] = {{3, 0}}, scratch[1];
   ok(sort_items(one, scratch, 1) == one && sort_items(one, scratch, 0) == one, "SS_SORT_RUNS: 0 and 1 elements stay in place");
 }
