@@ -173,6 +173,8 @@ struct ssNewtonWork {
   double reg;         /* their regularization, times G_tt (IMP_REG, more
                          after a line search without descent) */
   int *imp;           /* (ncontact) their indices */
+  int *live;          /* (ncontact) an evaluation's loaded points of one
+                         run of a group (evaluate_at) */
   double *mu, *mutry, *dmu; /* (ncontact x 2) their mu at y, at the trial,
                          the step */
   NImpEval *ie, *ietry; /* (ncontact) their equations at y, at the trial */
@@ -192,7 +194,7 @@ void ss_newton_work_free(ssNewtonWork *w)
   free(w->phitry); free(w->H); free(w->Htry); free(w->K); free(w->Ktry);
   free(w->col); free(w->pt);
   free(w->grp); free(w->sum);
-  free(w->q); free(w->qtry); free(w->imp); free(w->mu); free(w->mutry); free(w->dmu);
+  free(w->q); free(w->qtry); free(w->imp); free(w->live); free(w->mu); free(w->mutry); free(w->dmu);
   free(w->ie); free(w->ietry);
   free(w);
 }
@@ -218,6 +220,7 @@ static ssNewtonWork *work(ssData *d, int n, int nc, int nv, int ng)
         !grow(&w->K, 6 * (size_t)nc, sizeof(double)) ||
         !grow(&w->Ktry, 6 * (size_t)nc, sizeof(double)) ||
         !grow(&w->imp, (size_t)nc, sizeof(int)) ||
+        !grow(&w->live, (size_t)nc, sizeof(int)) ||
         !grow(&w->mu, 2 * (size_t)nc, sizeof(double)) ||
         !grow(&w->mutry, 2 * (size_t)nc, sizeof(double)) ||
         !grow(&w->dmu, 2 * (size_t)nc, sizeof(double)) ||
@@ -677,6 +680,92 @@ static void imp_step(const NPoint *P, const NImpEval *ie, double scale, const do
   dmu[1] = -(A[0] * g1 - A[2] * g0) / det;
 }
 
+/* The Jacobian's sums over the loaded points live[0, nl) of a group, into
+ * A: with K = [[kn, 0, 0], [k1n, k11, k12], [k2n, k12, k22]] and the
+ * point's J = [-[r]x, I], the blocks of J^T K J written out: K, K (-[r]x),
+ * [r]x K and [r]x K (-[r]x).  Two points at a time, one in each half of
+ * a pair of doubles (the odd one out with a zero partner, which adds
+ * zeros), the halves' sums added at the end: half the arithmetic
+ * instructions of a point at a time, and the same sums in another order
+ * (H is Newton's Jacobian; it moves the iterates, never the check). */
+static inline __attribute__((always_inline)) void h_sums(const NPoint *pt, const double *Ks,
+                                                        const int *live, int nl, NSum *A)
+{
+  ssV2 sK[6] = {0}, vw[9] = {0}, wv[9] = {0}, ww[9] = {0};
+  for (int k = 0; k < nl; k += 2) {
+    const int i = live[k];
+    const double *ra = pt[i].r, *Ka = Ks + 6 * i;
+    ssV2 r0, r1, r2, kn, k1n, k2n, k11, k12, k22;
+    if (k + 1 < nl) {
+      const int j = live[k + 1];
+      const double *rb = pt[j].r, *Kb = Ks + 6 * j;
+      r0 = (ssV2){ra[0], rb[0]};
+      r1 = (ssV2){ra[1], rb[1]};
+      r2 = (ssV2){ra[2], rb[2]};
+      kn = (ssV2){Ka[0], Kb[0]};
+      k1n = (ssV2){Ka[1], Kb[1]};
+      k2n = (ssV2){Ka[2], Kb[2]};
+      k11 = (ssV2){Ka[3], Kb[3]};
+      k12 = (ssV2){Ka[4], Kb[4]};
+      k22 = (ssV2){Ka[5], Kb[5]};
+    } else {
+      r0 = (ssV2){ra[0], 0};
+      r1 = (ssV2){ra[1], 0};
+      r2 = (ssV2){ra[2], 0};
+      kn = (ssV2){Ka[0], 0};
+      k1n = (ssV2){Ka[1], 0};
+      k2n = (ssV2){Ka[2], 0};
+      k11 = (ssV2){Ka[3], 0};
+      k12 = (ssV2){Ka[4], 0};
+      k22 = (ssV2){Ka[5], 0};
+    }
+    sK[0] += kn;
+    sK[1] += k1n;
+    sK[2] += k2n;
+    sK[3] += k11;
+    sK[4] += k12;
+    sK[5] += k22;
+    /* K (-[r]x), row by row */
+    ssV2 q01 = kn * r2, q02 = -kn * r1;
+    ssV2 q10 = k12 * r1 - k11 * r2, q11 = k1n * r2 - k12 * r0, q12 = k11 * r0 - k1n * r1;
+    ssV2 q20 = k22 * r1 - k12 * r2, q21 = k2n * r2 - k22 * r0, q22 = k12 * r0 - k2n * r1;
+    vw[1] += q01;
+    vw[2] += q02;
+    vw[3] += q10;
+    vw[4] += q11;
+    vw[5] += q12;
+    vw[6] += q20;
+    vw[7] += q21;
+    vw[8] += q22;
+    /* [r]x K */
+    wv[0] += r1 * k2n - r2 * k1n;
+    wv[1] += r1 * k12 - r2 * k11;
+    wv[2] += r1 * k22 - r2 * k12;
+    wv[3] += r2 * kn - r0 * k2n;
+    wv[4] -= r0 * k12;
+    wv[5] -= r0 * k22;
+    wv[6] += r0 * k1n - r1 * kn;
+    wv[7] += r0 * k11;
+    wv[8] += r0 * k12;
+    /* [r]x (K (-[r]x)): the rows of [r]x times the columns of q */
+    ww[0] += r1 * q20 - r2 * q10;
+    ww[1] += r1 * q21 - r2 * q11;
+    ww[2] += r1 * q22 - r2 * q12;
+    ww[3] -= r0 * q20;
+    ww[4] += r2 * q01 - r0 * q21;
+    ww[5] += r2 * q02 - r0 * q22;
+    ww[6] += r0 * q10;
+    ww[7] += r0 * q11 - r1 * q01;
+    ww[8] += r0 * q12 - r1 * q02;
+  }
+  for (int k = 0; k < 6; k++) A->K[k] += sK[k][0] + sK[k][1];
+  for (int k = 0; k < 9; k++) {
+    A->vw[k] += vw[k][0] + vw[k][1];
+    A->wv[k] += wv[k][0] + wv[k][1];
+    A->ww[k] += ww[k][0] + ww[k][1];
+  }
+}
+
 /* F(y, mu) and H(y) = dF/dy over all contacts, the soil points' impulses
  * in lam (3 each; the rows' are their entries of F), the impulse-form
  * points' equations in ie.  H: a 6 x 6 block per group, then one value
@@ -700,81 +789,55 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
     memset(A, 0, sizeof *A);
     to_group(w->grp + g, y + 6 * g, A->V);
   }
-  int gprev = -1, sticks = 0, near = 0;
+  int gprev = -1, sticks = 0, near = 0, *live = w->live;
   Mat M = {0};
-  for (int i = 0; i < s->first_row; i++) {
-    NPoint *P = w->pt + i;
-    int g = w->group_of[i];
+  for (int i0 = 0, i1; i0 < s->first_row; i0 = i1) {
+    /* a run of one group's points: their laws (impulses, and K, kept for
+     * the linear end of a step: apply_linear), then their sums */
+    const int g = w->group_of[i0];
+    for (i1 = i0 + 1; i1 < s->first_row && w->group_of[i1] == g; i1++) {
+    }
     NSum *A = w->sum + g;
     if (g != gprev) {
       gprev = g;
       M = mat_of(w->grp + g, dt);
     }
-    double *lam = lam_out + 3 * i, K[6];
-    int st = !(with_imp && P->imp) ? point_law(&M, P, A->V, lam, with_H ? K : NULL)
-                     : imp_law(&M, P, A->V, mu + 2 * i, lam, with_H ? K : NULL, ie + i);
-    if (st == UNLOADED) continue;
-    near |= st == NEAR;
-    if (st == STICKS) {
-      sticks = 1;
-      continue;
+    int nl = 0;
+    for (int i = i0; i < i1; i++) {
+      NPoint *P = w->pt + i;
+      double *lam = lam_out + 3 * i, *K = with_H ? K_out + 6 * i : NULL;
+      int st = !(with_imp && P->imp) ? point_law(&M, P, A->V, lam, K)
+                                     : imp_law(&M, P, A->V, mu + 2 * i, lam, K, ie + i);
+      if (st == UNLOADED) continue;
+      near |= st == NEAR;
+      if (st == STICKS) {
+        sticks = 1;
+        continue;
+      }
+      live[nl++] = i;
+      if (with_H && with_imp && P->imp) imp_eliminate(P, ie + i, w->reg, A);
     }
-    const double r0 = P->r[0], r1 = P->r[1], r2 = P->r[2];
-    const double ln = lam[0], l1 = lam[1], l2 = lam[2];
-    A->F[0] += r1 * l2 - r2 * l1;
-    A->F[1] += r2 * ln - r0 * l2;
-    A->F[2] += r0 * l1 - r1 * ln;
-    A->F[3] += ln;
-    A->F[4] += l1;
-    A->F[5] += l2;
-    if (!with_H) continue;
-    if (with_imp && P->imp) imp_eliminate(P, ie + i, w->reg, A);
-    /* K = [[kn, 0, 0], [k1n, k11, k12], [k2n, k12, k22]] and the blocks of
-     * J^T K J written out: K (-[r]x), [r]x K and [r]x K (-[r]x) */
-    const double kn = K[0], k1n = K[1], k2n = K[2], k11 = K[3], k12 = K[4], k22 = K[5];
-    for (int k = 0; k < 6; k++) A->K[k] += K[k];
-    /* K (-[r]x), row by row */
-    double q01 = kn * r2, q02 = -kn * r1;
-    double q10 = k12 * r1 - k11 * r2, q11 = k1n * r2 - k12 * r0, q12 = k11 * r0 - k1n * r1;
-    double q20 = k22 * r1 - k12 * r2, q21 = k2n * r2 - k22 * r0, q22 = k12 * r0 - k2n * r1;
-    A->vw[1] += q01;
-    A->vw[2] += q02;
-    A->vw[3] += q10;
-    A->vw[4] += q11;
-    A->vw[5] += q12;
-    A->vw[6] += q20;
-    A->vw[7] += q21;
-    A->vw[8] += q22;
-    /* [r]x K */
-    A->wv[0] += r1 * k2n - r2 * k1n;
-    A->wv[1] += r1 * k12 - r2 * k11;
-    A->wv[2] += r1 * k22 - r2 * k12;
-    A->wv[3] += r2 * kn - r0 * k2n;
-    A->wv[4] -= r0 * k12;
-    A->wv[5] -= r0 * k22;
-    A->wv[6] += r0 * k1n - r1 * kn;
-    A->wv[7] += r0 * k11;
-    A->wv[8] += r0 * k12;
-    /* [r]x (K (-[r]x)): the rows of [r]x times the columns of q */
-    A->ww[0] += r1 * q20 - r2 * q10;
-    A->ww[1] += r1 * q21 - r2 * q11;
-    A->ww[2] += r1 * q22 - r2 * q12;
-    A->ww[3] -= r0 * q20;
-    A->ww[4] += r2 * q01 - r0 * q21;
-    A->ww[5] += r2 * q02 - r0 * q22;
-    A->ww[6] += r0 * q10;
-    A->ww[7] += r0 * q11 - r1 * q01;
-    A->ww[8] += r0 * q12 - r1 * q02;
-    /* kept for the linear end of a step (apply_linear); here, after the
-     * sums (stored before them, or copied as an array, GCC's code for
-     * the sums came out 3-4 % of the step dearer) */
-    double *Ko = K_out + 6 * i;
-    Ko[0] = kn;
-    Ko[1] = k1n;
-    Ko[2] = k2n;
-    Ko[3] = k11;
-    Ko[4] = k12;
-    Ko[5] = k22;
+    /* F' = (sum r x lambda; sum lambda), point by point (in local
+     * accumulators, which stay in registers) */
+    double f0 = A->F[0], f1 = A->F[1], f2 = A->F[2], f3 = A->F[3], f4 = A->F[4], f5 = A->F[5];
+    for (int k = 0; k < nl; k++) {
+      const int i = live[k];
+      const double *r = w->pt[i].r, *lam = lam_out + 3 * i;
+      const double r0 = r[0], r1 = r[1], r2 = r[2], ln = lam[0], l1 = lam[1], l2 = lam[2];
+      f0 += r1 * l2 - r2 * l1;
+      f1 += r2 * ln - r0 * l2;
+      f2 += r0 * l1 - r1 * ln;
+      f3 += ln;
+      f4 += l1;
+      f5 += l2;
+    }
+    A->F[0] = f0;
+    A->F[1] = f1;
+    A->F[2] = f2;
+    A->F[3] = f3;
+    A->F[4] = f4;
+    A->F[5] = f5;
+    if (with_H) h_sums(w->pt, K_out, live, nl, A);
   }
   for (int g = 0; g < s->ngroup; g++) {
     const NSum *A = w->sum + g;
