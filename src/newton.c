@@ -519,12 +519,14 @@ static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint 
   if (M->rj > 0) mob = mobil_point(P, P->x0 + M->rj * sigma, &e);
   double T = tf * mob;
   lam[0] = ln;
-  lam[1] = lam[2] = 0;
-  if (K) K[1] = K[2] = K[3] = K[4] = K[5] = 0;
   if (K) K[0] = kn;
-  if (!(T > 0)) return LOADED;
   double Tg = T * P->gtt;
-  if (!(sigma > 0) || Tg > STICK_RATIO * sigma) return STICKS;
+  if (!(T > 0) || !(sigma > 0) || Tg > STICK_RATIO * sigma) {
+    /* no shear bound (LOADED), or sticking (STICKS) */
+    lam[1] = lam[2] = 0;
+    if (K) K[1] = K[2] = K[3] = K[4] = K[5] = 0;
+    return T > 0 ? STICKS : LOADED;
+  }
   double is = 1 / sigma, t1 = v1 * is, t2 = v2 * is;
   lam[1] = -T * t1;
   lam[2] = -T * t2;
@@ -981,17 +983,22 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
       gprev = g;
       M = mat_of(w->grp + g, dt);
     }
-    /* on a copy: the points' memos stay at the last evaluation's y, so
-     * that H formed there later (ss_newton_solve) is what the evaluation
-     * would have formed */
-    NPoint P = w->pt[i];
+    /* the points' memos are put back after: they stay at the last
+     * evaluation's y, so that H formed there later (ss_newton_solve) is
+     * what the evaluation would have formed */
+    NPoint *P = w->pt + i;
+    const ssPowMemo pw = P->pw;
+    const ssExpMemo mob = P->mob;
     double lam[3], dn;
-    if (P.imp) {
-      dn = imp_check(&M, &P, w->grp + g, w->sum[g].V, c->lambda);
+    if (P->imp) {
+      dn = imp_check(&M, P, w->grp + g, w->sum[g].V, c->lambda);
     } else {
-      if (point_law(&M, &P, w->sum[g].V, lam, NULL) == STICKS) return INFINITY;
+      int st = point_law(&M, P, w->sum[g].V, lam, NULL);
       dn = fabs(lam[0] - c->lambda[0]) + fabs(lam[1] - c->lambda[1]) + fabs(lam[2] - c->lambda[2]);
+      if (st == STICKS) dn = INFINITY;
     }
+    P->pw = pw;
+    P->mob = mob;
     measure_add(&q, dn, fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]));
   }
   for (int r = 0; r < s->nrow; r++) {
