@@ -330,7 +330,11 @@ static int ltdl_factor(ssArtWork *w)
 {
   int n = w->nv;
   double *H = w->L;
-  memcpy(H, w->M, (size_t)n * n * sizeof(double));
+  /* M's entries on the tree's pattern (k and its ancestors, the only
+   * ones the factor and ltdl_solve read; the rest of L stays as calloc
+   * left it) */
+  for (int k = 0; k < n; k++)
+    for (int j = k; j >= 0; j = w->dof_parent[j]) H[k * n + j] = w->M[k * n + j];
   double dmax = 0;
   for (int k = 0; k < n; k++) dmax = fmax(dmax, fabs(H[k * n + k]));
   for (int k = n - 1; k >= 0; k--) {
@@ -429,11 +433,22 @@ static void body_point(const ssData *d, int b, const double local[3], double p[3
   ss_v3_add(p, p, d->body_xpos + 3 * b);
 }
 
-/* closure rows K (nrow x nv) and residual phi at the current kinematics */
+/* r[k] = 0 for the dofs k on body b's path (those point_row adds to) */
+static void path_zero(const ssModel *m, const ssArtWork *w, int b, double *r)
+{
+  for (int a = b; a >= 0; a = m->body_parent[a]) {
+    int k0 = m->body_dofadr[a] - w->v0;
+    for (int k = k0; k < k0 + m->body_ndof[a]; k++) r[k] = 0;
+  }
+}
+
+/* closure rows K (nrow x nv) and residual phi at the current kinematics.
+ * A row's entries on its two bodies' paths are zeroed and summed anew;
+ * the rest of the row is never written and stays the zeros of K's calloc
+ * (the closures and their rows are fixed), without a memset per call */
 static void closures(const ssModel *m, const ssData *d, ssArtWork *w)
 {
   int n = w->nv, r = 0;
-  memset(w->K, 0, (size_t)w->nrow * n * sizeof(double));
   for (int e = 0; e < w->neq; e++) {
     int k = w->eq[e], b1 = m->eq_body[2 * k], b2 = m->eq_body[2 * k + 1];
     const double *an = m->eq_anchor + 6 * k;
@@ -445,6 +460,8 @@ static void closures(const ssModel *m, const ssData *d, ssArtWork *w)
       for (int i = 0; i < 3; i++) {
         double dir[3] = {i == 0, i == 1, i == 2};
         w->phi[r] = p1[i] - p2[i];
+        path_zero(m, w, b1, w->K + (size_t)r * n);
+        path_zero(m, w, b2, w->K + (size_t)r * n);
         point_row(m, w, b1, p1, dir, 1, w->K + (size_t)r * n);
         point_row(m, w, b2, p2, dir, -1, w->K + (size_t)r * n);
         r++;
@@ -458,6 +475,8 @@ static void closures(const ssModel *m, const ssData *d, ssArtWork *w)
       ss_v3_sub(dv, p1, p2);
       double len = ss_v3_normalize(dv);
       w->phi[r] = len - m->eq_data[2 * k];
+      path_zero(m, w, b1, w->K + (size_t)r * n);
+      path_zero(m, w, b2, w->K + (size_t)r * n);
       point_row(m, w, b1, p1, dv, 1, w->K + (size_t)r * n);
       point_row(m, w, b2, p2, dv, -1, w->K + (size_t)r * n);
       r++;
@@ -466,6 +485,8 @@ static void closures(const ssModel *m, const ssData *d, ssArtWork *w)
     case SS_CLOSURE_EQUALITY: {
       double ratio = m->eq_data[2 * k], off = m->eq_data[2 * k + 1];
       w->phi[r] = d->qpos[m->body_qadr[b1]] - ratio * d->qpos[m->body_qadr[b2]] - off;
+      w->K[(size_t)r * n + m->body_dofadr[b1] - w->v0] = 0;
+      w->K[(size_t)r * n + m->body_dofadr[b2] - w->v0] = 0;
       w->K[(size_t)r * n + m->body_dofadr[b1] - w->v0] += 1;
       w->K[(size_t)r * n + m->body_dofadr[b2] - w->v0] -= ratio;
       r++;
@@ -676,8 +697,10 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
     }
   }
 
-  /* CRBA: M[k][j] = S_j . (Ic_b S_k) for j on the path of k */
-  memset(w->M, 0, (size_t)n * n * sizeof(double));
+  /* CRBA: M[k][j] = S_j . (Ic_b S_k) for j on the path of k.  These are
+   * the only entries ever written (here, by the dampers on the diagonal
+   * and by the springs along one chain), each step anew: the others
+   * stay the zeros of M's calloc, without a memset a step */
   for (int lb = 0; lb < w->nb; lb++) {
     int b = b0 + lb, nd = m->body_ndof[b];
     if (!nd) continue;
@@ -736,7 +759,9 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
       double c = dt * (par[1] + dt * par[0]);
       for (int i = 0; i < n; i++) {
         if (Js[i] == 0) continue;
-        for (int j = 0; j < n; j++) w->M[i * n + j] += c * Js[i] * Js[j];
+        /* (the chain's pairs only: M's other entries stay zero) */
+        for (int j = 0; j < n; j++)
+          if (Js[j] != 0) w->M[i * n + j] += c * Js[i] * Js[j];
         w->rhs[i] -= dt * tension * Js[i];
       }
     } else {
