@@ -1229,7 +1229,13 @@ static int switch_all(ssNewtonWork *w, const Setup *s)
 static void lam_matrix(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork *w)
 {
   int n = s->n, ng = s->ngroup;
-  memset(w->Lam, 0, (size_t)n * n * sizeof(double));
+  /* every entry is written below where all groups are links of one
+   * system and every row is of it too (the buggy); else the blocks
+   * between systems, and a free body's with the rest, are zero */
+  int sys = ng > 0 ? w->grp[0].sys : s->nrow > 0 ? d->contact[s->first_row].sys : -1, full = 1;
+  for (int g = 0; g < ng; g++) full &= w->grp[g].link >= 0 && w->grp[g].sys == sys;
+  for (int r = 0; r < s->nrow; r++) full &= d->contact[s->first_row + r].sys == sys;
+  if (!full) memset(w->Lam, 0, (size_t)n * n * sizeof(double));
   for (int gc = 0; gc < ng; gc++) {
     const NGroup *Gc = w->grp + gc;
     if (Gc->link < 0) {
