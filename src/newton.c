@@ -1533,37 +1533,38 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     const ssContact *c = d->contact + i;
     if (c->type != SS_CONTACT_SOIL) return 0;
     int g = 0;
+    NGroup *G;
     if (i > 0 && c[-1].link == c->link && c[-1].sys == c->sys && c[-1].hfield == c->hfield) {
-      w->group_of[i] = g = w->group_of[i - 1];
+      /* the run goes on: the group and frame are the last point's */
+      g = w->group_of[i - 1];
+      G = w->grp + g;
     } else {
       if (!(c->nv > 0 && (c->link >= 0 || (c->nv == 6 && m->sys_type[c->sys] == SS_SYS_FREE))))
         return 0;
       while (g < ngroup && !(w->grp[g].link == c->link && w->grp[g].sys == c->sys &&
                              w->grp[g].mat == &m->hfield_soilmat[c->hfield]))
         g++;
-      w->group_of[i] = g;
+      if (g == w->cap_g && !work(d, 0, 0, 0, 2 * g + 4)) return 0;
+      G = w->grp + g;
+      if (g == ngroup) {
+        ngroup++;
+        G->link = c->link;
+        G->sys = c->sys;
+        G->body = c->link >= 0 ? c->link : m->geom_body[c->geom];
+        G->bed = c->hfield;
+        G->mat = &m->hfield_soilmat[c->hfield];
+        G->pt = ss_solver_pow_table(m, d, c->hfield);
+        G->ik = G->mat->shear_displacement > 0 ? 1 / G->mat->shear_displacement : 0;
+        G->kb = NAN;
+        memcpy(G->R, c->frame, sizeof G->R);
+        G->axes = c->bed_axes;
+        memcpy(G->o, c->pos, sizeof G->o);
+        if (c->link < 0) body_block(m, d, G->body, G->Yb);
+      } else if (memcmp(G->R, c->frame, sizeof G->R)) {
+        return 0;
+      }
     }
-    if (g == w->cap_g && !work(d, 0, 0, 0, 2 * g + 4)) return 0;
-    NGroup *G = w->grp + g;
-    if (i > 0 && g == w->group_of[i - 1] && c[-1].hfield == c->hfield) {
-      /* the run goes on: the group and frame are the last point's */
-    } else if (g == ngroup) {
-      ngroup++;
-      G->link = c->link;
-      G->sys = c->sys;
-      G->body = c->link >= 0 ? c->link : m->geom_body[c->geom];
-      G->bed = c->hfield;
-      G->mat = &m->hfield_soilmat[c->hfield];
-      G->pt = ss_solver_pow_table(m, d, c->hfield);
-      G->ik = G->mat->shear_displacement > 0 ? 1 / G->mat->shear_displacement : 0;
-      G->kb = NAN;
-      memcpy(G->R, c->frame, sizeof G->R);
-      G->axes = c->bed_axes;
-      memcpy(G->o, c->pos, sizeof G->o);
-      if (c->link < 0) body_block(m, d, G->body, G->Yb);
-    } else if (memcmp(G->R, c->frame, sizeof G->R)) {
-      return 0;
-    }
+    w->group_of[i] = g;
     /* the point's constants, its caches empty */
     NPoint *P = w->pt + i;
     const ssSoilMaterial *mat = G->mat;
