@@ -910,12 +910,32 @@ typedef struct {
   int key, pos;
 } SortItem;
 static int item_less(const SortItem *a, const SortItem *b) { return a->key < b->key; }
+enum { SORT_N = 97 }; /* the longest input */
 SS_SORT_RUNS(sort_items, SortItem, item_less)
+
+/* sort v[0, n) (t: its scratch) and compare with the stable insertion
+ * sort, element for element (key and original position); in_place: the
+ * result must also come back in v */
+static int sorts_stably(SortItem *v, SortItem *t, int n, int in_place)
+{
+  SortItem want[SORT_N];
+  memcpy(want, v, sizeof(SortItem) * (size_t)n);
+  for (int i = 1; i < n; i++)
+    for (int j = i; j > 0 && want[j].key < want[j - 1].key; j--) {
+      SortItem s = want[j];
+      want[j] = want[j - 1];
+      want[j - 1] = s;
+    }
+  SortItem *r = sort_items(v, t, n);
+  int same = 1;
+  for (int i = 0; i < n; i++) same &= r[i].key == want[i].key && r[i].pos == want[i].pos;
+  return same && (!in_place || r == v);
+}
 
 static void test_sort_runs(void)
 {
-  enum { N = 97 };
-  SortItem v[N], t[N], want[N];
+  enum { N = SORT_N };
+  SortItem v[N], t[N];
   uint32_t seed = 12345;
   int bad = 0, cases = 0;
   for (int c = 0; c < 400; c++) {
@@ -932,19 +952,9 @@ static void test_sort_runs(void)
       }
       v[i] = (SortItem){key, i};
     }
-    memcpy(want, v, sizeof(SortItem) * (size_t)n);
-    for (int i = 1; i < n; i++)
-      for (int j = i; j > 0 && want[j].key < want[j - 1].key; j--) {
-        SortItem s = want[j];
-        want[j] = want[j - 1];
-        want[j - 1] = s;
-      }
     int was_sorted = 1;
     for (int i = 1; i < n; i++) was_sorted &= v[i - 1].key <= v[i].key;
-    SortItem *r = sort_items(v, t, n);
-    int same = 1;
-    for (int i = 0; i < n; i++) same &= r[i].key == want[i].key && r[i].pos == want[i].pos;
-    if (!same || (was_sorted && r != v)) bad++;
+    bad += !sorts_stably(v, t, n, was_sorted);
     cases++;
   }
   ok(bad == 0, "SS_SORT_RUNS: %d of %d inputs (runs up and down, ties) in the stable order", cases - bad, cases);
@@ -959,19 +969,9 @@ static void test_sort_runs(void)
       int r = (int)(seed >> 24);
       v[i] = (SortItem){i < n - tail ? i / 3 : r % (n / 3 + 3) - 1, i};
     }
-    memcpy(want, v, sizeof(SortItem) * (size_t)n);
-    for (int i = 1; i < n; i++)
-      for (int j = i; j > 0 && want[j].key < want[j - 1].key; j--) {
-        SortItem s = want[j];
-        want[j] = want[j - 1];
-        want[j - 1] = s;
-      }
     int e0 = 1;
     while (e0 < n && v[e0 - 1].key <= v[e0].key) e0++;
-    SortItem *r = sort_items(v, t, n);
-    int same = 1;
-    for (int i = 0; i < n; i++) same &= r[i].key == want[i].key && r[i].pos == want[i].pos;
-    if (!same || (n - e0 <= SS_SORT_RUNS_TAIL && r != v)) bad++;
+    bad += !sorts_stably(v, t, n, n - e0 <= SS_SORT_RUNS_TAIL);
     cases++;
   }
   ok(bad == 0, "SS_SORT_RUNS: %d of %d runs with a short tail in the stable order, in place", cases - bad, cases);
