@@ -129,8 +129,7 @@ typedef struct NGroup {
   double o[3];        /* origin of the points' r (world) */
   const ssPowTable *pt; /* its bed's table of s^(n-1), or NULL */
   double ik;          /* 1 / K_j of its material, 0 for K_j = 0 */
-  double kb, kk;      /* the last width b its points had and the modulus
-                         ss_soil_modulus(mat, b) (kb NAN: none yet) */
+  ssModulusMemo mod;  /* its points' modulus, kept for their width */
   int axes;           /* R is an unturned bed's axes (ssContact.bed_axes):
                          r = R (p - o) a permutation */
 } NGroup;
@@ -993,9 +992,10 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
     if (P->imp) {
       dn = imp_check(&M, P, w->grp + g, w->sum[g].V, c->lambda);
     } else {
-      int st = point_law(&M, P, w->sum[g].V, lam, NULL);
-      dn = fabs(lam[0] - c->lambda[0]) + fabs(lam[1] - c->lambda[1]) + fabs(lam[2] - c->lambda[2]);
-      if (st == STICKS) dn = INFINITY;
+      dn = point_law(&M, P, w->sum[g].V, lam, NULL) == STICKS
+               ? INFINITY
+               : fabs(lam[0] - c->lambda[0]) + fabs(lam[1] - c->lambda[1]) +
+                     fabs(lam[2] - c->lambda[2]);
     }
     P->pw = pw;
     P->mob = mob;
@@ -1555,7 +1555,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
         G->mat = &m->hfield_soilmat[c->hfield];
         G->pt = ss_solver_pow_table(m, d, c->hfield);
         G->ik = G->mat->shear_displacement > 0 ? 1 / G->mat->shear_displacement : 0;
-        G->kb = NAN;
+        G->mod.b = NAN;
         memcpy(G->R, c->frame, sizeof G->R);
         G->axes = c->bed_axes;
         memcpy(G->o, c->pos, sizeof G->o);
@@ -1580,13 +1580,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     P->g0 = c->g0;
     P->sp = c->sp;
     P->S = c->area * m->opt.timestep;
-    /* the points of one collider share its width: its modulus (a
-     * division) is formed once, the same bits */
-    if (!(c->width == G->kb)) {
-      G->kb = c->width;
-      G->kk = ss_soil_modulus(mat, c->width);
-    }
-    P->k = G->kk;
+    P->k = ss_soil_modulus_at(mat, &G->mod, c->width);
     P->tf0 = P->S * mat->cohesion;
     /* x0 = j / K_j as the sweeps' law forms it (point.c, mobil_init):
      * the same bits, and no division a point */

@@ -18,6 +18,22 @@ static inline double ss_soil_modulus(const ssSoilMaterial *mat, double b)
   return (b > 0 && mat->bekker_kc != 0 ? mat->bekker_kc / b : 0) + mat->bekker_kphi;
 }
 
+/* ss_soil_modulus kept for the last width b (b NAN: none): the points of
+ * one collider share its width, so a loop over them forms it (a
+ * division) once, the same bits */
+typedef struct ssModulusMemo {
+  double b, k;
+} ssModulusMemo;
+
+static inline double ss_soil_modulus_at(const ssSoilMaterial *mat, ssModulusMemo *c, double b)
+{
+  if (!(b == c->b)) {
+    c->b = b;
+    c->k = ss_soil_modulus(mat, b);
+  }
+  return c->k;
+}
+
 /* A soil point's law (DESIGN 3.1) as its solve uses it (solver.c): set up
  * once per step from the contact and its material, plus the values the
  * solve reuses between visits -- the last power s^(n-1) and the last

@@ -437,7 +437,8 @@ void ss_terrain_update(const ssModel *m, ssData *d)
   int nload = 0, bed = -1;
   const ssSoilMaterial *mat = NULL;
   const ssPowTable *pt = NULL;
-  double n1 = 0, kb = NAN, kk = 0; /* the last width and its modulus */
+  double n1 = 0;
+  ssModulusMemo mod = {NAN, 0};
   for (int i = 0; i < d->ncontact; i++) {
     ssContact *c = d->contact + i;
     if (c->type != SS_CONTACT_SOIL) {
@@ -451,16 +452,11 @@ void ss_terrain_update(const ssModel *m, ssData *d)
       mat = &m->hfield_soilmat[bed];
       pt = ss_solver_pow_table(m, d, bed);
       n1 = mat->sinkage_exponent - 1;
-      kb = NAN;
-    }
-    /* a collider's points share its width: one division for them */
-    if (!(c->width == kb)) {
-      kb = c->width;
-      kk = ss_soil_modulus(mat, kb);
+      mod.b = NAN;
     }
     double delta = -(c->g0 + dt * c->v[0]);
     double s = c->sp + delta;
-    double spn = ss_soil_plastic_update_pow(mat, kk, s, c->sp,
+    double spn = ss_soil_plastic_update_pow(mat, ss_soil_modulus_at(mat, &mod, c->width), s, c->sp,
                                             n1 == 0 ? 1 : pt ? ss_pow_tab(pt, s) : pow(s, n1));
     double jn = c->j + dt * sqrt(c->v[1] * c->v[1] + c->v[2] * c->v[2]);
     int v = c->vertex;
