@@ -433,13 +433,11 @@ static void body_point(const ssData *d, int b, const double local[3], double p[3
   ss_v3_add(p, p, d->body_xpos + 3 * b);
 }
 
-/* r[k] = 0 for the dofs k on body b's path (those point_row adds to) */
+/* r[k] = 0 for the dofs k on body b's path (those point_row adds to):
+ * the LTDL chain from its last dof */
 static void path_zero(const ssModel *m, const ssArtWork *w, int b, double *r)
 {
-  for (int a = b; a >= 0; a = m->body_parent[a]) {
-    int k0 = m->body_dofadr[a] - w->v0;
-    for (int k = k0; k < k0 + m->body_ndof[a]; k++) r[k] = 0;
-  }
+  for (int k = last_dof(m, w, b); k >= 0; k = w->dof_parent[k]) r[k] = 0;
 }
 
 /* closure rows K (nrow x nv) and residual phi at the current kinematics.

@@ -265,24 +265,10 @@ static inline uint64_t entry_key(const ssWarmEntry *e)
   return warm_key(e->geom, e->vertex);
 }
 
-/* entry e against the key (geom, vertex): <0, 0, >0, the order of
- * warm_key in two comparisons (the sort's, where most pairs differ in the
- * geom or not at all) */
-static inline int cmp_key(const ssWarmEntry *e, int geom, int vertex)
-{
-  unsigned ge = (unsigned)e->geom, g = (unsigned)geom;
-  if (ge != g) return (ge > g) - (ge < g);
-  return (e->vertex > vertex) - (e->vertex < vertex);
-}
-
-static int cmp_warm(const ssWarmEntry *a, const ssWarmEntry *b)
-{
-  return cmp_key(a, b->geom, b->vertex);
-}
-
 int ss_solver_warm_cmp(const ssWarmEntry *a, const ssWarmEntry *b)
 {
-  return cmp_warm(a, b);
+  uint64_t ka = entry_key(a), kb = entry_key(b);
+  return (ka > kb) - (ka < kb);
 }
 
 /* cache key of a joint row: its dof and kind (PD, or the limit's side) */
@@ -504,8 +490,7 @@ static int cached(const ssContact *c)
          (c->type == SS_CONTACT_SOIL && c->lambda[0] > 0);
 }
 
-/* Sort the n cache entries of a by key (warm_key: cmp_warm's order in one
- * comparison), b being as large; returns whichever of a and b ends
+/* Sort the n cache entries of a by key (warm_key), b being as large; returns whichever of a and b ends
  * holding them.  The contacts come in a few ascending runs (one per bed,
  * then the joint rows: the PD rows in the model's order, then the
  * limits), so neighbouring runs are merged pairwise until one is left: a

@@ -12,9 +12,10 @@
  * short tail: SS_SORT_RUNS_TAIL).  Each pass finds the runs -- non-
  * decreasing, or strictly decreasing and then reversed in place -- and
  * merges them pairwise, taking the left element on ties: the sort is
- * stable, so its result is the one stable order, whatever the runs.  Linear for input already sorted, a few passes for a
- * few runs; no allocation and no call through a pointer per comparison
- * (the element type and comparison are the caller's, inlined). */
+ * stable, so its result is the one stable order, whatever the runs.
+ * Linear for input already sorted, a few passes for a few runs; no
+ * allocation and no call through a pointer per comparison (the element
+ * type and comparison are the caller's, inlined). */
 #ifndef SS_SORT_RUNS_H
 #define SS_SORT_RUNS_H
 
