@@ -92,7 +92,8 @@ typedef struct NPoint {
                          (rows n, t1, t2) */
   double g0, sp, S;   /* start separation, rut depth, A dt */
   double k, tf0;      /* k_c/b + k_phi; A dt c */
-  double x0, gtt;     /* j/K_j; largest diagonal entry of G_tt */
+  double x0, gtt;     /* j/K_j; largest diagonal entry of G_tt, formed
+                         where first needed (point_gtt; < 0: not yet) */
   ssPowMemo pw;       /* last s^(n-1) (pw.s = 0: none) */
   ssExpMemo mob;      /* last x = x0 + sigma dt/K_j, 1 - exp(-x), exp(-x)
                          (mob.x < 0: none) */
@@ -124,6 +125,8 @@ typedef struct NGroup {
   double Lg[36];      /* its Lam in the group's frame (group_lam) */
   double gq[12];      /* the points' G_11, G_22 as quadratics in r
                          (slip_quadratics of Lg) */
+  double rmax[3];     /* the largest |r_k| of its points */
+  double gmax;        /* a bound on its points' G_tt (slip_bound) */
   const ssSoilMaterial *mat;
   double R[9];        /* contact frame rows n, t1, t2 (world) */
   double o[3];        /* origin of the points' r (world) */
@@ -429,11 +432,30 @@ static double slip_response(const double q[12], const double r[3])
   return g1 > g2 ? g1 : g2;
 }
 
+/* An upper bound on slip_response over the points with |r_k| <= R_k:
+ * each term's magnitude at R, summed in slip_response's order (rounding
+ * is monotone, so the sum of the magnitudes is never below the sum that
+ * slip_response rounds), doubled for good measure.  The law needs a
+ * point's G_tt only where T G_tt may pass IMP_RATIO |v_t|, which the
+ * bound rules out for nearly every point (T G_tt / |v_t| is below 1e-2
+ * of it on the rolling buggy and the settled plate), so G_tt is formed
+ * only there (point_gtt) instead of for every point at the set-up. */
+static double slip_bound(const double q[12], const double R[3])
+{
+  double g1 = fabs(q[0]) * R[2] * R[2] + fabs(q[1]) * R[0] * R[0] + fabs(q[2]) +
+              fabs(q[3]) * R[0] * R[2] + fabs(q[4]) * R[2] + fabs(q[5]) * R[0];
+  double g2 = fabs(q[6]) * R[1] * R[1] + fabs(q[7]) * R[0] * R[0] + fabs(q[8]) +
+              fabs(q[9]) * R[0] * R[1] + fabs(q[10]) * R[1] + fabs(q[11]) * R[0];
+  return 2 * (g1 > g2 ? g1 : g2);
+}
+
 /* a bed material's constants as the law uses them */
 typedef struct Mat {
   double dt, n, Ke, D, mu, rj; /* rj = dt / K_j, 0 when K_j = 0 */
   int linear;
   ssPowSeries pser;            /* of s^(n-1), when not linear */
+  const double *gq;            /* its group's slip_quadratics */
+  double gmax;                 /* and bound on G_tt (slip_bound) */
 } Mat;
 
 static Mat mat_of(const NGroup *G, double dt)
@@ -442,12 +464,19 @@ static Mat mat_of(const NGroup *G, double dt)
   Mat M = {dt, mat->sinkage_exponent,
            mat->elastic_stiffness, mat->damping, mat->friction_coefficient,
            mat->shear_displacement > 0 ? dt / mat->shear_displacement : 0,
-           mat->sinkage_exponent == 1.0, {0, {0}, 0, NULL}};
+           mat->sinkage_exponent == 1.0, {0, {0}, 0, NULL}, G->gq, G->gmax};
   if (!M.linear) {
     M.pser = ss_pow_series(M.n - 1);
     M.pser.tab = G->pt;
   }
   return M;
+}
+
+/* a point's G_tt, formed at its first use */
+static inline double point_gtt(const double gq[12], NPoint *P)
+{
+  if (P->gtt < 0) P->gtt = slip_response(gq, P->r);
+  return P->gtt;
 }
 
 enum { UNLOADED = 0, LOADED = 1, STICKS = 2, NEAR = 3 };
@@ -519,7 +548,9 @@ static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint 
   double T = tf * mob;
   lam[0] = ln;
   if (K) K[0] = kn;
-  double Tg = T * P->gtt;
+  /* T G_tt, where the group's bound lets it pass IMP_RATIO |v_t| (else
+   * 0: both tests below fail for it as for T G_tt) */
+  double Tg = T * M->gmax > IMP_RATIO * sigma ? T * point_gtt(M->gq, P) : 0;
   if (!(T > 0) || !(sigma > 0) || Tg > STICK_RATIO * sigma) {
     /* no shear bound (LOADED), or sticking (STICKS) */
     lam[1] = lam[2] = 0;
@@ -1192,6 +1223,7 @@ static int switch_points(const ssModel *m, const ssData *d, const Setup *s, ssNe
     if (st == STICKS) ss_solver_warm_lambda(m, d, i, warm);
     const double *m0 = st == STICKS ? warm + 1 : lam + 1;
     w->pt[i].imp = 1;
+    point_gtt(w->grp[g].gq, w->pt + i);
     w->imp[w->ns++] = i;
     w->mu[2 * i] = m0[0];
     w->mu[2 * i + 1] = m0[1];
@@ -1210,6 +1242,7 @@ static int switch_all(ssNewtonWork *w, const Setup *s)
     const double *l = w->lam + 3 * i;
     if (P->imp || !(l[0] > 0)) continue;
     P->imp = 1;
+    point_gtt(w->grp[w->group_of[i]].gq, P);
     w->imp[w->ns++] = i;
     w->mu[2 * i] = l[1];
     w->mu[2 * i + 1] = l[2];
@@ -1559,6 +1592,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
         memcpy(G->R, c->frame, sizeof G->R);
         G->axes = c->bed_axes;
         memcpy(G->o, c->pos, sizeof G->o);
+        G->rmax[0] = G->rmax[1] = G->rmax[2] = 0;
         if (c->link < 0) body_block(m, d, G->body, G->Yb);
       } else if (memcmp(G->R, c->frame, sizeof G->R)) {
         return 0;
@@ -1588,23 +1622,27 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     P->pw.s = 0;
     P->mob = ss_exp_memo_start(P->x0);
     P->imp = 0;
+    P->gtt = -1;
+    for (int k = 0; k < 3; k++) {
+      double a = fabs(P->r[k]);
+      if (a > G->rmax[k]) G->rmax[k] = a;
+    }
   }
   int n = 6 * ngroup + nrow;
   if (!work(d, n, 0, 0, ngroup)) return 0;
   Setup s = {ngroup, nrow, n, first_row};
 
   lam_matrix(m, d, &s, w);
-  /* the stick test's G_tt of each point, from its group's diagonal block
-   * of Lam */
+  /* the stick test's G_tt, from each group's diagonal block of Lam: the
+   * quadratics that give a point's, and their bound over the group */
   for (int g = 0; g < ngroup; g++) {
     double Lb[36];
     for (int a = 0; a < 6; a++)
       for (int k = 0; k < 6; k++) Lb[6 * a + k] = w->Lam[(size_t)(6 * g + a) * n + 6 * g + k];
     group_lam(w->grp + g, Lb, w->grp[g].Lg);
     slip_quadratics(w->grp[g].Lg, w->grp[g].gq);
+    w->grp[g].gmax = slip_bound(w->grp[g].gq, w->grp[g].rmax);
   }
-  for (int i = 0; i < first_row; i++)
-    w->pt[i].gtt = slip_response(w->grp[w->group_of[i]].gq, w->pt[i].r);
   unknowns_of(m, d, &s, w, d->qvel_free, w->yfree);
   uint64_t key = unknowns_key(d, &s, w);
   int from_last = *predicted = may_predict && predict(m, d, &s, w, key);
