@@ -50,6 +50,9 @@ struct ssArtWork {
   double *Xd, *XDd, *Wd;
   unsigned char *dok;
   int rank_deficient;    /* rows dropped in the last factorization */
+  double *kin_q;         /* (the system's nq) the qpos of the last
+                            ss_art_forward, whose poses and S stand */
+  int kin_ok;            /* 0: no ss_art_forward yet */
 };
 
 /* ---------------------------------------------------------------------- */
@@ -142,7 +145,7 @@ void ss_art_work_free(ssArtWork *w)
   free(w->Y); free(w->Lam); free(w->Yok);
   free(w->path); free(w->npath); free(w->Xp); free(w->XD); free(w->Wp); free(w->Xok);
   free(w->fsum); free(w->dpath); free(w->dnp); free(w->Xd); free(w->XDd); free(w->Wd);
-  free(w->dok);
+  free(w->dok); free(w->kin_q);
   free(w);
 }
 
@@ -193,7 +196,8 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
   w->XDd = calloc(nv * nv, sizeof(double));
   w->Wd = calloc(nv * nr, sizeof(double));
   w->dok = calloc(nv, 1);
-  if (!w->path || !w->npath || !w->Xp || !w->XD || !w->Wp || !w->Xok || !w->fsum ||
+  w->kin_q = calloc(m->sys_nq[s] ? (size_t)m->sys_nq[s] : 1, sizeof(double));
+  if (!w->kin_q || !w->path || !w->npath || !w->Xp || !w->XD || !w->Wp || !w->Xok || !w->fsum ||
       !w->dpath || !w->dnp || !w->Xd || !w->XDd || !w->Wd || !w->dok) {
     ss_art_work_free(w);
     return NULL;
@@ -321,6 +325,16 @@ void ss_art_forward(const ssModel *m, ssData *d, int s)
       break;
     }
   }
+  memcpy(w->kin_q, d->qpos + m->sys_qadr[s], (size_t)m->sys_nq[s] * sizeof(double));
+  w->kin_ok = 1;
+}
+
+/* (articulated.h) */
+int ss_art_forward_current(const ssModel *m, const ssData *d, int s)
+{
+  const ssArtWork *w = d->art[s];
+  return w->kin_ok &&
+         !memcmp(w->kin_q, d->qpos + m->sys_qadr[s], (size_t)m->sys_nq[s] * sizeof(double));
 }
 
 /* ---------------------------------------------------------------------- */

@@ -66,6 +66,11 @@ void ss_art_work_free(ssArtWork *w);
 
 /* Body poses, centres of mass and motion subspaces from qpos. */
 void ss_art_forward(const ssModel *m, ssData *d, int sys);
+/* 1 if the system's poses and motion subspaces are ss_art_forward's at
+ * the current qpos: the last ss_art_forward ran at these very bytes of
+ * its qpos (the model is immutable, and nothing else writes them), so
+ * running it again would give the same bits. */
+int ss_art_forward_current(const ssModel *m, const ssData *d, int sys);
 /* qvel <- constrained free velocity; prepares the responses for contacts.
  * Returns SS_ERR_NUMERIC when the mass matrix is not positive definite. */
 ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int sys,

@@ -1,6 +1,7 @@
 /* data.c -- the mutable state of a world and its accessors. */
 #include "soilsim.h"
 #include "articulated.h"
+#include "dynamics.h"
 #include "solver.h"
 #include "ss_math.h"
 
@@ -103,11 +104,11 @@ void ss_data_reset(const ssModel *m, ssData *d)
   ss_forward(m, d);
 }
 
-void ss_forward(const ssModel *m, ssData *d)
+static void forward(const ssModel *m, ssData *d, int reuse)
 {
   for (int s = 0; s < m->nsys; s++) {
     if (m->sys_type[s] == SS_SYS_ARTICULATED) {
-      ss_art_forward(m, d, s);
+      if (!(reuse && ss_art_forward_current(m, d, s))) ss_art_forward(m, d, s);
       continue;
     }
     /* single bodies: qpos holds the pose of the body frame (its COM) */
@@ -127,6 +128,17 @@ void ss_forward(const ssModel *m, ssData *d)
     ss_quat_to_mat(Rg, m->geom_quat + 4 * g);
     ss_m3_mul(d->geom_xmat + 9 * g, R, Rg);
   }
+}
+
+void ss_forward(const ssModel *m, ssData *d)
+{
+  forward(m, d, 0);
+}
+
+/* (dynamics.h) */
+void ss_forward_step(const ssModel *m, ssData *d)
+{
+  forward(m, d, 1);
 }
 
 ssStatus ss_remove(const ssModel *m, ssData *d, const char *name, ssError *err)

@@ -5,6 +5,11 @@
 
 #include "soilsim.h"
 
+/* ss_forward as a step runs it: an articulated system whose poses are
+ * ss_art_forward's at the current qpos already (ss_art_forward_current:
+ * the end of the last step, or the loop-closure projection's last pass)
+ * is not formed again; the same bits as ss_forward. */
+void ss_forward_step(const ssModel *m, ssData *d);
 /* qvel <- qvel + dt M^-1 (gravity + external forces - gyroscopic terms),
  * for articulated systems with their force elements and loop closures. */
 ssStatus ss_dyn_free_velocity(const ssModel *m, ssData *d, ssError *err);

@@ -34,8 +34,9 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
   double *t = d->stats.time_stage, t0 = now(), t1;
   ssStatus st = SS_OK;
 
-  /* poses of bodies and colliders from qpos */
-  ss_forward(m, d);
+  /* poses of bodies and colliders from qpos (an articulated system's
+   * stand where the last step left them for this qpos) */
+  ss_forward_step(m, d);
   t1 = now(); t[0] = t1 - t0; t0 = t1;
 
   /* velocities under gravity, external loads, force elements and loop
@@ -67,7 +68,7 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
   /* positions from the new velocities; loop-closure drift removed */
   d->closure_error = 0;
   ss_dyn_integrate(m, d);
-  ss_forward(m, d);
+  ss_forward_step(m, d);
   t1 = now(); t[5] = t1 - t0; t0 = t1;
 
   bad = ss_dyn_check_finite(m, d);
