@@ -53,6 +53,9 @@ struct ssArtWork {
   double *kin_q;         /* (the system's nq) the qpos of the last
                             ss_art_forward, whose poses and S stand */
   int kin_ok;            /* 0: no ss_art_forward yet */
+  unsigned long kin_gen; /* ss_art_forward's runs */
+  unsigned long clo_gen; /* kin_gen where closures last formed K and phi
+                            (they depend on the poses, S and qpos alone) */
 };
 
 /* ---------------------------------------------------------------------- */
@@ -210,6 +213,7 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
     return NULL;
   }
   sys_closures(m, s, w->eq, NULL);
+  w->clo_gen = (unsigned long)-1;
   /* LTDL parent of each dof: the previous dof of its joint, else the last
    * dof of the nearest ancestor that has one */
   for (int lb = 0; lb < w->nb; lb++) {
@@ -327,6 +331,7 @@ void ss_art_forward(const ssModel *m, ssData *d, int s)
   }
   memcpy(w->kin_q, d->qpos + m->sys_qadr[s], (size_t)m->sys_nq[s] * sizeof(double));
   w->kin_ok = 1;
+  w->kin_gen++;
 }
 
 /* (articulated.h) */
@@ -461,6 +466,7 @@ static void path_zero(const ssModel *m, const ssArtWork *w, int b, double *r)
 static void closures(const ssModel *m, const ssData *d, ssArtWork *w)
 {
   int n = w->nv, r = 0;
+  w->clo_gen = w->kin_gen;
   for (int e = 0; e < w->neq; e++) {
     int k = w->eq[e], b1 = m->eq_body[2 * k], b2 = m->eq_body[2 * k + 1];
     const double *an = m->eq_anchor + 6 * k;
@@ -793,7 +799,10 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
   memcpy(u, w->rhs, (size_t)n * sizeof(double));
   ltdl_solve(w, u, 1);
   if (w->nrow) {
-    closures(m, d, w);
+    /* K and phi stand where the poses do since closures formed them (the
+     * closure projection's last pass of the step before, whose poses this
+     * step kept: ss_forward_step) */
+    if (w->clo_gen != w->kin_gen) closures(m, d, w);
     factor_closures(w);
     project(w, u);
   }
