@@ -1190,8 +1190,14 @@ static void lu_solve(const double *A, const int *piv, int n, double *x)
       x[k] = x[piv[k]];
       x[piv[k]] = t;
     }
-  for (int k = 0; k < n; k++)
-    for (int i = k + 1; i < n; i++) x[i] -= A[i * n + k] * x[k];
+  /* L's substitution row by row: x_i's updates are those of the column
+   * sweep (x_i -= l_ik x_k for k = 0, 1, ...), in the same order, with
+   * x_i in a register and l_i read along its row */
+  for (int i = 1; i < n; i++) {
+    double t = x[i];
+    for (int k = 0; k < i; k++) t -= A[i * n + k] * x[k];
+    x[i] = t;
+  }
   for (int k = n - 1; k >= 0; k--) {
     double t = x[k];
     for (int j = k + 1; j < n; j++) t -= A[k * n + j] * x[j];
