@@ -694,12 +694,6 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
     first_row--;
   int rows = first_row < d->ncontact;
 
-  /* runs of contacts on one link (packed groups) */
-  for (int i = first_row - 1; i >= 0; i--) {
-    ssContact *c = d->contact + i;
-    c->run = 1;
-    if (c->link >= 0 && i + 1 < first_row && c[1].link == c->link) c->run += c[1].run;
-  }
   int pack = !d->solver_full;
 
   /* Newton on the contact links' velocities, where it applies: its answer
@@ -731,9 +725,15 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
    * answer (which left nothing pending) */
   ss_solver_warm_apply(m, d);
 
-  /* what only the sweeps use: the body contacts' responses (a rigid
-   * body's J, W and G, a link contact's X, LX and G), and the soil points' laws
-   * (the Newton phase has its own) */
+  /* what only the sweeps use: the runs of contacts on one link (packed
+   * groups), the body contacts' responses (a rigid body's J, W and G, a
+   * link contact's X, LX and G), and the soil points' laws (the Newton
+   * phase has its own) */
+  for (int i = first_row - 1; i >= 0 && sweeps > 0; i--) {
+    ssContact *c = d->contact + i;
+    c->run = 1;
+    if (c->link >= 0 && i + 1 < first_row && c[1].link == c->link) c->run += c[1].run;
+  }
   for (int i = 0; i < d->ncontact && sweeps > 0; i++) {
     ssContact *c = d->contact + i;
     double *J = d->jac + c->jadr;
