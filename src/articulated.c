@@ -27,6 +27,9 @@ struct ssArtWork {
   double *L;             /* (nv x nv) LTDL factor of M' */
   double *rhs, *x, *y;   /* (nv) scratch */
   double *K;             /* (nrow x nv) closure Jacobian */
+  int *kcol, *nkcol;     /* (nrow x nv), (nrow) each row's columns that
+                            closures may write (its bodies' paths, or its
+                            two dofs), ascending: K is zero elsewhere */
   double *phi;           /* (nrow) closure residual */
   double *MiKT;          /* (nv x nrow) M'^-1 K^T */
   double *A;             /* (nrow x nrow) Cholesky factor of K M'^-1 K^T */
@@ -148,7 +151,7 @@ void ss_art_work_free(ssArtWork *w)
   free(w->Y); free(w->Lam); free(w->Yok);
   free(w->path); free(w->npath); free(w->Xp); free(w->XD); free(w->Wp); free(w->Xok);
   free(w->fsum); free(w->dpath); free(w->dnp); free(w->Xd); free(w->XDd); free(w->Wd);
-  free(w->dok); free(w->kin_q);
+  free(w->dok); free(w->kin_q); free(w->kcol); free(w->nkcol);
   free(w);
 }
 
@@ -200,7 +203,9 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
   w->Wd = calloc(nv * nr, sizeof(double));
   w->dok = calloc(nv, 1);
   w->kin_q = calloc(m->sys_nq[s] ? (size_t)m->sys_nq[s] : 1, sizeof(double));
-  if (!w->kin_q || !w->path || !w->npath || !w->Xp || !w->XD || !w->Wp || !w->Xok || !w->fsum ||
+  w->kcol = calloc(nr * nv, sizeof(int));
+  w->nkcol = calloc(nr, sizeof(int));
+  if (!w->kin_q || !w->kcol || !w->nkcol || !w->path || !w->npath || !w->Xp || !w->XD || !w->Wp || !w->Xok || !w->fsum ||
       !w->dpath || !w->dnp || !w->Xd || !w->XDd || !w->Wd || !w->dok) {
     ss_art_work_free(w);
     return NULL;
@@ -226,6 +231,34 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
       w->dof_parent[k0 + k] = k ? k0 + k - 1 : par;
     }
   }
+  /* each closure row's columns, from the dofs closures writes (path_zero
+   * and point_row along both bodies' paths; an equality's two dofs) */
+  unsigned char *on = calloc(nv, 1);
+  if (!on) {
+    ss_art_work_free(w);
+    return NULL;
+  }
+  for (int e = 0, r = 0; e < w->neq; e++) {
+    int k = w->eq[e], b1 = m->eq_body[2 * k], b2 = m->eq_body[2 * k + 1];
+    int rows = m->eq_type[k] == SS_CLOSURE_PIN ? 3 : 1, nc = 0;
+    int *col = w->kcol + (size_t)r * w->nv;
+    if (m->eq_type[k] == SS_CLOSURE_EQUALITY) {
+      on[m->body_dofadr[b1] - w->v0] = on[m->body_dofadr[b2] - w->v0] = 1;
+    } else {
+      for (int j = last_dof(m, w, b1); j >= 0; j = w->dof_parent[j]) on[j] = 1;
+      for (int j = last_dof(m, w, b2); j >= 0; j = w->dof_parent[j]) on[j] = 1;
+    }
+    for (int j = 0; j < w->nv; j++)
+      if (on[j]) {
+        col[nc++] = j;
+        on[j] = 0;
+      }
+    for (int q = 0; q < rows; q++, r++) {
+      if (q) memcpy(w->kcol + (size_t)r * w->nv, col, (size_t)nc * sizeof(int));
+      w->nkcol[r] = nc;
+    }
+  }
+  free(on);
   return w;
 }
 
@@ -530,8 +563,10 @@ static void factor_closures(ssArtWork *w)
   for (int i = 0; i < nr; i++) {
     double *Ai = A + (size_t)i * nr;
     const double *Ki = w->K + (size_t)i * n;
+    const int *col = w->kcol + (size_t)i * n;
     for (int j = 0; j <= i; j++) Ai[j] = 0;
-    for (int k = 0; k < n; k++) {
+    for (int c = 0; c < w->nkcol[i]; c++) {
+      int k = col[c];
       double kik = Ki[k];
       if (kik == 0) continue;
       const double *Mk = w->MiKT + (size_t)k * nr;
@@ -613,9 +648,12 @@ static void project(const ssArtWork *w, double *x)
   if (!nr) return;
   double z[64], *zz = nr <= 64 ? z : malloc((size_t)nr * sizeof(double));
   if (!zz) return;
+  /* K x over each row's columns (the rest of K is zero: the same sum) */
   for (int r = 0; r < nr; r++) {
+    const double *Kr = w->K + (size_t)r * n;
+    const int *col = w->kcol + (size_t)r * n;
     double s = 0;
-    for (int k = 0; k < n; k++) s += w->K[(size_t)r * n + k] * x[k];
+    for (int c = 0; c < w->nkcol[r]; c++) s += Kr[col[c]] * x[col[c]];
     zz[r] = s;
   }
   closure_solve(w, zz, 1);
