@@ -437,7 +437,9 @@ typedef struct ssData {
   unsigned char *sys_active; /* (nsys) 0 once removed from the world */
   double *pd_target;      /* (npd x 2) position and velocity targets */
 
-  /* derived kinematics (ss_forward) */
+  /* derived kinematics (ss_forward), outputs: a step forms them from
+   * qpos, and keeps an articulated system's where its qpos is the one
+   * they were formed at; write qpos, never these */
   double *body_xpos;      /* (nbody x 3) COM position, world */
   double *body_xquat;     /* (nbody x 4) */
   double *body_xmat;      /* (nbody x 9) rotation, row-major */
