@@ -1567,25 +1567,32 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
   /* groups: one per link (or body) and bed (a link's contacts may come in
    * several runs); every point of a bed shares the bed's frame (the
    * bed's axes, terrain.c's frame_from_bed: the same bits for all its
-   * points of a step), so it is compared only where a run starts */
+   * points of a step), so it is compared only where a run starts.  The
+   * run's group, its key and its points' largest offsets stay in locals
+   * while it goes on. */
+  const double dt = m->opt.timestep;
+  int gr = -1, run_link = 0, run_sys = 0, run_bed = 0;
+  NGroup *G = NULL;
+  double rm0 = 0, rm1 = 0, rm2 = 0;
   for (int i = 0; i < first_row; i++) {
     const ssContact *c = d->contact + i;
     if (c->type != SS_CONTACT_SOIL) return 0;
-    int g = 0;
-    NGroup *G;
-    if (i > 0 && c[-1].link == c->link && c[-1].sys == c->sys && c[-1].hfield == c->hfield) {
-      /* the run goes on: the group and frame are the last point's */
-      g = w->group_of[i - 1];
-      G = w->grp + g;
-    } else {
+    if (!(G && c->link == run_link && c->sys == run_sys && c->hfield == run_bed)) {
+      /* a new run: the last one's offsets into its group first */
+      if (G) {
+        G->rmax[0] = rm0;
+        G->rmax[1] = rm1;
+        G->rmax[2] = rm2;
+      }
       if (!(c->nv > 0 && (c->link >= 0 || (c->nv == 6 && m->sys_type[c->sys] == SS_SYS_FREE))))
         return 0;
-      while (g < ngroup && !(w->grp[g].link == c->link && w->grp[g].sys == c->sys &&
-                             w->grp[g].mat == &m->hfield_soilmat[c->hfield]))
-        g++;
-      if (g == w->cap_g && !work(d, 0, 0, 0, 2 * g + 4)) return 0;
-      G = w->grp + g;
-      if (g == ngroup) {
+      gr = 0;
+      while (gr < ngroup && !(w->grp[gr].link == c->link && w->grp[gr].sys == c->sys &&
+                             w->grp[gr].mat == &m->hfield_soilmat[c->hfield]))
+        gr++;
+      if (gr == w->cap_g && !work(d, 0, 0, 0, 2 * gr + 4)) return 0;
+      G = w->grp + gr;
+      if (gr == ngroup) {
         ngroup++;
         G->link = c->link;
         G->sys = c->sys;
@@ -1603,8 +1610,14 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
       } else if (memcmp(G->R, c->frame, sizeof G->R)) {
         return 0;
       }
+      run_link = c->link;
+      run_sys = c->sys;
+      run_bed = c->hfield;
+      rm0 = G->rmax[0];
+      rm1 = G->rmax[1];
+      rm2 = G->rmax[2];
     }
-    w->group_of[i] = g;
+    w->group_of[i] = gr;
     /* the point's constants, its caches empty */
     NPoint *P = w->pt + i;
     const ssSoilMaterial *mat = G->mat;
@@ -1619,7 +1632,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     }
     P->g0 = c->g0;
     P->sp = c->sp;
-    P->S = c->area * m->opt.timestep;
+    P->S = c->area * dt;
     P->k = ss_soil_modulus_at(mat, &G->mod, c->width);
     P->tf0 = P->S * mat->cohesion;
     /* x0 = j / K_j as the sweeps' law forms it (point.c, mobil_init):
@@ -1629,10 +1642,15 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     P->mob = ss_exp_memo_start(P->x0);
     P->imp = 0;
     P->gtt = -1;
-    for (int k = 0; k < 3; k++) {
-      double a = fabs(P->r[k]);
-      if (a > G->rmax[k]) G->rmax[k] = a;
-    }
+    double a0 = fabs(P->r[0]), a1 = fabs(P->r[1]), a2 = fabs(P->r[2]);
+    rm0 = a0 > rm0 ? a0 : rm0;
+    rm1 = a1 > rm1 ? a1 : rm1;
+    rm2 = a2 > rm2 ? a2 : rm2;
+  }
+  if (G) {
+    G->rmax[0] = rm0;
+    G->rmax[1] = rm1;
+    G->rmax[2] = rm2;
   }
   int n = 6 * ngroup + nrow;
   if (!work(d, n, 0, 0, ngroup)) return 0;

@@ -285,16 +285,17 @@ static void row_key(const ssData *d, const ssContact *c, int *geom, int *vertex)
  * the keys ascend, a few entries at most, and falls back to bisection
  * when they do not (a new bed, the joint rows, a gap of more than 8
  * entries no longer loaded). */
-static const ssWarmEntry *find_warm(const ssData *d, int geom, int vertex, int *cursor)
+static const ssWarmEntry *find_warm(const ssWarmEntry *warm, int n, int geom, int vertex,
+                                    int *cursor)
 {
-  int p = *cursor, n = d->nwarm;
+  int p = *cursor;
   const uint64_t key = warm_key(geom, vertex);
-  if (p < n && entry_key(d->warm + p) <= key) {
+  if (p < n && entry_key(warm + p) <= key) {
     for (int k = 0; k < 8 && p < n; k++, p++) {
-      uint64_t ek = entry_key(d->warm + p);
+      uint64_t ek = entry_key(warm + p);
       if (ek == key) {
         *cursor = p + 1;
-        return d->warm + p;
+        return warm + p;
       }
       if (ek > key) return NULL; /* passed it: not cached */
     }
@@ -303,12 +304,12 @@ static const ssWarmEntry *find_warm(const ssData *d, int geom, int vertex, int *
   int a = 0, b = n;
   while (a < b) {
     int mid = a + (b - a) / 2;
-    if (entry_key(d->warm + mid) < key) a = mid + 1;
+    if (entry_key(warm + mid) < key) a = mid + 1;
     else b = mid;
   }
-  if (a == n || entry_key(d->warm + a) != key) return NULL;
+  if (a == n || entry_key(warm + a) != key) return NULL;
   *cursor = a + 1;
-  return d->warm + a;
+  return warm + a;
 }
 
 /* A rigid body's run of contacts in the warm start: the sum of their
@@ -441,14 +442,18 @@ static int warm_start(const ssModel *m, ssData *d, int converged, int creep_rate
   int left = 0, cursor = 0, defer = !d->solver_warm_eager && ss_newton_may_predict(m, d);
   WarmApply a = {{NULL, NULL, NULL, {0}, {0}}, {-1, {0}}};
   d->warm_creep_rates = creep_rates;
-  for (int i = 0; i < d->ncontact; i++) {
+  /* (the loop's invariants in locals: the contacts' stores could alias
+   * them, as the compiler sees it) */
+  const ssWarmEntry *warm = d->warm;
+  const int nwarm = m->opt.terrain_warm_start ? d->nwarm : 0, ncontact = d->ncontact;
+  for (int i = 0; i < ncontact; i++) {
     ssContact *c = d->contact + i;
     c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
     const ssWarmEntry *e = NULL;
-    if (m->opt.terrain_warm_start && c->type != SS_CONTACT_RIGID && d->nwarm) {
+    if (nwarm && c->type != SS_CONTACT_RIGID) {
       int geom = c->geom, vertex = c->vertex;
       if (c->type != SS_CONTACT_SOIL) row_key(d, c, &geom, &vertex);
-      e = find_warm(d, geom, vertex, &cursor);
+      e = find_warm(warm, nwarm, geom, vertex, &cursor);
     }
     if (defer) c->warm_entry = e ? (int)(e - d->warm) : -1;
     if (!e) continue;
@@ -560,14 +565,18 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
    * for CREEP_SLIP */
   double *patch = d->geom_patch;
   memset(patch, 0, 3 * (size_t)m->ngeom * sizeof *patch);
-  for (int i = 0; i < d->ncontact; i++) {
+  /* (the loop's invariants in locals: the entries' stores could alias
+   * them, as the compiler sees it) */
+  const int converged = d->stats.converged, ncontact = d->ncontact;
+  const double tol = m->opt.solver_tolerance;
+  for (int i = 0; i < ncontact; i++) {
     const ssContact *c = d->contact + i;
     if (!cached(c)) continue;
     ssWarmEntry *e = next + n++;
     e->creep = 0;
     if (c->type == SS_CONTACT_SOIL) {
       double inv = 1.0 / (c->area * dt);
-      int trend = c->warm_trend && d->stats.converged;
+      int trend = c->warm_trend && converged;
       e->vertex = c->vertex;
       e->geom = c->geom;
       /* (the soil points come first, as the Newton phase needs) */
@@ -581,7 +590,7 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
       }
       /* a change within the solver's tolerance is not a trend: the
        * tractions are known to about that (a settled body's drift) */
-      if (ch <= m->opt.solver_tolerance * size) {
+      if (ch <= tol * size) {
         e->rate[0] = e->rate[1] = e->rate[2] = 0;
       } else {
         double *g = patch + 3 * c->geom, v2 = c->v[1] * c->v[1] + c->v[2] * c->v[2];

@@ -38,19 +38,30 @@ static long contact_jlen(const ssModel *m, int sys)
   return m->sys_type[sys] == SS_SYS_ARTICULATED ? 36 : 6L * m->sys_nv[sys];
 }
 
-/* fill the system-dependent part of a contact: its system and link; a
- * link contact's rows X, a rigid body's J and every response, which only
- * the sweeps use, come when they run (ss_solver_solve) */
-static void attach(const ssModel *m, ssContact *c, int sys)
+/* The system-dependent part of geom g's contacts: their system and link;
+ * a link contact's rows X, a rigid body's J and every response, which
+ * only the sweeps use, come when they run (ss_solver_solve).  Formed once
+ * per geom (attach_of), filled into each contact (attach). */
+typedef struct Attach {
+  int sys, vadr, nv, link; /* sys -1 and nv 0: a static body */
+} Attach;
+
+static Attach attach_of(const ssModel *m, int g, int sys)
 {
-  if (sys >= 0 && m->sys_nv[sys] > 0) {
-    c->sys = sys;
-    c->vadr = m->sys_vadr[sys];
-    c->nv = m->sys_nv[sys];
-    if (m->sys_type[sys] == SS_SYS_ARTICULATED) c->link = m->geom_body[c->geom];
+  if (sys >= 0 && m->sys_nv[sys] > 0)
+    return (Attach){sys, m->sys_vadr[sys], m->sys_nv[sys],
+                    m->sys_type[sys] == SS_SYS_ARTICULATED ? m->geom_body[g] : -1};
+  return (Attach){-1, 0, 0, -1};
+}
+
+static inline void attach(const Attach *a, ssContact *c)
+{
+  c->sys = a->sys;
+  c->nv = a->nv;
+  if (a->nv > 0) {
+    c->vadr = a->vadr;
+    c->link = a->link;
   } else {
-    c->sys = -1;
-    c->nv = 0;
     memset(c->G, 0, sizeof c->G);
   }
 }
@@ -205,6 +216,8 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
   static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   int turned = memcmp(R, I3, sizeof I3) != 0;
   long njac = contact_jlen(m, sys);
+  const Attach at = attach_of(m, g, sys);
+  const int mesh = m->geom_type[g] == SS_GEOM_MESH;
   const double *z0 = m->hfield_data + adr;
   const double *sp = d->soil_plastic + adr, *jj = d->soil_shear + adr;
   double tiny = 1e-12 * dx * dy;
@@ -253,7 +266,7 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
         }
       }
       double zl;
-      if (m->geom_type[g] == SS_GEOM_MESH) {
+      if (mesh) {
         if (!mesh_depth(m, d, g, R, p, qx, qy, lo[2], &zl)) continue;
       } else if (!ss_shape_cast_lowest_z(&cast, qx, qy, &zl)) {
         continue;
@@ -283,7 +296,7 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       c->g0 = g0;
       c->sp = sp[k];
       c->j = jj[k];
-      attach(m, c, sys);
+      attach(&at, c);
     }
   }
   return SS_OK;
@@ -341,6 +354,7 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
   int mat = h >= 0 ? m->hfield_material[h] : m->plane_material[plane];
   const ssMaterialPair *pair = ss_model_pair(m, m->geom_material[g], mat);
   long njac = contact_jlen(m, sys);
+  const Attach at = attach_of(m, g, sys);
   for (int k = 0; k < npt; k++) {
     double zs = 0, nl[3] = {0, 0, 1};
     if (h >= 0 && !hfield_sample(m, h, pts[k][0], pts[k][1], &zs, nl)) continue;
@@ -371,7 +385,7 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
           -pair->restitution * vn > c->vn_target)
         c->vn_target = -pair->restitution * vn;
     }
-    attach(m, c, sys);
+    attach(&at, c);
   }
   return SS_OK;
 }
@@ -411,9 +425,6 @@ void ss_terrain_update(const ssModel *m, ssData *d)
 {
   const double dt = m->opt.timestep;
   ssStepStats *st = &d->stats;
-  st->soil_contacts = st->soil_loaded = 0;
-  st->soil_contact_area = st->soil_normal_force = 0;
-  st->rigid_contacts = 0;
 
   /* unloaded vertices recover elastically to the rut floor at once */
   for (int k = 0; k < d->nsoil_loaded; k++) {
@@ -439,13 +450,17 @@ void ss_terrain_update(const ssModel *m, ssData *d)
   const ssPowTable *pt = NULL;
   double n1 = 0;
   ssModulusMemo mod = {NAN, 0};
+  /* the statistics' sums in locals, in the same order (the soil arrays'
+   * stores could alias them, as the compiler sees it) */
+  int nrigid = 0, nsoil = 0;
+  double area = 0, normal = 0;
   for (int i = 0; i < d->ncontact; i++) {
     ssContact *c = d->contact + i;
     if (c->type != SS_CONTACT_SOIL) {
-      if (c->type == SS_CONTACT_RIGID) st->rigid_contacts++;
+      if (c->type == SS_CONTACT_RIGID) nrigid++;
       continue;
     }
-    st->soil_contacts++;
+    nsoil++;
     if (!c->loaded) continue;
     if (c->hfield != bed) {
       bed = c->hfield;
@@ -464,12 +479,16 @@ void ss_terrain_update(const ssModel *m, ssData *d)
     if (s > d->soil_sinkage[v]) d->soil_sinkage[v] = s;
     if (spn > d->soil_plastic[v]) d->soil_plastic[v] = spn;
     if (jn > d->soil_shear[v]) d->soil_shear[v] = jn;
-    st->soil_loaded++;
-    st->soil_contact_area += c->area;
-    st->soil_normal_force += c->lambda[0] / dt;
+    area += c->area;
+    normal += c->lambda[0] / dt;
     if (collect) d->soil_loaded[nload] = v;
     nload++;
   }
+  st->rigid_contacts = nrigid;
+  st->soil_contacts = nsoil;
+  st->soil_loaded = nload;
+  st->soil_contact_area = area;
+  st->soil_normal_force = normal;
   if (!collect) return;
   /* the new list of loaded vertices (unique): one collider's vertices
    * come in order already (then the sort only checks them); several
