@@ -1073,6 +1073,7 @@ static ssStatus parse_state(const ssModel *m, const Parsed *f, const char *path,
     ssWarmEntry *e = s->warm + k;
     e->vertex = r_i32(&r);
     e->geom = r_i32(&r);
+    ss_solver_warm_key(e);
     e->creep = r_i32(&r);
     r_f64s(&r, e->traction, 3);
     r_f64s(&r, e->rate, 3);

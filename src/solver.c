@@ -262,12 +262,18 @@ static inline uint64_t warm_key(int geom, int vertex)
 
 static inline uint64_t entry_key(const ssWarmEntry *e)
 {
-  return warm_key(e->geom, e->vertex);
+  return e->key;
 }
 
+void ss_solver_warm_key(ssWarmEntry *e)
+{
+  e->key = warm_key(e->geom, e->vertex);
+}
+
+/* (from the fields: it checks a checkpoint's entries as they were read) */
 int ss_solver_warm_cmp(const ssWarmEntry *a, const ssWarmEntry *b)
 {
-  uint64_t ka = entry_key(a), kb = entry_key(b);
+  uint64_t ka = warm_key(a->geom, a->vertex), kb = warm_key(b->geom, b->vertex);
   return (ka > kb) - (ka < kb);
 }
 
@@ -579,6 +585,7 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
       int trend = c->warm_trend && converged;
       e->vertex = c->vertex;
       e->geom = c->geom;
+      e->key = warm_key(c->geom, c->vertex);
       /* (the soil points come first, as the Newton phase needs) */
       const double *l = law ? law + 3 * i : c->lambda;
       double ch = 0, size = 0;
@@ -600,6 +607,7 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
       }
     } else {
       row_key(d, c, &e->geom, &e->vertex);
+      e->key = warm_key(e->geom, e->vertex);
       e->traction[0] = c->lambda[0] / dt;
       e->traction[1] = e->traction[2] = 0;
       e->rate[0] = e->rate[1] = e->rate[2] = 0;

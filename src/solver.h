@@ -106,12 +106,18 @@ struct ssWarmEntry {
   double traction[3];/* impulse / (area dt), contact frame (Pa); joint
                         rows: impulse / dt in traction[0] */
   double rate[3];    /* traction change over the last step (Pa); 0 for rows */
+  uint64_t key;      /* the cache's order as one number, from geom and
+                        vertex (ss_solver_warm_key), kept for the look-ups
+                        and the sort */
 };
 
 /* The warm-start cache's order (<0, 0, >0): by collider, then vertex,
  * the joint rows last; checkpoints hold the cache in it (checkpoint.c
  * checks a file's entries with it). */
 int ss_solver_warm_cmp(const ssWarmEntry *a, const ssWarmEntry *b);
+/* Sets e->key from e->geom and e->vertex: wherever an entry is made (the
+ * cache's store, a checkpoint's restore). */
+void ss_solver_warm_key(ssWarmEntry *e);
 
 /* Room for one more contact (zeroed up to pos, see ssContact, so its point
  * cache empty; link = -1)
