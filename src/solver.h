@@ -170,6 +170,21 @@ static inline ssContact *ss_contact_add(ssData *d, long njac)
   return c;
 }
 
+/* ss_contact_add for a loop that makes many contacts of one collider: the
+ * head copied from the caller's template (ss_contact_zero's with the
+ * fields they share set once: type, collider, system, link, jlen, ...),
+ * the Jacobian storage at jadr (the caller's running
+ * ss_contact_jac_end, each contact's jlen on).  Room as for
+ * ss_contact_add (ss_contact_reserve). */
+static inline ssContact *ss_contact_add_head(ssData *d, const ssContact *head, long jadr)
+{
+  ssContact *c = d->contact + d->ncontact;
+  memcpy(c, head, offsetof(ssContact, pos));
+  c->jadr = jadr;
+  d->ncontact++;
+  return c;
+}
+
 /* Solve all contacts in d->contact; d->qvel holds the free velocity on entry
  * and the end-of-step velocity on return.  Fills d->stats.  The warm-start
  * cache is not touched: ss_solver_store_warm keeps this step's tractions

@@ -54,16 +54,23 @@ static Attach attach_of(const ssModel *m, int g, int sys)
   return (Attach){-1, 0, 0, -1};
 }
 
-static inline void attach(const Attach *a, ssContact *c)
+/* the system part of a contact's head: its system, velocity block and
+ * link (a static body's: sys -1, nv 0, the head's vadr 0 and link -1) */
+static inline void attach_head(const Attach *a, ssContact *c)
 {
   c->sys = a->sys;
   c->nv = a->nv;
   if (a->nv > 0) {
     c->vadr = a->vadr;
     c->link = a->link;
-  } else {
-    memset(c->G, 0, sizeof c->G);
   }
+}
+
+/* the same into a new contact, with a static body's zero response */
+static inline void attach(const Attach *a, ssContact *c)
+{
+  attach_head(a, c);
+  if (!(a->nv > 0)) memset(c->G, 0, sizeof c->G);
 }
 
 /* the collider of geom g expressed in a frame (R, p); a mesh stands in as
@@ -218,6 +225,19 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
   long njac = contact_jlen(m, sys);
   const Attach at = attach_of(m, g, sys);
   const int mesh = m->geom_type[g] == SS_GEOM_MESH;
+  /* the head its points share (ss_contact_add_head), and where their
+   * Jacobian storage starts */
+  ssContact head;
+  memcpy(&head, &ss_contact_zero, offsetof(ssContact, pos));
+  head.link = -1;
+  head.type = SS_CONTACT_SOIL;
+  head.geom = g;
+  head.hfield = h;
+  head.jlen = njac;
+  head.width = width;
+  head.bed_axes = !turned;
+  attach_head(&at, &head);
+  long jadr = ss_contact_jac_end(d);
   const double *z0 = m->hfield_data + adr;
   const double *sp = d->soil_plastic + adr, *jj = d->soil_shear + adr;
   double tiny = 1e-12 * dx * dy;
@@ -275,10 +295,8 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       double floor_z = z0[k] - sp[k];
       double g0 = zl - floor_z;
       if (g0 > margin) continue;
-      ssContact *c = ss_contact_add(d, njac);
-      c->type = SS_CONTACT_SOIL;
-      c->geom = g;
-      c->hfield = h;
+      ssContact *c = ss_contact_add_head(d, &head, jadr);
+      jadr += njac;
       c->vertex = adr + k;
       if (turned) {
         double pl[3] = {qx, qy, zl};
@@ -290,13 +308,11 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
         c->pos[2] = zl + p[2];
       }
       memcpy(c->frame, frame, sizeof frame);
-      c->bed_axes = !turned;
       c->area = area;
-      c->width = width;
       c->g0 = g0;
       c->sp = sp[k];
       c->j = jj[k];
-      attach(&at, c);
+      if (!(at.nv > 0)) memset(c->G, 0, sizeof c->G);
     }
   }
   return SS_OK;
