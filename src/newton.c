@@ -835,11 +835,16 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
       M = mat_of(w->grp + g, dt);
     }
     int nl = 0;
+    /* the group's velocity in a local (the laws' stores could alias the
+     * sums', as the compiler sees it, and it would be loaded again at
+     * every point) */
+    double V[6];
+    memcpy(V, A->V, sizeof V);
     for (int i = i0; i < i1; i++) {
       NPoint *P = w->pt + i;
       double *lam = lam_out + 3 * i, *K = with_H ? K_out + 6 * i : NULL;
-      int st = !(with_imp && P->imp) ? point_law(&M, P, A->V, lam, K)
-                                     : imp_law(&M, P, A->V, mu + 2 * i, lam, K, ie + i);
+      int st = !(with_imp && P->imp) ? point_law(&M, P, V, lam, K)
+                                     : imp_law(&M, P, V, mu + 2 * i, lam, K, ie + i);
       if (st == UNLOADED) continue;
       near |= st == NEAR;
       if (st == STICKS) {
