@@ -265,19 +265,26 @@ static ssNewtonWork *work(ssData *d, int n, int nc, int nv, int ng)
 
 /* the series are ss_math.h's (shared with src/point.c) */
 
-/* s^(n-1) of point P, moved from its last value when near */
+/* s^(n-1) of point P, moved from its last value when near; with keep,
+ * its memo stays where it was (check: the memos stay at the last
+ * evaluation's y, so that H formed there later is what that evaluation
+ * would have formed) */
 static inline __attribute__((always_inline)) double pow_point(NPoint *P, double s,
-                                                             const ssPowSeries *ser)
+                                                             const ssPowSeries *ser,
+                                                             const int keep)
 {
-  return ss_pow_moved(&P->pw, s, ser);
+  return keep ? ss_pow_at(&P->pw, s, ser) : ss_pow_moved(&P->pw, s, ser);
 }
 
-/* Janosi mobilisation 1 - exp(-x) of point P and exp(-x) in *e */
-static inline __attribute__((always_inline)) double mobil_point(NPoint *P, double x, double *e)
+/* Janosi mobilisation 1 - exp(-x) of point P and exp(-x) in *e; keep as
+ * for pow_point */
+static inline __attribute__((always_inline)) double mobil_point(NPoint *P, double x, double *e,
+                                                               const int keep)
 {
-  P->mob = ss_exp_memo_move(P->mob, x);
-  *e = P->mob.e;
-  return P->mob.m;
+  ssExpMemo c = ss_exp_memo_move(P->mob, x);
+  if (!keep) P->mob = c;
+  *e = c.e;
+  return c.m;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -496,14 +503,15 @@ static inline __attribute__((always_inline)) void point_velocity(const double r[
 /* The normal law of point P at normal velocity vn: lambda_n, and its
  * derivative d lambda_n / d v_n in *kn; -1 when unloaded (no overlap) */
 static inline __attribute__((always_inline)) double point_normal(const Mat *M, NPoint *P,
-                                                                 double vn, double *kn)
+                                                                 double vn, double *kn,
+                                                                 const int keep)
 {
   double delta = -(P->g0 + M->dt * vn);
   if (!(delta > 0)) {
     *kn = 0;
     return -1;
   }
-  double sk = P->sp + delta, sn1 = M->linear ? 1.0 : pow_point(P, sk, &M->pser);
+  double sk = P->sp + delta, sn1 = M->linear ? 1.0 : pow_point(P, sk, &M->pser, keep);
   double pe = M->Ke * delta, py = P->k * sk * sn1, p, slope;
   if (pe <= py) {
     p = pe;
@@ -529,13 +537,13 @@ static inline __attribute__((always_inline)) double point_normal(const Mat *M, N
  * STICKS when the point sticks or so nearly that T / |v_t| exceeds
  * STICK_RATIO / G_tt: the velocity form is set-valued there. */
 static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint *P, const double V[6],
-                            double lam[3], double *K)
+                            double lam[3], double *K, const int keep)
 {
   const double *r = P->r;
   /* v = v_o + omega x r (point_velocity, the tangential part formed only
    * for a loaded point) */
   double vn = V[3] + V[1] * r[2] - V[2] * r[1], kn;
-  double ln = point_normal(M, P, vn, &kn);
+  double ln = point_normal(M, P, vn, &kn, keep);
   if (ln < 0) {
     lam[0] = lam[1] = lam[2] = 0;
     return UNLOADED;
@@ -544,7 +552,7 @@ static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint 
   double v2 = V[5] + V[0] * r[1] - V[1] * r[0];
   /* shear: the bound T = tf m(sigma) opposes the slip */
   double sigma = sqrt(v1 * v1 + v2 * v2), tf = P->tf0 + M->mu * ln, mob = 1, e = 0;
-  if (M->rj > 0) mob = mobil_point(P, P->x0 + M->rj * sigma, &e);
+  if (M->rj > 0) mob = mobil_point(P, P->x0 + M->rj * sigma, &e, keep);
   double T = tf * mob;
   lam[0] = ln;
   if (K) K[0] = kn;
@@ -643,7 +651,7 @@ static __attribute__((noinline)) int imp_law(const Mat *M, NPoint *P, const doub
 {
   double v[3], kn;
   point_velocity(P->r, V, v);
-  double ln = point_normal(M, P, v[0], &kn);
+  double ln = point_normal(M, P, v[0], &kn, 0);
   if (ln < 0) return STICKS;
   imp_map(M, P, v + 1, ln, kn, mu, 1, ie);
   lam[0] = ln;
@@ -843,7 +851,7 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
     for (int i = i0; i < i1; i++) {
       NPoint *P = w->pt + i;
       double *lam = lam_out + 3 * i, *K = with_H ? K_out + 6 * i : NULL;
-      int st = !(with_imp && P->imp) ? point_law(&M, P, V, lam, K)
+      int st = !(with_imp && P->imp) ? point_law(&M, P, V, lam, K, 0)
                                      : imp_law(&M, P, V, mu + 2 * i, lam, K, ie + i);
       if (st == UNLOADED) continue;
       near |= st == NEAR;
@@ -969,7 +977,7 @@ static double imp_check(const Mat *M, NPoint *P, const NGroup *G, const double V
   const double *r = P->r;
   double v[3], kn;
   point_velocity(r, V, v);
-  double ln = point_normal(M, P, v[0], &kn);
+  double ln = point_normal(M, P, v[0], &kn, 1);
   if (ln < 0) ln = kn = 0;
   NImpEval ie;
   double mu[2] = {lam[1], lam[2]};
@@ -1018,23 +1026,19 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
       gprev = g;
       M = mat_of(w->grp + g, dt);
     }
-    /* the points' memos are put back after: they stay at the last
-     * evaluation's y, so that H formed there later (ss_newton_solve) is
-     * what the evaluation would have formed */
+    /* the laws keep the points' memos where they are (pow_point): at
+     * the last evaluation's y, so that H formed there later
+     * (ss_newton_solve) is what the evaluation would have formed */
     NPoint *P = w->pt + i;
-    const ssPowMemo pw = P->pw;
-    const ssExpMemo mob = P->mob;
     double lam[3], dn;
     if (P->imp) {
       dn = imp_check(&M, P, w->grp + g, w->sum[g].V, c->lambda);
     } else {
-      dn = point_law(&M, P, w->sum[g].V, lam, NULL) == STICKS
+      dn = point_law(&M, P, w->sum[g].V, lam, NULL, 1) == STICKS
                ? INFINITY
                : fabs(lam[0] - c->lambda[0]) + fabs(lam[1] - c->lambda[1]) +
                      fabs(lam[2] - c->lambda[2]);
     }
-    P->pw = pw;
-    P->mob = mob;
     measure_add(&q, dn, fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]));
   }
   for (int r = 0; r < s->nrow; r++) {
@@ -1229,7 +1233,7 @@ static int switch_points(const ssModel *m, const ssData *d, const Setup *s, ssNe
       M = mat_of(w->grp + g, m->opt.timestep);
     }
     double lam[3], warm[3];
-    int st = point_law(&M, &P, w->sum[g].V, lam, NULL);
+    int st = point_law(&M, &P, w->sum[g].V, lam, NULL, 0);
     if (st != NEAR && st != STICKS) continue;
     if (st == STICKS) ss_solver_warm_lambda(m, d, i, warm);
     const double *m0 = st == STICKS ? warm + 1 : lam + 1;

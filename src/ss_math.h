@@ -306,11 +306,17 @@ static __attribute__((noinline, unused)) double ss_pow_far(const ssPowSeries *p,
 /* s^a, moved by the series p (exponent a) from the memo when s is within
  * SS_POW_SERIES_MAX of it, else from p's table (or libm); the memo moves
  * to s */
+/* s^a as ss_pow_moved forms it, the memo left where it is */
+static inline double ss_pow_at(const ssPowMemo *c, double s, const ssPowSeries *p)
+{
+  double u = c->s > 0 ? (s - c->s) * c->is : INFINITY;
+  if (fabs(u) <= SS_POW_SERIES_MAX && p->ok) return c->v + c->v * ss_pow1p_m1(p, u);
+  return ss_pow_far(p, s);
+}
+
 static inline double ss_pow_moved(ssPowMemo *c, double s, const ssPowSeries *p)
 {
-  double u = c->s > 0 ? (s - c->s) * c->is : INFINITY, v;
-  if (fabs(u) <= SS_POW_SERIES_MAX && p->ok) v = c->v + c->v * ss_pow1p_m1(p, u);
-  else v = ss_pow_far(p, s);
+  double v = ss_pow_at(c, s, p);
   c->s = s;
   c->v = v;
   c->is = 1 / s;
