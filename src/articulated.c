@@ -56,8 +56,8 @@ struct ssArtWork {
   double *kin_q;         /* (the system's nq) the qpos of the last
                             ss_art_forward, whose poses and S stand */
   int kin_ok;            /* 0: no ss_art_forward yet */
-  unsigned long kin_gen; /* ss_art_forward's runs */
-  unsigned long clo_gen; /* kin_gen where closures last formed K and phi
+  uint64_t kin_gen;      /* ss_art_forward's runs */
+  uint64_t clo_gen;      /* kin_gen where closures last formed K and phi
                             (they depend on the poses, S and qpos alone) */
 };
 
@@ -205,8 +205,8 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
   w->kin_q = calloc(m->sys_nq[s] ? (size_t)m->sys_nq[s] : 1, sizeof(double));
   w->kcol = calloc(nr * nv, sizeof(int));
   w->nkcol = calloc(nr, sizeof(int));
-  if (!w->kin_q || !w->kcol || !w->nkcol || !w->path || !w->npath || !w->Xp || !w->XD || !w->Wp || !w->Xok || !w->fsum ||
-      !w->dpath || !w->dnp || !w->Xd || !w->XDd || !w->Wd || !w->dok) {
+  if (!w->kin_q || !w->kcol || !w->nkcol || !w->path || !w->npath || !w->Xp || !w->XD ||
+      !w->Wp || !w->Xok || !w->fsum || !w->dpath || !w->dnp || !w->Xd || !w->XDd || !w->Wd || !w->dok) {
     ss_art_work_free(w);
     return NULL;
   }
@@ -218,7 +218,7 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
     return NULL;
   }
   sys_closures(m, s, w->eq, NULL);
-  w->clo_gen = (unsigned long)-1;
+  w->clo_gen = UINT64_MAX;
   /* LTDL parent of each dof: the previous dof of its joint, else the last
    * dof of the nearest ancestor that has one */
   for (int lb = 0; lb < w->nb; lb++) {

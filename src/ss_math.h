@@ -303,9 +303,6 @@ static __attribute__((noinline, unused)) double ss_pow_far(const ssPowSeries *p,
   return p->tab ? ss_pow_tab(p->tab, s) : pow(s, p->a);
 }
 
-/* s^a, moved by the series p (exponent a) from the memo when s is within
- * SS_POW_SERIES_MAX of it, else from p's table (or libm); the memo moves
- * to s */
 /* s^a as ss_pow_moved forms it, the memo left where it is */
 static inline double ss_pow_at(const ssPowMemo *c, double s, const ssPowSeries *p)
 {
@@ -314,6 +311,9 @@ static inline double ss_pow_at(const ssPowMemo *c, double s, const ssPowSeries *
   return ss_pow_far(p, s);
 }
 
+/* s^a, moved by the series p (exponent a) from the memo when s is within
+ * SS_POW_SERIES_MAX of it, else from p's table (or libm); the memo moves
+ * to s */
 static inline double ss_pow_moved(ssPowMemo *c, double s, const ssPowSeries *p)
 {
   double v = ss_pow_at(c, s, p);
