@@ -1215,7 +1215,7 @@ static void lu_solve(const double *A, const int *piv, int n, double *x)
 }
 
 /* Points at y that stick or come near it (point_law's STICKS, NEAR; the
- * law run again on copies of the points, their memos kept) go to impulse
+ * law run again with the points' memos kept) go to impulse
  * form, from their impulse there or, sticking, their warm start's
  * (ss_solver_warm_lambda: applied or still pending).  Returns how many
  * went. */
@@ -1225,20 +1225,20 @@ static int switch_points(const ssModel *m, const ssData *d, const Setup *s, ssNe
   Mat M = {0};
   for (int g = 0; g < s->ngroup; g++) to_group(w->grp + g, w->y + 6 * g, w->sum[g].V);
   for (int i = 0; i < s->first_row; i++) {
-    NPoint P = w->pt[i];
+    NPoint *P = w->pt + i;
     int g = w->group_of[i];
-    if (P.imp || !(w->lam[3 * i] > 0)) continue;
+    if (P->imp || !(w->lam[3 * i] > 0)) continue;
     if (g != gprev) {
       gprev = g;
       M = mat_of(w->grp + g, m->opt.timestep);
     }
     double lam[3], warm[3];
-    int st = point_law(&M, &P, w->sum[g].V, lam, NULL, 0);
+    int st = point_law(&M, P, w->sum[g].V, lam, NULL, 1);
     if (st != NEAR && st != STICKS) continue;
     if (st == STICKS) ss_solver_warm_lambda(m, d, i, warm);
     const double *m0 = st == STICKS ? warm + 1 : lam + 1;
-    w->pt[i].imp = 1;
-    point_gtt(w->grp[g].gq, w->pt + i);
+    P->imp = 1;
+    point_gtt(w->grp[g].gq, P);
     w->imp[w->ns++] = i;
     w->mu[2 * i] = m0[0];
     w->mu[2 * i + 1] = m0[1];

@@ -38,12 +38,12 @@ static void limit_row(ssContact *c, const double v0[3])
   c->lambda[0] = l > 0 ? l : 0;
 }
 
-/* the zeroed head of a new contact is copied from here (ss_contact_add):
- * GCC lowers a memset of its 184 bytes (offsetof(ssContact, pos)) to
- * `rep stos`, whose start-up costs about three times the dozen loads and
- * stores of this copy (10 ns a contact on the benchmark machine, some 7 %
- * of a settled plate point's step) */
-const ssContact ss_contact_zero;
+/* the head of a new contact, zeros but link = -1 (no link), is copied
+ * from here (ss_contact_add): GCC lowers a memset of its 184 bytes
+ * (offsetof(ssContact, pos)) to `rep stos`, whose start-up costs about
+ * three times the dozen loads and stores of this copy (10 ns a contact on
+ * the benchmark machine, some 7 % of a settled plate point's step) */
+const ssContact ss_contact_blank = {.link = -1};
 
 int ss_contact_reserve(ssData *d, int count, long njac)
 {
@@ -461,7 +461,7 @@ static int warm_start(const ssModel *m, ssData *d, int converged, int creep_rate
       if (c->type != SS_CONTACT_SOIL) row_key(d, c, &geom, &vertex);
       e = find_warm(warm, nwarm, geom, vertex, &cursor);
     }
-    if (defer) c->warm_entry = e ? (int)(e - d->warm) : -1;
+    if (defer) c->warm_entry = e ? (int)(e - warm) : -1;
     if (!e) continue;
     if (c->type == SS_CONTACT_SOIL) {
       if (e->creep && !creep_rates) left++;
@@ -501,8 +501,9 @@ static int cached(const ssContact *c)
          (c->type == SS_CONTACT_SOIL && c->lambda[0] > 0);
 }
 
-/* Sort the n cache entries of a by key (warm_key), b being as large; returns whichever of a and b ends
- * holding them.  The contacts come in a few ascending runs (one per bed,
+/* Sort the n cache entries of a by key (warm_key), b being as large;
+ * returns whichever of a and b ends holding them.  The contacts come in a
+ * few ascending runs (one per bed,
  * then the joint rows: the PD rows in the model's order, then the
  * limits), so neighbouring runs are merged pairwise until one is left: a
  * few passes, no general sort, none where the entries came sorted, and a

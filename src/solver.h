@@ -128,7 +128,7 @@ ssContact *ss_contact_new(ssData *d, long njac);
  * contacts of njac doubles each (0 when out of memory), then each one
  * taken without a check (ss_contact_add, at most count of them). */
 int ss_contact_reserve(ssData *d, int count, long njac);
-extern const ssContact ss_contact_zero;
+extern const ssContact ss_contact_blank;
 /* end of the Jacobian storage in use */
 static inline long ss_contact_jac_end(const ssData *d)
 {
@@ -162,8 +162,7 @@ static inline ssContact *ss_contact_add(ssData *d, long njac)
 {
   ssContact *c = d->contact + d->ncontact;
   long jadr = ss_contact_jac_end(d);
-  memcpy(c, &ss_contact_zero, offsetof(ssContact, pos));
-  c->link = -1;
+  memcpy(c, &ss_contact_blank, offsetof(ssContact, pos));
   c->jadr = jadr;
   c->jlen = njac;
   d->ncontact++;
@@ -171,7 +170,7 @@ static inline ssContact *ss_contact_add(ssData *d, long njac)
 }
 
 /* ss_contact_add for a loop that makes many contacts of one collider: the
- * head copied from the caller's template (ss_contact_zero's with the
+ * head copied from the caller's template (ss_contact_blank's with the
  * fields they share set once: type, collider, system, link, jlen, ...),
  * the Jacobian storage at jadr (the caller's running
  * ss_contact_jac_end, each contact's jlen on).  Room as for

@@ -41,7 +41,8 @@ static long contact_jlen(const ssModel *m, int sys)
 /* The system-dependent part of geom g's contacts: their system and link;
  * a link contact's rows X, a rigid body's J and every response, which
  * only the sweeps use, come when they run (ss_solver_solve).  Formed once
- * per geom (attach_of), filled into each contact (attach). */
+ * per geom (attach_of), filled into each contact's head (attach_head) and
+ * response (attach_response). */
 typedef struct Attach {
   int sys, vadr, nv, link; /* sys -1 and nv 0: a static body */
 } Attach;
@@ -66,10 +67,10 @@ static inline void attach_head(const Attach *a, ssContact *c)
   }
 }
 
-/* the same into a new contact, with a static body's zero response */
-static inline void attach(const Attach *a, ssContact *c)
+/* a static body's contact: its response G is zero (the rest's comes
+ * with the sweeps) */
+static inline void attach_response(const Attach *a, ssContact *c)
 {
-  attach_head(a, c);
   if (!(a->nv > 0)) memset(c->G, 0, sizeof c->G);
 }
 
@@ -228,8 +229,7 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
   /* the head its points share (ss_contact_add_head), and where their
    * Jacobian storage starts */
   ssContact head;
-  memcpy(&head, &ss_contact_zero, offsetof(ssContact, pos));
-  head.link = -1;
+  memcpy(&head, &ss_contact_blank, offsetof(ssContact, pos));
   head.type = SS_CONTACT_SOIL;
   head.geom = g;
   head.hfield = h;
@@ -312,7 +312,7 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       c->g0 = g0;
       c->sp = sp[k];
       c->j = jj[k];
-      if (!(at.nv > 0)) memset(c->G, 0, sizeof c->G);
+      attach_response(&at, c);
     }
   }
   return SS_OK;
@@ -401,7 +401,8 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
           -pair->restitution * vn > c->vn_target)
         c->vn_target = -pair->restitution * vn;
     }
-    attach(&at, c);
+    attach_head(&at, c);
+    attach_response(&at, c);
   }
   return SS_OK;
 }
