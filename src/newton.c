@@ -295,6 +295,8 @@ static inline __attribute__((always_inline)) double mobil_point(NPoint *P, doubl
  * [first_row, ncontact) the rows */
 typedef struct Setup {
   int ngroup, nrow, n, first_row;
+  int linear;         /* every group's soil is linear (n = 1): its laws
+                         need no power (evaluate's own form) */
 } Setup;
 
 /* y_b (omega; v_O, world, about the origin) in a group's frame about its
@@ -817,9 +819,11 @@ static inline __attribute__((always_inline)) int
 evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWork *w,
             const double *y, double *mu, double *F, double *H, double *q,
             double *lam_out, double *restrict K_out, NImpEval *ie, const int with_H,
-            const int with_imp)
+            const int with_imp, const int linear)
 {
   const double dt = m->opt.timestep;
+  /* (K_out is there with H: the laws' tests of K compile away) */
+  if (with_H && !K_out) __builtin_unreachable();
   memset(F, 0, (size_t)s->n * sizeof(double));
   /* each group's velocity in its frame about o; its sums in the same
    * frame: F' = (sum r x lambda; sum lambda), H' = sum J^T K J with the
@@ -841,6 +845,8 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
     if (g != gprev) {
       gprev = g;
       M = mat_of(w->grp + g, dt);
+      /* (the same value, now known where this form is compiled) */
+      if (linear) M.linear = 1;
     }
     int nl = 0;
     /* the group's velocity in a local (the laws' stores could alias the
@@ -925,21 +931,24 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
 
 /* the forms, each compiled for itself: without H, the Jacobian's work is
  * dropped at compile time, and without impulse-form points (most steps)
- * their tests and sums */
+ * their tests and sums; on linear soil alone (the plate's) the powers'
+ * code too, which would otherwise crowd the loop's registers */
 static int evaluate(const ssModel *m, const ssData *d, const Setup *s,
                     const ssNewtonWork *w, const double *y, double *mu, double *F,
                     double *H, double *q, double *lam_out, double *K, NImpEval *ie)
 {
-  return w->ns ? evaluate_at(m, d, s, w, y, mu, F, H, q, lam_out, K, ie, 1, 1)
-               : evaluate_at(m, d, s, w, y, mu, F, H, q, lam_out, K, ie, 1, 0);
+  if (w->ns) return evaluate_at(m, d, s, w, y, mu, F, H, q, lam_out, K, ie, 1, 1, 0);
+  return s->linear ? evaluate_at(m, d, s, w, y, mu, F, H, q, lam_out, K, ie, 1, 0, 1)
+                   : evaluate_at(m, d, s, w, y, mu, F, H, q, lam_out, K, ie, 1, 0, 0);
 }
 
 static inline __attribute__((always_inline)) int
 evaluate_F(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWork *w,
            const double *y, double *mu, double *F, double *lam_out, NImpEval *ie)
 {
-  return w->ns ? evaluate_at(m, d, s, w, y, mu, F, NULL, NULL, lam_out, NULL, ie, 0, 1)
-               : evaluate_at(m, d, s, w, y, mu, F, NULL, NULL, lam_out, NULL, ie, 0, 0);
+  if (w->ns) return evaluate_at(m, d, s, w, y, mu, F, NULL, NULL, lam_out, NULL, ie, 0, 1, 0);
+  return s->linear ? evaluate_at(m, d, s, w, y, mu, F, NULL, NULL, lam_out, NULL, ie, 0, 0, 1)
+                   : evaluate_at(m, d, s, w, y, mu, F, NULL, NULL, lam_out, NULL, ie, 0, 0, 0);
 }
 
 /* The sweeps' measure of a solve: the largest change |law - lambda|_1 a
@@ -1663,7 +1672,8 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
   }
   int n = 6 * ngroup + nrow;
   if (!work(d, n, 0, 0, ngroup)) return 0;
-  Setup s = {ngroup, nrow, n, first_row};
+  Setup s = {ngroup, nrow, n, first_row, 1};
+  for (int g = 0; g < ngroup; g++) s.linear &= w->grp[g].mat->sinkage_exponent == 1.0;
 
   lam_matrix(m, d, &s, w);
   /* the stick test's G_tt, from each group's diagonal block of Lam: the

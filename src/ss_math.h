@@ -296,19 +296,17 @@ typedef struct ssPowMemo {
   double s, v, is;
 } ssPowMemo;
 
-/* s^a from p's table, or libm's pow where it has none (out of line: the
- * callers' loops stay as small as with pow alone) */
-static __attribute__((noinline, unused)) double ss_pow_far(const ssPowSeries *p, double s)
-{
-  return p->tab ? ss_pow_tab(p->tab, s) : pow(s, p->a);
-}
-
-/* s^a as ss_pow_moved forms it, the memo left where it is */
+/* s^a as ss_pow_moved forms it, the memo left where it is.  Its table
+ * (a point's first power of a step) inline: a call here made the caller
+ * keep every live value of its loop on the stack around it (all of SSE's
+ * registers are the caller's to save), which cost as much as the table;
+ * only libm's pow, where there is no table, stays a call. */
 static inline double ss_pow_at(const ssPowMemo *c, double s, const ssPowSeries *p)
 {
   double u = c->s > 0 ? (s - c->s) * c->is : INFINITY;
   if (fabs(u) <= SS_POW_SERIES_MAX && p->ok) return c->v + c->v * ss_pow1p_m1(p, u);
-  return ss_pow_far(p, s);
+  if (p->tab) return ss_pow_tab(p->tab, s);
+  return pow(s, p->a);
 }
 
 /* s^a, moved by the series p (exponent a) from the memo when s is within
