@@ -609,6 +609,35 @@ static inline void closure_forward(const ssArtWork *w, double *Z, int m)
       for (int r = 0; r < m; r++) zi[r] = 0;
       continue;
     }
+    if (m == 6) {
+      /* a link probe's six columns: the row's updates in registers, three
+       * pairs (the same products and sums, in the same order, as the row
+       * updates below) */
+      ssV2 z0, z1, z2, x0, x1, x2;
+      memcpy(&z0, zi, sizeof z0);
+      memcpy(&z1, zi + 2, sizeof z1);
+      memcpy(&z2, zi + 4, sizeof z2);
+      for (int k = 0; k < i; k++) {
+        double a = -A[i * nr + k];
+        ssV2 av = {a, a};
+        const double *zk = Z + 6 * (size_t)k;
+        memcpy(&x0, zk, sizeof x0);
+        memcpy(&x1, zk + 2, sizeof x1);
+        memcpy(&x2, zk + 4, sizeof x2);
+        z0 += av * x0;
+        z1 += av * x1;
+        z2 += av * x2;
+      }
+      double d = A[i * nr + i];
+      ssV2 dv = {d, d};
+      z0 /= dv;
+      z1 /= dv;
+      z2 /= dv;
+      memcpy(zi, &z0, sizeof z0);
+      memcpy(zi + 2, &z1, sizeof z1);
+      memcpy(zi + 4, &z2, sizeof z2);
+      continue;
+    }
     for (int k = 0; k < i; k++) {
       double a = A[i * nr + k];
       ss_row_add_scaled(zi, -a, Z + (size_t)m * k, m);
@@ -897,11 +926,25 @@ static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, doubl
   }
   if (!nr) return;
   if (ncol == 6) {
-    memset(W, 0, 6 * (size_t)nr * sizeof(double));
-    for (int i = 0; i < np; i++) {
-      int k = path[i];
-      const double *Sk = w->S + 6 * k, *Mk = w->MiKT + (size_t)k * nr;
-      for (int r = 0; r < nr; r++) ss_row_add_scaled(W + 6 * r, Mk[r], Sk, 6);
+    /* row r = sum over the path of MiKT_kr S_k, its six sums in registers
+     * (three pairs, from +0, in the path's order: the bits of row updates
+     * of a zeroed W) */
+    for (int r = 0; r < nr; r++) {
+      ssV2 w0 = {0, 0}, w1 = {0, 0}, w2 = {0, 0}, s0, s1, s2;
+      for (int i = 0; i < np; i++) {
+        int k = path[i];
+        const double *Sk = w->S + 6 * k, mk = w->MiKT[(size_t)k * nr + r];
+        ssV2 mv = {mk, mk};
+        memcpy(&s0, Sk, sizeof s0);
+        memcpy(&s1, Sk + 2, sizeof s1);
+        memcpy(&s2, Sk + 4, sizeof s2);
+        w0 += mv * s0;
+        w1 += mv * s1;
+        w2 += mv * s2;
+      }
+      memcpy(W + 6 * r, &w0, sizeof w0);
+      memcpy(W + 6 * r + 2, &w1, sizeof w1);
+      memcpy(W + 6 * r + 4, &w2, sizeof w2);
     }
   } else {
     memcpy(W, w->MiKT + (size_t)top * nr, (size_t)nr * sizeof(double));
@@ -1015,6 +1058,42 @@ probe_pair(const ssArtWork *w, Probe a, Probe b, int ca, int cb, double *out, in
   while (i < a.np && j < b.np && a.path[i] != b.path[j]) {
     if (a.path[i] > b.path[j]) i++;
     else j++;
+  }
+  if (ca == 6 && cb == 6) {
+    /* two links: three rows of the block at a time, their 18 sums in
+     * registers (nine pairs, from +0), the same products and sums in the
+     * same order as the row updates below */
+    for (int r0 = 0; r0 < 6; r0 += 3) {
+      ssV2 s[9] = {{0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}};
+      for (int k = i; k < a.np; k++) {
+        const double *x = a.X + 6 * a.path[k] + r0, *y = b.XD + 6 * a.path[k];
+        ssV2 y0, y1, y2;
+        memcpy(&y0, y, sizeof y0);
+        memcpy(&y1, y + 2, sizeof y1);
+        memcpy(&y2, y + 4, sizeof y2);
+        for (int r = 0; r < 3; r++) {
+          ssV2 xv = {x[r], x[r]};
+          s[3 * r] += xv * y0;
+          s[3 * r + 1] += xv * y1;
+          s[3 * r + 2] += xv * y2;
+        }
+      }
+      for (int k = 0; k < nr; k++) {
+        const double *x = a.W + 6 * k + r0, *y = b.W + 6 * k;
+        ssV2 y0, y1, y2;
+        memcpy(&y0, y, sizeof y0);
+        memcpy(&y1, y + 2, sizeof y1);
+        memcpy(&y2, y + 4, sizeof y2);
+        for (int r = 0; r < 3; r++) {
+          ssV2 xv = {-x[r], -x[r]};
+          s[3 * r] += xv * y0;
+          s[3 * r + 1] += xv * y1;
+          s[3 * r + 2] += xv * y2;
+        }
+      }
+      for (int r = 0; r < 3; r++) memcpy(out + (size_t)ldo * (r0 + r), s + 3 * r, 6 * sizeof(double));
+    }
+    return;
   }
   double acc[36] = {0};
   for (; i < a.np; i++) {

@@ -150,6 +150,8 @@ typedef struct NSum {
 struct ssNewtonWork {
   int cap_n, cap_c, cap_v, cap_g;
   int *group_of;      /* (ncontact) group of each soil contact */
+  int *run, nrun;     /* (ncontact + 1) the soil contacts' runs of one
+                         group: run q is [run[q], run[q + 1]) */
   double *lam, *lamtry; /* (ncontact x 3) the soil points' impulses at y,
                          at the trial point */
   double *Lam;        /* (n x n) J Y over the groups' links and the rows */
@@ -190,7 +192,7 @@ const double *ss_newton_law(const ssData *d)
 void ss_newton_work_free(ssNewtonWork *w)
 {
   if (!w) return;
-  free(w->group_of); free(w->lam); free(w->lamtry);
+  free(w->group_of); free(w->run); free(w->lam); free(w->lamtry);
   free(w->Lam); free(w->A); free(w->piv); free(w->y); free(w->yfree);
   free(w->phi); free(w->dy); free(w->F); free(w->ytry); free(w->Ftry);
   free(w->phitry); free(w->H); free(w->Htry); free(w->K); free(w->Ktry);
@@ -216,6 +218,7 @@ static ssNewtonWork *work(ssData *d, int n, int nc, int nv, int ng)
   if (!w && !(w = d->newton = calloc(1, sizeof *w))) return NULL;
   if (nc > w->cap_c) {
     if (!grow(&w->group_of, (size_t)nc, sizeof(int)) ||
+        !grow(&w->run, (size_t)nc + 1, sizeof(int)) ||
         !grow(&w->pt, (size_t)nc, sizeof(NPoint)) ||
         !grow(&w->lam, 3 * (size_t)nc, sizeof(double)) ||
         !grow(&w->lamtry, 3 * (size_t)nc, sizeof(double)) ||
@@ -835,12 +838,10 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
   }
   int gprev = -1, sticks = 0, near = 0, *live = w->live;
   Mat M = {0};
-  for (int i0 = 0, i1; i0 < s->first_row; i0 = i1) {
+  for (int u = 0; u < w->nrun; u++) {
     /* a run of one group's points: their laws (impulses, and K, kept for
      * the linear end of a step: apply_linear), then their sums */
-    const int g = w->group_of[i0];
-    for (i1 = i0 + 1; i1 < s->first_row && w->group_of[i1] == g; i1++) {
-    }
+    const int i0 = w->run[u], i1 = w->run[u + 1], g = w->group_of[i0];
     NSum *A = w->sum + g;
     if (g != gprev) {
       gprev = g;
@@ -1028,27 +1029,31 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
   Measure q = {0, 0, 1};
   int gprev = -1;
   Mat M = {0};
-  for (int i = 0; i < s->first_row; i++) {
-    const ssContact *c = d->contact + i;
-    int g = w->group_of[i];
+  for (int u = 0; u < w->nrun; u++) {
+    const int i0 = w->run[u], i1 = w->run[u + 1], g = w->group_of[i0];
     if (g != gprev) {
       gprev = g;
       M = mat_of(w->grp + g, dt);
     }
-    /* the laws keep the points' memos where they are (pow_point): at
-     * the last evaluation's y, so that H formed there later
-     * (ss_newton_solve) is what the evaluation would have formed */
-    NPoint *P = w->pt + i;
-    double lam[3], dn;
-    if (P->imp) {
-      dn = imp_check(&M, P, w->grp + g, w->sum[g].V, c->lambda);
-    } else {
-      dn = point_law(&M, P, w->sum[g].V, lam, NULL, 1) == STICKS
-               ? INFINITY
-               : fabs(lam[0] - c->lambda[0]) + fabs(lam[1] - c->lambda[1]) +
-                     fabs(lam[2] - c->lambda[2]);
+    double V[6];
+    memcpy(V, w->sum[g].V, sizeof V);
+    for (int i = i0; i < i1; i++) {
+      const ssContact *c = d->contact + i;
+      /* the laws keep the points' memos where they are (pow_point): at
+       * the last evaluation's y, so that H formed there later
+       * (ss_newton_solve) is what the evaluation would have formed */
+      NPoint *P = w->pt + i;
+      double lam[3], dn;
+      if (P->imp) {
+        dn = imp_check(&M, P, w->grp + g, V, c->lambda);
+      } else {
+        dn = point_law(&M, P, V, lam, NULL, 1) == STICKS
+                 ? INFINITY
+                 : fabs(lam[0] - c->lambda[0]) + fabs(lam[1] - c->lambda[1]) +
+                       fabs(lam[2] - c->lambda[2]);
+      }
+      measure_add(&q, dn, fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]));
     }
-    measure_add(&q, dn, fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]));
   }
   for (int r = 0; r < s->nrow; r++) {
     const ssContact *c = d->contact + s->first_row + r;
@@ -1422,17 +1427,22 @@ static double apply_linear(const ssModel *m, ssData *d, const Setup *s, ssNewton
 {
   /* (the scratch sums' V hold each group's dy, frame about o) */
   for (int g = 0; g < s->ngroup; g++) to_group(w->grp + g, w->dy + 6 * g, w->sum[g].V);
-  for (int i = 0; i < s->first_row; i++) {
-    const double *l = w->lam + 3 * i, *K = w->K + 6 * i;
-    double *lt = w->lamtry + 3 * i, dv[3];
-    lt[0] = lt[1] = lt[2] = 0;
-    if (!(l[0] > 0)) continue;
-    point_velocity(w->pt[i].r, w->sum[w->group_of[i]].V, dv);
-    double ln = l[0] + K[0] * dv[0];
-    if (!(ln > 0)) return INFINITY;
-    lt[0] = ln;
-    lt[1] = l[1] + K[1] * dv[0] + K[3] * dv[1] + K[4] * dv[2];
-    lt[2] = l[2] + K[2] * dv[0] + K[4] * dv[1] + K[5] * dv[2];
+  for (int u = 0; u < w->nrun; u++) {
+    const int i1 = w->run[u + 1];
+    double V[6];
+    memcpy(V, w->sum[w->group_of[w->run[u]]].V, sizeof V);
+    for (int i = w->run[u]; i < i1; i++) {
+      const double *l = w->lam + 3 * i, *K = w->K + 6 * i;
+      double *lt = w->lamtry + 3 * i, dv[3];
+      lt[0] = lt[1] = lt[2] = 0;
+      if (!(l[0] > 0)) continue;
+      point_velocity(w->pt[i].r, V, dv);
+      double ln = l[0] + K[0] * dv[0];
+      if (!(ln > 0)) return INFINITY;
+      lt[0] = ln;
+      lt[1] = l[1] + K[1] * dv[0] + K[3] * dv[1] + K[4] * dv[2];
+      lt[2] = l[2] + K[2] * dv[0] + K[4] * dv[1] + K[5] * dv[2];
+    }
   }
   for (int g = 0; g < s->ngroup; g++) {
     const double *H = w->H + 36 * g, *dy = w->dy + 6 * g;
@@ -1589,7 +1599,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
    * run's group, its key and its points' largest offsets stay in locals
    * while it goes on. */
   const double dt = m->opt.timestep;
-  int gr = -1, run_link = 0, run_sys = 0, run_bed = 0;
+  int gr = -1, run_link = 0, run_sys = 0, run_bed = 0, nrun = 0;
   NGroup *G = NULL;
   double rm0 = 0, rm1 = 0, rm2 = 0;
   for (int i = 0; i < first_row; i++) {
@@ -1597,6 +1607,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     if (c->type != SS_CONTACT_SOIL) return 0;
     if (!(G && c->link == run_link && c->sys == run_sys && c->hfield == run_bed)) {
       /* a new run: the last one's offsets into its group first */
+      w->run[nrun++] = i;
       if (G) {
         G->rmax[0] = rm0;
         G->rmax[1] = rm1;
@@ -1670,6 +1681,8 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     G->rmax[1] = rm1;
     G->rmax[2] = rm2;
   }
+  w->run[nrun] = first_row;
+  w->nrun = nrun;
   int n = 6 * ngroup + nrow;
   if (!work(d, n, 0, 0, ngroup)) return 0;
   Setup s = {ngroup, nrow, n, first_row, 1};
