@@ -17,6 +17,11 @@ struct ssArtWork {
   int neq, *eq;          /* closures of this system (model indices) */
   int *dof_body;         /* (nv) body of each local dof */
   int *dof_parent;       /* (nv) LTDL parent dof, -1 at the root */
+  int *anc, *anc_adr;    /* (sum of depths), (nv + 1): dof k's chain to the
+                            root, k first, at anc + anc_adr[k] (the factor's
+                            and solves' loops read their dofs from it: a
+                            parent's index is then no load that waits for
+                            the last one) */
   double *S;             /* (nv x 6) motion subspace columns, world */
   double *vel;           /* (nb x 6) body spatial velocities */
   double *acc;           /* (nb x 6) bias accelerations */
@@ -144,7 +149,8 @@ static int last_dof(const ssModel *m, const ssArtWork *w, int a)
 void ss_art_work_free(ssArtWork *w)
 {
   if (!w) return;
-  free(w->eq); free(w->dof_body); free(w->dof_parent); free(w->S);
+  free(w->eq); free(w->dof_body); free(w->dof_parent); free(w->anc); free(w->anc_adr);
+  free(w->S);
   free(w->vel); free(w->acc); free(w->frc); free(w->I6); free(w->Ic);
   free(w->M); free(w->L); free(w->rhs); free(w->x); free(w->y);
   free(w->K); free(w->phi); free(w->MiKT); free(w->A); free(w->Z); free(w->row_on);
@@ -231,6 +237,22 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
       w->dof_parent[k0 + k] = k ? k0 + k - 1 : par;
     }
   }
+  /* the chains to the root (parents come before their children) */
+  int nanc = 0;
+  for (int k = 0; k < w->nv; k++)
+    for (int j = k; j >= 0; j = w->dof_parent[j]) nanc++;
+  w->anc = malloc((size_t)(nanc ? nanc : 1) * sizeof(int));
+  w->anc_adr = malloc((nv + 1) * sizeof(int));
+  if (!w->anc || !w->anc_adr) {
+    ss_art_work_free(w);
+    return NULL;
+  }
+  nanc = 0;
+  for (int k = 0; k < w->nv; k++) {
+    w->anc_adr[k] = nanc;
+    for (int j = k; j >= 0; j = w->dof_parent[j]) w->anc[nanc++] = j;
+  }
+  w->anc_adr[w->nv] = nanc;
   /* each closure row's columns, from the dofs closures writes (path_zero
    * and point_row along both bodies' paths; an equality's two dofs) */
   unsigned char *on = calloc(nv, 1);
@@ -386,15 +408,22 @@ static int ltdl_factor(ssArtWork *w)
    * ones the factor and ltdl_solve read; the rest of L stays as calloc
    * left it) */
   for (int k = 0; k < n; k++)
-    for (int j = k; j >= 0; j = w->dof_parent[j]) H[k * n + j] = w->M[k * n + j];
+    for (int t = w->anc_adr[k]; t < w->anc_adr[k + 1]; t++) {
+      int j = w->anc[t];
+      H[k * n + j] = w->M[k * n + j];
+    }
   double dmax = 0;
   for (int k = 0; k < n; k++) dmax = fmax(dmax, fabs(H[k * n + k]));
   for (int k = n - 1; k >= 0; k--) {
     if (!(H[k * n + k] > 1e-14 * dmax)) return -1 - k;
-    for (int i = w->dof_parent[k]; i >= 0; i = w->dof_parent[i]) {
-      double a = H[k * n + i] / H[k * n + k];
-      for (int j = i; j >= 0; j = w->dof_parent[j]) H[i * n + j] -= a * H[k * n + j];
-      H[k * n + i] = a;
+    /* i runs up k's chain; its own chain is the rest of k's */
+    const int *ak = w->anc + w->anc_adr[k], nk = w->anc_adr[k + 1] - w->anc_adr[k];
+    double *Hk = H + (size_t)k * n;
+    for (int t = 1; t < nk; t++) {
+      int i = ak[t];
+      double a = Hk[i] / Hk[k], *Hi = H + (size_t)i * n;
+      for (int u = t; u < nk; u++) Hi[ak[u]] -= a * Hk[ak[u]];
+      Hk[i] = a;
     }
   }
   return 0;
@@ -414,7 +443,8 @@ static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
     int r = 0;
     while (r < m && xi[r] == 0) r++;
     if (r == m) continue;
-    for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) {
+    for (int t = w->anc_adr[i] + 1; t < w->anc_adr[i + 1]; t++) {
+      int j = w->anc[t];
       double h = H[i * n + j], *xj = X + (size_t)m * j;
       ss_row_add_scaled(xj, -h, xi, m);
     }
@@ -433,7 +463,8 @@ static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
       memcpy(&a0, xi, sizeof a0);
       memcpy(&a1, xi + 2, sizeof a1);
       memcpy(&a2, xi + 4, sizeof a2);
-      for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) {
+      for (int t = w->anc_adr[i] + 1; t < w->anc_adr[i + 1]; t++) {
+        int j = w->anc[t];
         double h = -H[i * n + j];
         ssV2 hv = {h, h};
         const double *xj = X + 6 * (size_t)j;
@@ -449,7 +480,8 @@ static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
       memcpy(xi + 4, &a2, sizeof a2);
       continue;
     }
-    for (int j = w->dof_parent[i]; j >= 0; j = w->dof_parent[j]) {
+    for (int t = w->anc_adr[i] + 1; t < w->anc_adr[i + 1]; t++) {
+      int j = w->anc[t];
       double h = H[i * n + j];
       const double *xj = X + (size_t)m * j;
       ss_row_add_scaled(xi, -h, xj, m);
@@ -793,7 +825,8 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
     for (int k = k0; k < k0 + nd; k++) {
       double F[6];
       m6v(F, w->Ic + 36 * lb, w->S + 6 * k);
-      for (int j = k; j >= 0; j = w->dof_parent[j]) {
+      for (int t = w->anc_adr[k]; t < w->anc_adr[k + 1]; t++) {
+        int j = w->anc[t];
         double v = dot6(w->S + 6 * j, F);
         w->M[k * n + j] = w->M[j * n + k] = v;
       }
@@ -906,7 +939,7 @@ static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, doubl
                    double *XD, double *W)
 {
   int n = w->nv, nr = w->nrow, np = 0;
-  for (int k = top; k >= 0; k = w->dof_parent[k]) path[np++] = k;
+  for (int t = w->anc_adr[top]; t < w->anc_adr[top + 1]; t++) path[np++] = w->anc[t];
   *npath = np;
   for (int i = 0; i < np; i++) {
     int k = path[i];
@@ -917,8 +950,8 @@ static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, doubl
   for (int i = 0; i < np; i++) {
     int k = path[i];
     const double *xk = X + (size_t)ncol * k;
-    for (int j = w->dof_parent[k]; j >= 0; j = w->dof_parent[j])
-      ss_row_add_scaled(X + (size_t)ncol * j, -H[k * n + j], xk, ncol);
+    for (int t = i + 1; t < np; t++)
+      ss_row_add_scaled(X + (size_t)ncol * path[t], -H[k * n + path[t]], xk, ncol);
   }
   for (int i = 0; i < np; i++) {
     int k = path[i];
