@@ -1215,12 +1215,28 @@ static void lu_solve(const double *A, const int *piv, int n, double *x)
     }
   /* L's substitution row by row: x_i's updates are those of the column
    * sweep (x_i -= l_ik x_k for k = 0, 1, ...), in the same order, with
-   * x_i in a register and l_i read along its row */
-  for (int i = 1; i < n; i++) {
+   * x_i in a register and l_i read along its row.  Two rows at a time:
+   * each row's sum is a chain of dependent subtractions, and the second
+   * row's, which needs x_i only for its last term, runs beside the
+   * first's (the same operations, in the same order, for each row) */
+  int i = 1;
+  for (; i + 1 < n; i += 2) {
+    const double *a0 = A + i * n, *a1 = a0 + n;
+    double t0 = x[i], t1 = x[i + 1];
+    for (int k = 0; k < i; k++) {
+      t0 -= a0[k] * x[k];
+      t1 -= a1[k] * x[k];
+    }
+    x[i] = t0;
+    x[i + 1] = t1 - a1[i] * t0;
+  }
+  for (; i < n; i++) {
     double t = x[i];
     for (int k = 0; k < i; k++) t -= A[i * n + k] * x[k];
     x[i] = t;
   }
+  /* (U's sums start with the term of the row just solved: one row at a
+   * time) */
   for (int k = n - 1; k >= 0; k--) {
     double t = x[k];
     for (int j = k + 1; j < n; j++) t -= A[k * n + j] * x[j];
