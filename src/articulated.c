@@ -480,11 +480,41 @@ static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
       memcpy(xi + 4, &a2, sizeof a2);
       continue;
     }
+    /* wider blocks (the closure rows' columns, MiKT): eight columns at a
+     * time in registers, four pairs, each column's sum over the ancestors
+     * in the same order as the row updates after them */
+    int c = 0;
+    for (; c + 8 <= m; c += 8) {
+      ssV2 a0, a1, a2, a3, x0, x1, x2, x3;
+      memcpy(&a0, xi + c, sizeof a0);
+      memcpy(&a1, xi + c + 2, sizeof a1);
+      memcpy(&a2, xi + c + 4, sizeof a2);
+      memcpy(&a3, xi + c + 6, sizeof a3);
+      for (int t = w->anc_adr[i] + 1; t < w->anc_adr[i + 1]; t++) {
+        int j = w->anc[t];
+        double h = -H[i * n + j];
+        ssV2 hv = {h, h};
+        const double *xj = X + (size_t)m * j + c;
+        memcpy(&x0, xj, sizeof x0);
+        memcpy(&x1, xj + 2, sizeof x1);
+        memcpy(&x2, xj + 4, sizeof x2);
+        memcpy(&x3, xj + 6, sizeof x3);
+        a0 += hv * x0;
+        a1 += hv * x1;
+        a2 += hv * x2;
+        a3 += hv * x3;
+      }
+      memcpy(xi + c, &a0, sizeof a0);
+      memcpy(xi + c + 2, &a1, sizeof a1);
+      memcpy(xi + c + 4, &a2, sizeof a2);
+      memcpy(xi + c + 6, &a3, sizeof a3);
+    }
+    if (c == m) continue;
     for (int t = w->anc_adr[i] + 1; t < w->anc_adr[i + 1]; t++) {
       int j = w->anc[t];
       double h = H[i * n + j];
       const double *xj = X + (size_t)m * j;
-      ss_row_add_scaled(xi, -h, xj, m);
+      ss_row_add_scaled(xi + c, -h, xj + c, m - c);
     }
   }
 }
@@ -637,6 +667,23 @@ static inline void closure_forward(const ssArtWork *w, double *Z, int m)
   const double *A = w->A;
   for (int i = 0; i < nr; i++) {
     double *zi = Z + (size_t)m * i;
+    if (m == 1 && i + 1 < nr && w->row_on[i] && w->row_on[i + 1]) {
+      /* one column: rows i and i + 1 together, each row's chain of
+       * dependent sums beside the other's (row i + 1 needs z_i only for
+       * its last term), the same operations in the same order */
+      const double *a0 = A + i * nr, *a1 = a0 + nr;
+      double t0 = Z[i], t1 = Z[i + 1];
+      for (int k = 0; k < i; k++) {
+        t0 += -a0[k] * Z[k];
+        t1 += -a1[k] * Z[k];
+      }
+      t0 /= a0[i];
+      t1 += -a1[i] * t0;
+      Z[i] = t0;
+      Z[i + 1] = t1 / a1[i + 1];
+      i++;
+      continue;
+    }
     if (!w->row_on[i]) {
       for (int r = 0; r < m; r++) zi[r] = 0;
       continue;
