@@ -452,14 +452,17 @@ void ss_terrain_update(const ssModel *m, ssData *d)
   /* room for the new list of loaded vertices (at most one per contact)
    * and the scratch of its sort after it; without it the old list stays
    * (worst case some vertices recover a step late) */
-  if (2 * d->ncontact > d->cap_soil_loaded) {
-    int *p = realloc(d->soil_loaded, (size_t)d->ncontact * 2 * sizeof(int));
+  const int ncontact = d->ncontact;
+  if (2 * ncontact > d->cap_soil_loaded) {
+    int *p = realloc(d->soil_loaded, (size_t)ncontact * 2 * sizeof(int));
     if (p) {
       d->soil_loaded = p;
-      d->cap_soil_loaded = 2 * d->ncontact;
+      d->cap_soil_loaded = 2 * ncontact;
     }
   }
-  int collect = 2 * d->ncontact <= d->cap_soil_loaded;
+  const int collect = 2 * ncontact <= d->cap_soil_loaded;
+  int *loaded = d->soil_loaded;
+  const ssContact *contact = d->contact;
   /* the material of bed `bed` and s^(n-1) for it: 1 where n = 1, else
    * by its table (solver.h), else libm, as the law forms it */
   int nload = 0, bed = -1;
@@ -471,8 +474,11 @@ void ss_terrain_update(const ssModel *m, ssData *d)
    * stores could alias them, as the compiler sees it) */
   int nrigid = 0, nsoil = 0;
   double area = 0, normal = 0;
-  for (int i = 0; i < d->ncontact; i++) {
-    ssContact *c = d->contact + i;
+  /* the end of the loaded vertices' first strictly ascending run, -1
+   * while it goes on (one collider's vertices come so) */
+  int run = -1, last = -1;
+  for (int i = 0; i < ncontact; i++) {
+    const ssContact *c = contact + i;
     if (c->type != SS_CONTACT_SOIL) {
       if (c->type == SS_CONTACT_RIGID) nrigid++;
       continue;
@@ -498,7 +504,9 @@ void ss_terrain_update(const ssModel *m, ssData *d)
     if (jn > d->soil_shear[v]) d->soil_shear[v] = jn;
     area += c->area;
     normal += c->lambda[0] / dt;
-    if (collect) d->soil_loaded[nload] = v;
+    if (collect) loaded[nload] = v;
+    if (v <= last && run < 0) run = nload;
+    last = v;
     nload++;
   }
   st->rigid_contacts = nrigid;
@@ -507,14 +515,17 @@ void ss_terrain_update(const ssModel *m, ssData *d)
   st->soil_contact_area = area;
   st->soil_normal_force = normal;
   if (!collect) return;
-  /* the new list of loaded vertices (unique): one collider's vertices
-   * come in order already (then the sort only checks them); several
-   * colliders' are merged.  (With none loaded the list may not exist yet:
-   * no arithmetic on its NULL.) */
-  const int *v = nload > 1 ? merge_sort_runs(d->soil_loaded, d->soil_loaded + nload, nload)
-                           : d->soil_loaded;
+  /* the new list of loaded vertices (unique): as they came where they
+   * ascend strictly (one collider's, or none loaded, when the list may
+   * not exist yet: no arithmetic on its NULL), else merged from their
+   * runs (one per collider, the first known) */
+  if (run < 0) {
+    d->nsoil_loaded = nload;
+    return;
+  }
+  const int *v = merge_sort_runs_from(loaded, loaded + nload, nload, run);
   int u = 0;
   for (int i = 0; i < nload; i++)
-    if (u == 0 || d->soil_loaded[u - 1] != v[i]) d->soil_loaded[u++] = v[i];
+    if (u == 0 || loaded[u - 1] != v[i]) loaded[u++] = v[i];
   d->nsoil_loaded = u;
 }
