@@ -576,17 +576,20 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
    * them, as the compiler sees it) */
   const int converged = d->stats.converged, ncontact = d->ncontact;
   const double tol = m->opt.solver_tolerance;
+  /* the end of the entries' first run of ascending keys, -1 while it
+   * goes on, for the sort (the soil points come in runs, see warm_key) */
+  int run = -1;
+  uint64_t last = 0;
   for (int i = 0; i < ncontact; i++) {
     const ssContact *c = d->contact + i;
     if (!cached(c)) continue;
-    ssWarmEntry *e = next + n++;
+    ssWarmEntry *e = next + n;
     e->creep = 0;
     if (c->type == SS_CONTACT_SOIL) {
       double inv = 1.0 / (c->area * dt);
       int trend = c->warm_trend && converged;
       e->vertex = c->vertex;
       e->geom = c->geom;
-      e->key = warm_key(c->geom, c->vertex);
       /* (the soil points come first, as the Newton phase needs) */
       const double *l = law ? law + 3 * i : c->lambda;
       double ch = 0, size = 0;
@@ -608,11 +611,15 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
       }
     } else {
       row_key(d, c, &e->geom, &e->vertex);
-      e->key = warm_key(e->geom, e->vertex);
       e->traction[0] = c->lambda[0] / dt;
       e->traction[1] = e->traction[2] = 0;
       e->rate[0] = e->rate[1] = e->rate[2] = 0;
     }
+    uint64_t key = warm_key(e->geom, e->vertex);
+    e->key = key;
+    if (key < last && run < 0) run = n;
+    last = key;
+    n++;
   }
   /* a creeping collider's points keep no rates */
   int creeping = 0;
@@ -626,7 +633,7 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
     e->creep = e->geom >= 0 && patch[3 * e->geom] != 0 &&
                (e->rate[0] != 0 || e->rate[1] != 0 || e->rate[2] != 0);
   }
-  if (sort_runs(next, d->warm, n) == next) {
+  if (run < 0 || sort_runs_from(next, d->warm, n, run) == next) {
     /* sorted in warm_next: the buffers change places (and capacities) */
     int cap = d->cap_warm;
     d->warm_next = d->warm;
