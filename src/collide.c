@@ -721,15 +721,18 @@ typedef struct BandChain {
  * one division a cell instead of six (they sat on the edge cells' chain
  * of dependent operations).  c->k, the first edge that may reach past a,
  * moves on as the cells do. */
-static void chain_integrals(BandChain *c, double a, double b, double sh, double I[3])
+static inline void chain_integrals(BandChain *c, double a, double b, double sh, double I[3])
 {
   const double *x = c->x, *y = c->y;
+  const int m = c->m;
   int k = c->k;
   if (k > 0 && x[k] > a) k = 0;
-  while (k < c->m - 2 && x[k + 1] <= a) k++;
+  while (k < m - 2 && x[k + 1] <= a) k++;
   c->k = k;
-  I[0] = I[1] = I[2] = 0;
-  for (; k < c->m - 1 && x[k] < b; k++) {
+  /* the sums in locals, stored once: stored as they grow, each would be
+   * read back after every store (a double's store may alias them) */
+  double i0 = 0, i1 = 0, i2 = 0;
+  for (; k < m - 1 && x[k] < b; k++) {
     double xa = x[k], xb = x[k + 1];
     if (!(xb > xa)) continue; /* an edge along y adds nothing */
     double s = xa > a ? xa : a, t = xb < b ? xb : b, w = t - s;
@@ -738,10 +741,13 @@ static void chain_integrals(BandChain *c, double a, double b, double sh, double 
     double ys = s == xa ? y[k] : y[k] + (s - xa) * slope;
     double yt = t == xb ? y[k + 1] : y[k] + (t - xa) * slope;
     double su = s - sh, tu = t - sh;
-    I[0] += w * (ys + yt);
-    I[1] += w * (su * (2 * ys + yt) + tu * (ys + 2 * yt));
-    I[2] += w * (ys * ys + ys * yt + yt * yt);
+    i0 += w * (ys + yt);
+    i1 += w * (su * (2 * ys + yt) + tu * (ys + 2 * yt));
+    i2 += w * (ys * ys + ys * yt + yt * yt);
   }
+  I[0] = i0;
+  I[1] = i1;
+  I[2] = i2;
 }
 
 int ss_poly_band(const ssPoly2 *p, ssPolyChains *yc, double y0, double y1, double ox,
