@@ -175,81 +175,104 @@ static void axis_side(const double a[3], double w[3])
  * cleanly convex; convex_hull then decides. */
 static int swept_hull(const pt2 *p, int n, int ccw, double tx, double ty, ssPoly2 *out)
 {
-  /* the points counter-clockwise, q[0, n) (first copy) and q[n, 2n);
-   * B, A: least and greatest extent along the normal (-ty, tx) */
-  pt2 q[HULL_IN_MAX];
-  for (int k = 0; k < n; k++) {
-    int i = ccw || k == 0 ? k : n - k;
-    q[k] = p[i];
-    q[n + k] = p[n + i];
-  }
+  /* the points counter-clockwise, read in place: the first copy's k-th is
+   * p[i] with i = k d (mod n), d = 1 when ccw, else n - 1 (p[0], then
+   * backwards), the second copy's p[n + i]; B, A: least and greatest
+   * extent along the normal (-ty, tx) */
+  const int d = ccw ? 1 : n - 1;
   int kb = 0, ka = 0;
   double lo = INFINITY, hi = -INFINITY;
-  for (int k = 0; k < n; k++) {
-    double e = tx * q[k].y - ty * q[k].x;
+  for (int k = 0, i = 0; k < n; k++, i = i + d < n ? i + d : i + d - n) {
+    double e = tx * p[i].y - ty * p[i].x;
     if (e < lo) {
       lo = e;
-      kb = k;
+      kb = i;
     }
     if (e > hi) {
       hi = e;
-      ka = k;
+      ka = i;
     }
   }
+  /* B to A on the first copy (its edges face +t), A to B on the second,
+   * and their bounding box (begun at the first point, as they come) */
   pt2 h[HULL_IN_MAX + 2];
   int m = 0;
-  /* B to A on the first copy (its edges face +t), A to B on the second */
-  for (int k = kb;; k = k + 1 == n ? 0 : k + 1) {
-    h[m++] = q[k];
-    if (k == ka) break;
+  double xlo = p[kb].x, xhi = p[kb].x, ylo = p[kb].y, yhi = p[kb].y;
+  for (int i = kb, stop = 0; !stop; i = i + d < n ? i + d : i + d - n) {
+    pt2 v = p[i];
+    stop = i == ka;
+    h[m++] = v;
+    if (v.x < xlo) xlo = v.x;
+    if (v.x > xhi) xhi = v.x;
+    if (v.y < ylo) ylo = v.y;
+    if (v.y > yhi) yhi = v.y;
   }
-  for (int k = ka;; k = k + 1 == n ? 0 : k + 1) {
-    h[m++] = q[n + k];
-    if (k == kb) break;
-  }
-  double xlo = h[0].x, xhi = h[0].x, ylo = h[0].y, yhi = h[0].y;
-  for (int i = 1; i < m; i++) {
-    if (h[i].x < xlo) xlo = h[i].x;
-    if (h[i].x > xhi) xhi = h[i].x;
-    if (h[i].y < ylo) ylo = h[i].y;
-    if (h[i].y > yhi) yhi = h[i].y;
+  for (int i = ka, stop = 0; !stop; i = i + d < n ? i + d : i + d - n) {
+    pt2 v = p[n + i];
+    stop = i == kb;
+    h[m++] = v;
+    if (v.x < xlo) xlo = v.x;
+    if (v.x > xhi) xhi = v.x;
+    if (v.y < ylo) ylo = v.y;
+    if (v.y > yhi) yhi = v.y;
   }
   double ext = xhi - xlo > yhi - ylo ? xhi - xlo : yhi - ylo;
   if (!(ext > 0)) return 0;
   double tol = HULL_COLLINEAR_EPS * ext * ext;
-  /* left turns only, as convex_hull keeps them, around the cycle */
-  int k = 0;
+  /* left turns only, as convex_hull keeps them, around the cycle.  Every
+   * turn the stack keeps was tested left when its last point came, so
+   * only a test neither left nor not (NaN: a point not finite) leaves
+   * the turns to be tested again below (odd) */
+  int k = 0, odd = 0;
   for (int i = 0; i < m; i++) {
-    while (k >= 2 && cross3(&h[k - 2], &h[k - 1], &h[i]) <= tol) k--;
+    while (k >= 2) {
+      double t = cross3(&h[k - 2], &h[k - 1], &h[i]);
+      if (!(t <= tol)) {
+        odd |= !(t > tol);
+        break;
+      }
+      k--;
+    }
     h[k++] = h[i];
   }
   int first = 0;
   for (int changed = 1; changed && k - first >= 3;) {
     changed = 0;
-    if (cross3(&h[k - 2], &h[k - 1], &h[first]) <= tol) {
+    double t0 = cross3(&h[k - 2], &h[k - 1], &h[first]), t1;
+    if (t0 <= tol) {
       k--;
       changed = 1;
-    } else if (cross3(&h[k - 1], &h[first], &h[first + 1]) <= tol) {
+    } else if ((t1 = cross3(&h[k - 1], &h[first], &h[first + 1])) <= tol) {
       first++;
       changed = 1;
+    } else {
+      /* the two turns across the cycle's ends, tested last */
+      odd |= !(t0 > tol && t1 > tol);
     }
   }
   const pt2 *c = h + first;
   int cnt = k - first;
   if (cnt < 3) return 0;
   /* every turn left (the filter's stack makes them so, unless a point is
-   * not finite): else leave it to convex_hull */
-  for (int i = 0; i < cnt; i++) {
-    int i1 = i + 1 < cnt ? i + 1 : i + 1 - cnt, i2 = i + 2 < cnt ? i + 2 : i + 2 - cnt;
-    if (!(cross3(c + i, c + i1, c + i2) > tol)) return 0;
+   * not finite: odd): else leave it to convex_hull */
+  if (odd) {
+    for (int i = 0; i < cnt; i++) {
+      int i1 = i + 1 < cnt ? i + 1 : i + 1 - cnt, i2 = i + 2 < cnt ? i + 2 : i + 2 - cnt;
+      if (!(cross3(c + i, c + i1, c + i2) > tol)) return 0;
+    }
   }
   int start = 0;
   for (int i = 1; i < cnt; i++)
     if (pt_less(c + i, c + start)) start = i;
+  /* from the least point to the end, then the rest */
   out->n = cnt;
-  for (int i = 0, j = start; i < cnt; i++, j = j + 1 == cnt ? 0 : j + 1) {
-    out->x[i] = c[j].x;
-    out->y[i] = c[j].y;
+  for (int i = start; i < cnt; i++) {
+    out->x[i - start] = c[i].x;
+    out->y[i - start] = c[i].y;
+  }
+  for (int i = 0; i < start; i++) {
+    out->x[cnt - start + i] = c[i].x;
+    out->y[cnt - start + i] = c[i].y;
   }
   return 1;
 }
