@@ -240,7 +240,7 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
   long jadr = ss_contact_jac_end(d);
   const double *z0 = m->hfield_data + adr;
   const double *sp = d->soil_plastic + adr, *jj = d->soil_shear + adr;
-  double tiny = 1e-12 * dx * dy;
+  double tiny = 1e-12 * dx * dy, hdx = 0.5 * dx;
 
   /* the chord at the last row's upper boundary, which is (to round-off)
    * this row's lower one */
@@ -262,27 +262,33 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       in1 = fmin(a1, b1) - 1e-9 * dx;
     }
     int band_ready = 0;
+    /* the row's vertices */
+    const int kr = j * nx;
+    const double *zr = z0 + kr, *spr = sp + kr, *jr = jj + kr;
     /* room for the row's points at once (ss_contact_add below) */
     if (!ss_contact_reserve(d, i1 - i0 + 1, njac))
       return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
     for (int i = i0; i <= i1; i++) {
       double x = x0 + i * dx;
-      double cx0 = i == 0 ? x : x - 0.5 * dx, cx1 = i == nx - 1 ? x : x + 0.5 * dx;
+      double cx0 = i == 0 ? x : x - hdx, cx1 = i == nx - 1 ? x : x + hdx;
       double qx = x, qy = y, full = (cx1 - cx0) * (cy1 - cy0), area = full;
       if (!(cx0 > in0 && cx1 < in1)) {
         if (!band_ready) {
           band_ready = banded && ss_poly_band(&fp, &ych, cy0, cy1, x, &band) ? 1 : -1;
         }
-        area = band_ready > 0 ? ss_poly_band_area(&band, cx0, cx1, &qx, &qy)
-                              : ss_poly_rect_area(&fp, cx0, cx1, cy0, cy1, &qx, &qy);
+        /* (the centroid in its own pair: qx and qy, whose addresses the
+         * calls would take, would live in memory for every cell) */
+        double gx = x, gy = y;
+        area = band_ready > 0 ? ss_poly_band_area(&band, cx0, cx1, &gx, &gy)
+                              : ss_poly_rect_area(&fp, cx0, cx1, cy0, cy1, &gx, &gy);
         if (!(area > tiny)) continue;
         /* the point represents the covered part of the cell: the vertex
          * when the cell is fully covered, else the covered part's centroid
          * (a vertex on or outside the footprint's edge would see a side
          * face) */
-        if (area >= full * (1 - 1e-9)) {
-          qx = x;
-          qy = y;
+        if (!(area >= full * (1 - 1e-9))) {
+          qx = gx;
+          qy = gy;
         }
       }
       double zl;
@@ -291,8 +297,8 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       } else if (!ss_shape_cast_lowest_z(&cast, qx, qy, &zl)) {
         continue;
       }
-      int k = j * nx + i;
-      double floor_z = z0[k] - sp[k];
+      int k = kr + i;
+      double floor_z = zr[i] - spr[i];
       double g0 = zl - floor_z;
       if (g0 > margin) continue;
       ssContact *c = ss_contact_add_head(d, &head, jadr);
@@ -310,8 +316,8 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       memcpy(c->frame, frame, sizeof frame);
       c->area = area;
       c->g0 = g0;
-      c->sp = sp[k];
-      c->j = jj[k];
+      c->sp = spr[i];
+      c->j = jr[i];
       attach_response(&at, c);
     }
   }
