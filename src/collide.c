@@ -644,8 +644,8 @@ static int chain_search(const double *x, int n, int start, int cnt, double v,
 /* the edges (index of their end vertex) of chain start -> start + cnt of
  * the polygon (co, n) whose range in the coordinate co meets [x0, x1], as
  * up to two ascending index ranges */
-static int chain_edges(const double *co, int n, int start, int cnt, double sgn,
-                       double x0, double x1, int hint[2], int *rg)
+static inline int chain_edges(const double *co, int n, int start, int cnt, double sgn,
+                              double x0, double x1, int hint[2], int *rg)
 {
   int s1 = start + 1 < n ? start + 1 : 0;
   /* sgn = 1: co rises along the chain; edge k runs from vertex k to k + 1 */
