@@ -556,6 +556,23 @@ static int clip_slab(const double *ic, const double *io, int n, const int *rg,
   return m;
 }
 
+/* whether co never falls (rise) or never rises (!rise) along the vertices
+ * a, a + 1, ..., b of the polygon (co, n), indices modulo n: the run to the
+ * array's end, its edge n - 1 -> 0, then the run from 0, so that no step
+ * tests for the wrap */
+static inline int chain_monotone(const double *co, int n, int a, int b, int rise)
+{
+  if (a > b) {
+    for (int i = a; i < n - 1; i++)
+      if (rise ? co[i + 1] < co[i] : co[i + 1] > co[i]) return 0;
+    if (rise ? co[0] < co[n - 1] : co[0] > co[n - 1]) return 0;
+    a = 0;
+  }
+  for (int i = a; i < b; i++)
+    if (rise ? co[i + 1] < co[i] : co[i + 1] > co[i]) return 0;
+  return 1;
+}
+
 /* the two chains of the polygon (co, n) monotone in the coordinate co */
 static int mono_chains(const double *co, int n, ssPolyChains *c)
 {
@@ -567,16 +584,7 @@ static int mono_chains(const double *co, int n, ssPolyChains *c)
   }
   if (l == r) return 0;
   /* co must not fall from l to r, nor rise from r back to l */
-  for (int i = l; i != r;) {
-    int k = i + 1 < n ? i + 1 : 0;
-    if (co[k] < co[i]) return 0;
-    i = k;
-  }
-  for (int i = r; i != l;) {
-    int k = i + 1 < n ? i + 1 : 0;
-    if (co[k] > co[i]) return 0;
-    i = k;
-  }
+  if (!chain_monotone(co, n, l, r, 1) || !chain_monotone(co, n, r, l, 0)) return 0;
   c->l = l;
   c->r = r;
   for (int k = 0; k < 4; k++) c->hint[k] = -1;
