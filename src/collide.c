@@ -781,6 +781,19 @@ static inline void chain_integrals(BandChain *c, double a, double b, double sh, 
   I[2] = i2;
 }
 
+/* vertices i = i0, i0 + step, ..., i1 of (x, y) into the band b from its
+ * m-th on, in a run that does not wrap (a chain that does takes two, so
+ * that no vertex tests for the wrap); returns the band's new count */
+static inline int band_put(ssPolyBand *b, int m, const double *x, const double *y, int i0,
+                           int i1, int step)
+{
+  for (int i = i0;; i += step) {
+    b->x[m] = x[i];
+    b->y[m++] = y[i];
+    if (i == i1) return m;
+  }
+}
+
 int ss_poly_band(const ssPoly2 *p, ssPolyChains *yc, double y0, double y1, double ox,
                  ssPolyBand *b)
 {
@@ -799,16 +812,18 @@ int ss_poly_band(const ssPoly2 *p, ssPolyChains *yc, double y0, double y1, doubl
   ssPolyChains c;
   if (!mono_chains(x, n, &c)) return 0;
   int m = 0;
-  for (int i = c.l;; i = i + 1 < n ? i + 1 : 0) {
-    b->x[m] = x[i];
-    b->y[m++] = y[i];
-    if (i == c.r) break;
+  if (c.l <= c.r) {
+    m = band_put(b, m, x, y, c.l, c.r, 1);
+  } else {
+    m = band_put(b, m, x, y, c.l, n - 1, 1);
+    m = band_put(b, m, x, y, 0, c.r, 1);
   }
   b->l = m;
-  for (int i = c.l;; i = i > 0 ? i - 1 : n - 1) {
-    b->x[m] = x[i];
-    b->y[m++] = y[i];
-    if (i == c.r) break;
+  if (c.l >= c.r) {
+    m = band_put(b, m, x, y, c.l, c.r, -1);
+  } else {
+    m = band_put(b, m, x, y, c.l, 0, -1);
+    m = band_put(b, m, x, y, n - 1, c.r, -1);
   }
   b->n = m;
   b->k[0] = b->k[1] = 0;
