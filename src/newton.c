@@ -276,7 +276,7 @@ static inline __attribute__((always_inline)) double pow_point(NPoint *P, double 
                                                              const ssPowSeries *ser,
                                                              const int keep)
 {
-  return keep ? ss_pow_at(&P->pw, s, ser) : ss_pow_moved(&P->pw, s, ser);
+  return keep ? ss_pow_at(&P->pw, s, ser, 0) : ss_pow_moved(&P->pw, s, ser, 0);
 }
 
 /* Janosi mobilisation 1 - exp(-x) of point P and exp(-x) in *e; keep as

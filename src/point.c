@@ -83,7 +83,7 @@ typedef ssLaw Law;
  * it: seven terms where pow would cost a log and an exp */
 static inline double pow_near(Law *L, double s)
 {
-  return ss_pow_moved(&L->pw, s, &L->pser);
+  return ss_pow_moved(&L->pw, s, &L->pser, 1);
 }
 
 /* Normal pressure at end-of-step normal velocity vn (DESIGN 3.1) and its

@@ -296,25 +296,37 @@ typedef struct ssPowMemo {
   double s, v, is;
 } ssPowMemo;
 
-/* s^a as ss_pow_moved forms it, the memo left where it is.  Its table
- * (a point's first power of a step) inline: a call here made the caller
- * keep every live value of its loop on the stack around it (all of SSE's
- * registers are the caller's to save), which cost as much as the table;
- * only libm's pow, where there is no table, stays a call. */
-static inline double ss_pow_at(const ssPowMemo *c, double s, const ssPowSeries *p)
+/* s^a from p's table, or libm's pow where it has none, out of line (for
+ * a caller whose loop is small: the sweeps' point law, src/point.c) */
+static __attribute__((noinline, unused)) double ss_pow_far(const ssPowSeries *p, double s)
+{
+  return p->tab ? ss_pow_tab(p->tab, s) : pow(s, p->a);
+}
+
+/* s^a as ss_pow_moved forms it, the memo left where it is.  Where the
+ * series does not reach, the table inline (near = 0: the Newton phase's
+ * laws, where a call made the evaluation's loop keep every live value on
+ * the stack around it, all of SSE's registers being the caller's to save,
+ * at as much as the table costs) or out of line (near = 1: a small
+ * caller, whose code the inline table would crowd; only libm's pow,
+ * where there is no table, is a call either way). */
+static inline double ss_pow_at(const ssPowMemo *c, double s, const ssPowSeries *p,
+                               const int near)
 {
   double u = c->s > 0 ? (s - c->s) * c->is : INFINITY;
   if (fabs(u) <= SS_POW_SERIES_MAX && p->ok) return c->v + c->v * ss_pow1p_m1(p, u);
+  if (near) return ss_pow_far(p, s);
   if (p->tab) return ss_pow_tab(p->tab, s);
   return pow(s, p->a);
 }
 
 /* s^a, moved by the series p (exponent a) from the memo when s is within
- * SS_POW_SERIES_MAX of it, else from p's table (or libm); the memo moves
- * to s */
-static inline double ss_pow_moved(ssPowMemo *c, double s, const ssPowSeries *p)
+ * SS_POW_SERIES_MAX of it, else from p's table (or libm; near: as
+ * ss_pow_at); the memo moves to s */
+static inline double ss_pow_moved(ssPowMemo *c, double s, const ssPowSeries *p,
+                                  const int near)
 {
-  double v = ss_pow_at(c, s, p);
+  double v = ss_pow_at(c, s, p, near);
   c->s = s;
   c->v = v;
   c->is = 1 / s;
