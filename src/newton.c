@@ -1615,19 +1615,23 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
    * run's group, its key and its points' largest offsets stay in locals
    * while it goes on. */
   const double dt = m->opt.timestep;
-  int gr = -1, run_link = 0, run_sys = 0, run_bed = 0, nrun = 0;
+  int gr = -1, run_link = 0, run_sys = 0, run_bed = 0, nrun = 0, axes = 0;
   NGroup *G = NULL;
-  double rm0 = 0, rm1 = 0, rm2 = 0;
+  const ssSoilMaterial *mat = NULL;
+  double rm0 = 0, rm1 = 0, rm2 = 0, o0 = 0, o1 = 0, o2 = 0, ik = 0, coh = 0;
+  ssModulusMemo mod = {NAN, 0};
   for (int i = 0; i < first_row; i++) {
     const ssContact *c = d->contact + i;
     if (c->type != SS_CONTACT_SOIL) return 0;
     if (!(G && c->link == run_link && c->sys == run_sys && c->hfield == run_bed)) {
-      /* a new run: the last one's offsets into its group first */
+      /* a new run: the last one's offsets and modulus into its group
+       * first */
       w->run[nrun++] = i;
       if (G) {
         G->rmax[0] = rm0;
         G->rmax[1] = rm1;
         G->rmax[2] = rm2;
+        G->mod = mod;
       }
       if (!(c->nv > 0 && (c->link >= 0 || (c->nv == 6 && m->sys_type[c->sys] == SS_SYS_FREE))))
         return 0;
@@ -1661,14 +1665,22 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
       rm0 = G->rmax[0];
       rm1 = G->rmax[1];
       rm2 = G->rmax[2];
+      mod = G->mod;
+      /* (and what its points read from the group: the point's stores
+       * could alias them, as the compiler sees it) */
+      mat = G->mat;
+      o0 = G->o[0];
+      o1 = G->o[1];
+      o2 = G->o[2];
+      ik = G->ik;
+      coh = mat->cohesion;
+      axes = G->axes;
     }
     w->group_of[i] = gr;
     /* the point's constants, its caches empty */
     NPoint *P = w->pt + i;
-    const ssSoilMaterial *mat = G->mat;
-    double rel[3];
-    ss_v3_sub(rel, c->pos, G->o);
-    if (G->axes) {
+    double rel[3] = {c->pos[0] - o0, c->pos[1] - o1, c->pos[2] - o2};
+    if (axes) {
       P->r[0] = rel[2];
       P->r[1] = rel[0];
       P->r[2] = rel[1];
@@ -1678,11 +1690,11 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     P->g0 = c->g0;
     P->sp = c->sp;
     P->S = c->area * dt;
-    P->k = ss_soil_modulus_at(mat, &G->mod, c->width);
-    P->tf0 = P->S * mat->cohesion;
+    P->k = ss_soil_modulus_at(mat, &mod, c->width);
+    P->tf0 = P->S * coh;
     /* x0 = j / K_j as the sweeps' law forms it (point.c, mobil_init):
      * the same bits, and no division a point */
-    P->x0 = (c->j > 0 ? c->j : 0) * G->ik;
+    P->x0 = (c->j > 0 ? c->j : 0) * ik;
     P->pw.s = 0;
     P->mob = ss_exp_memo_start(P->x0);
     P->imp = 0;
@@ -1696,6 +1708,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     G->rmax[0] = rm0;
     G->rmax[1] = rm1;
     G->rmax[2] = rm2;
+    G->mod = mod;
   }
   w->run[nrun] = first_row;
   w->nrun = nrun;
