@@ -959,8 +959,10 @@ void ss_shape_cast_init(ssShapeCast *c, const ssShape *s)
 int ss_shape_lowest_z(const ssShape *s, double x, double y, double *z)
 {
   ssShapeCast c;
+  ssCastRow r;
   ss_shape_cast_init(&c, s);
-  return ss_shape_cast_lowest_z(&c, x, y, z);
+  ss_shape_cast_row(&c, y, &r);
+  return ss_shape_cast_lowest_z(&c, &r, x, z);
 }
 
 /* ---------------------------------------------------------------------- */

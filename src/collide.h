@@ -102,8 +102,9 @@ int ss_shape_lowest_z(const ssShape *s, double x, double y, double *z);
 /* ss_shape_lowest_z for many lines through one shape: what does not depend
  * on (x, y) formed once (ss_shape_cast_init), the direction's reciprocals
  * among it, so that a line costs no division for a box and one for a
- * cylinder (the results differ from a division's by rounding).
- * ss_shape_lowest_z is the two in one. */
+ * cylinder (the results differ from a division's by rounding), and what
+ * depends on y alone once per row of lines (ss_shape_cast_row).
+ * ss_shape_lowest_z is the three in one. */
 typedef struct ssShapeCast {
   int type;
   double pos[3];
@@ -115,6 +116,19 @@ typedef struct ssShapeCast {
   double end[2][3];    /* a capsule's sphere centres */
 } ssShapeCast;
 void ss_shape_cast_init(ssShapeCast *c, const ssShape *s);
+/* The part of the lines at one y that does not depend on x: y itself and
+ * the origin's products oy wy (wy = y - pos_y), formed once for a row of
+ * lines (ss_shape_cast_row) instead of once per line. */
+typedef struct ssCastRow {
+  double y;
+  double oyw[3];
+} ssCastRow;
+static inline void ss_shape_cast_row(const ssShapeCast *c, double y, ssCastRow *r)
+{
+  double wy = y - c->pos[1];
+  r->y = y;
+  for (int k = 0; k < 3; k++) r->oyw[k] = c->oy[k] * wy;
+}
 
 /* The slab |o + t d| <= h along one axis, with d's reciprocal id formed
  * once (0 where d = 0: the line is parallel to it, inside or not) and
@@ -141,16 +155,18 @@ static inline int ss_cast_sphere(const double c[3], double r, double x, double y
   return 1;
 }
 
-/* ss_shape_lowest_z of the prepared shape c (inline: soil_contacts calls
- * it once per cell) */
-static inline int ss_shape_cast_lowest_z(const ssShapeCast *c, double x, double y, double *z)
+/* ss_shape_lowest_z of the prepared shape c on the line through x of the
+ * row r (inline: soil_contacts calls it once per cell) */
+static inline int ss_shape_cast_lowest_z(const ssShapeCast *c, const ssCastRow *r, double x,
+                                         double *z)
 {
+  const double y = r->y;
   if (c->type == SS_GEOM_SPHERE) return ss_cast_sphere(c->pos, c->r, x, y, z);
   if (c->type != SS_GEOM_BOX && c->type != SS_GEOM_CYLINDER && c->type != SS_GEOM_CAPSULE)
     return 0;
-  double wx = x - c->pos[0], wy = y - c->pos[1];
-  double o0 = c->ox[0] * wx + c->oy[0] * wy, o1 = c->ox[1] * wx + c->oy[1] * wy;
-  double o2 = c->ox[2] * wx + c->oy[2] * wy;
+  double wx = x - c->pos[0];
+  double o0 = c->ox[0] * wx + r->oyw[0], o1 = c->ox[1] * wx + r->oyw[1];
+  double o2 = c->ox[2] * wx + r->oyw[2];
   double tin = -INFINITY, tout = INFINITY;
 
   if (c->type == SS_GEOM_BOX) {

@@ -248,6 +248,10 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
   int b_ok = 0;
   for (int j = j0; j <= j1; j++) {
     double y = y0 + j * dy;
+    /* the casts through the row's vertices share y: their products by it
+     * formed once (a centroid's line forms its own) */
+    ssCastRow crow, cq;
+    ss_shape_cast_row(&cast, y, &crow);
     double cy0 = j == 0 ? y : y - 0.5 * dy, cy1 = j == ny - 1 ? y : y + 0.5 * dy;
     /* cells whose x range lies inside both chords of the row's band lie
      * inside the (convex) footprint: fully covered, no clipping; a margin
@@ -272,6 +276,7 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       double x = x0 + i * dx;
       double cx0 = i == 0 ? x : x - hdx, cx1 = i == nx - 1 ? x : x + hdx;
       double qx = x, qy = y, full = (cx1 - cx0) * (cy1 - cy0), area = full;
+      const ssCastRow *qrow = &crow;
       if (!(cx0 > in0 && cx1 < in1)) {
         if (!band_ready) {
           band_ready = banded && ss_poly_band(&fp, &ych, cy0, cy1, x, &band) ? 1 : -1;
@@ -289,12 +294,14 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
         if (!(area >= full * (1 - 1e-9))) {
           qx = gx;
           qy = gy;
+          ss_shape_cast_row(&cast, qy, &cq);
+          qrow = &cq;
         }
       }
       double zl;
       if (mesh) {
         if (!mesh_depth(m, d, g, R, p, qx, qy, lo[2], &zl)) continue;
-      } else if (!ss_shape_cast_lowest_z(&cast, qx, qy, &zl)) {
+      } else if (!ss_shape_cast_lowest_z(&cast, qrow, qx, &zl)) {
         continue;
       }
       int k = kr + i;
