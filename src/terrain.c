@@ -266,8 +266,8 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       in1 = fmin(a1, b1) - 1e-9 * dx;
     }
     int band_ready = 0;
-    /* the row's vertices */
-    const int kr = j * nx;
+    /* the row's vertices (vr: the first one's absolute index) */
+    const int kr = j * nx, vr = adr + kr;
     const double *zr = z0 + kr, *spr = sp + kr, *jr = jj + kr;
     /* room for the row's points at once (ss_contact_add below) */
     if (!ss_contact_reserve(d, i1 - i0 + 1, njac))
@@ -304,13 +304,12 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       } else if (!ss_shape_cast_lowest_z(&cast, qrow, qx, &zl)) {
         continue;
       }
-      int k = kr + i;
       double floor_z = zr[i] - spr[i];
       double g0 = zl - floor_z;
       if (g0 > margin) continue;
       ssContact *c = ss_contact_add_head(d, &head, jadr);
       jadr += njac;
-      c->vertex = adr + k;
+      c->vertex = vr + i;
       if (turned) {
         double pl[3] = {qx, qy, zl};
         ss_m3_mulv(c->pos, R, pl);
