@@ -204,8 +204,13 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
 
   ssPoly2 fp;
   ss_shape_footprint(&s, &fp);
+  const int mesh = m->geom_type[g] == SS_GEOM_MESH;
+  /* a mesh's depth comes from mesh_depth: the cast of its stand-in box
+   * is made to miss (the type it does not cast), so that a cell tests
+   * for the mesh only where the cast missed */
   ssShapeCast cast;
   ss_shape_cast_init(&cast, &s);
+  if (mesh) cast.type = SS_GEOM_MESH;
   /* a row's cells on the footprint's edge: area and centroid integrated
    * along the row's band of the footprint (ss_poly_band, formed at the
    * row's first such cell), the full clip where the band cannot be split
@@ -225,7 +230,6 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
   int turned = memcmp(R, I3, sizeof I3) != 0;
   long njac = contact_jlen(m, sys);
   const Attach at = attach_of(m, g, sys);
-  const int mesh = m->geom_type[g] == SS_GEOM_MESH;
   /* the head its points share (ss_contact_add_head), and where their
    * Jacobian storage starts */
   ssContact head;
@@ -299,11 +303,9 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
         }
       }
       double zl;
-      if (mesh) {
-        if (!mesh_depth(m, d, g, R, p, qx, qy, lo[2], &zl)) continue;
-      } else if (!ss_shape_cast_lowest_z(&cast, qrow, qx, &zl)) {
+      if (!ss_shape_cast_lowest_z(&cast, qrow, qx, &zl) &&
+          !(mesh && mesh_depth(m, d, g, R, p, qx, qy, lo[2], &zl)))
         continue;
-      }
       double floor_z = zr[i] - spr[i];
       double g0 = zl - floor_z;
       if (g0 > margin) continue;
