@@ -266,8 +266,10 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
     int a_ok = j > j0 ? b_ok : ss_poly_chord_y(&fp, yc, cy0, &a0, &a1);
     b_ok = ss_poly_chord_y(&fp, yc, cy1, &b0, &b1);
     if (a_ok && b_ok) {
-      in0 = fmax(a0, b0) + 1e-9 * dx;
-      in1 = fmin(a1, b1) - 1e-9 * dx;
+      /* (found chords' ends are numbers: comparisons instead of fmax and
+       * fmin's calls, and the sign of a zero is lost in the margin) */
+      in0 = (a0 > b0 ? a0 : b0) + 1e-9 * dx;
+      in1 = (a1 < b1 ? a1 : b1) - 1e-9 * dx;
     }
     int band_ready = 0;
     /* the row's vertices (vr: the first one's absolute index) */
