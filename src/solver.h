@@ -169,16 +169,18 @@ static inline ssContact *ss_contact_add(ssData *d, long njac)
   return c;
 }
 
-/* ss_contact_add for a loop that makes many contacts of one collider: the
- * head copied from the caller's template (ss_contact_blank's with the
- * fields they share set once: type, collider, system, link, jlen, ...),
- * the Jacobian storage at jadr (the caller's running
- * ss_contact_jac_end, each contact's jlen on).  Room as for
- * ss_contact_add (ss_contact_reserve). */
+/* ss_contact_add for a loop that makes many soil points of one collider:
+ * the head copied from the caller's template (ss_contact_blank's with the
+ * fields they share set once: type, collider, system, link, jlen, ...)
+ * but for the soil quantities area, width, g0, sp and j, which the caller
+ * sets (copied, they would be stored twice), the Jacobian storage at jadr
+ * (the caller's running ss_contact_jac_end, each contact's jlen on).
+ * Room as for ss_contact_add (ss_contact_reserve). */
 static inline ssContact *ss_contact_add_head(ssData *d, const ssContact *head, long jadr)
 {
   ssContact *c = d->contact + d->ncontact;
-  memcpy(c, head, offsetof(ssContact, pos));
+  memcpy(c, head, offsetof(ssContact, area));
+  memcpy(c->lambda, head->lambda, offsetof(ssContact, pos) - offsetof(ssContact, lambda));
   c->jadr = jadr;
   d->ncontact++;
   return c;

@@ -238,7 +238,6 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
   head.geom = g;
   head.hfield = h;
   head.jlen = njac;
-  head.width = width;
   head.bed_axes = !turned;
   attach_head(&at, &head);
   long jadr = ss_contact_jac_end(d);
@@ -325,6 +324,7 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
       }
       memcpy(c->frame, frame, sizeof frame);
       c->area = area;
+      c->width = width;
       c->g0 = g0;
       c->sp = spr[i];
       c->j = jr[i];
