@@ -176,6 +176,9 @@ static inline ssContact *ss_contact_add(ssData *d, long njac)
  * sets (copied, they would be stored twice), the Jacobian storage at jadr
  * (the caller's running ss_contact_jac_end, each contact's jlen on).
  * Room as for ss_contact_add (ss_contact_reserve). */
+/* (the five lie together, just before lambda) */
+_Static_assert(offsetof(ssContact, lambda) - offsetof(ssContact, area) == 5 * sizeof(double),
+               "ss_contact_add_head skips area, width, g0, sp and j as one block");
 static inline ssContact *ss_contact_add_head(ssData *d, const ssContact *head, long jadr)
 {
   ssContact *c = d->contact + d->ncontact;
