@@ -29,7 +29,10 @@ struct ssArtWork {
   double *I6;            /* (nb x 36) spatial inertias, world */
   double *Ic;            /* (nb x 36) composite inertias */
   double *M;             /* (nv x nv) M' = M + implicit terms */
-  double *L;             /* (nv x nv) LTDL factor of M' */
+  double *L;             /* (sum of depths) LTDL factor of M' on the tree's
+                            pattern, row k along k's chain: L[anc_adr[k] + t]
+                            is L_kj, j = anc[anc_adr[k] + t] (t = 0: D_k), so
+                            that row k's tail from t on is row j's start */
   double *rhs, *x, *y;   /* (nv) scratch */
   double *K;             /* (nrow x nv) closure Jacobian */
   int *kcol, *nkcol;     /* (nrow x nv), (nrow) each row's columns that
@@ -182,7 +185,6 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
   w->I6 = calloc(nb * 36, sizeof(double));
   w->Ic = calloc(nb * 36, sizeof(double));
   w->M = calloc(nv * nv, sizeof(double));
-  w->L = calloc(nv * nv, sizeof(double));
   w->rhs = calloc(nv, sizeof(double));
   w->x = calloc(nv, sizeof(double));
   w->y = calloc(nv > nr ? nv : nr, sizeof(double));
@@ -217,7 +219,7 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
     return NULL;
   }
   if (!w->eq || !w->dof_body || !w->dof_parent || !w->S || !w->vel || !w->acc ||
-      !w->frc || !w->I6 || !w->Ic || !w->M || !w->L || !w->rhs || !w->x || !w->y ||
+      !w->frc || !w->I6 || !w->Ic || !w->M || !w->rhs || !w->x || !w->y ||
       !w->K || !w->phi || !w->MiKT || !w->A || !w->Z || !w->row_on || !w->Y || !w->Lam ||
       !w->Yok) {
     ss_art_work_free(w);
@@ -243,7 +245,8 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
     for (int j = k; j >= 0; j = w->dof_parent[j]) nanc++;
   w->anc = malloc((size_t)(nanc ? nanc : 1) * sizeof(int));
   w->anc_adr = malloc((nv + 1) * sizeof(int));
-  if (!w->anc || !w->anc_adr) {
+  w->L = malloc((size_t)(nanc ? nanc : 1) * sizeof(double));
+  if (!w->anc || !w->anc_adr || !w->L) {
     ss_art_work_free(w);
     return NULL;
   }
@@ -403,27 +406,34 @@ int ss_art_forward_current(const ssModel *m, const ssData *d, int s)
 static int ltdl_factor(ssArtWork *w)
 {
   int n = w->nv;
-  double *H = w->L;
+  double *L = w->L;
   /* M's entries on the tree's pattern (k and its ancestors, the only
-   * ones the factor and ltdl_solve read; the rest of L stays as calloc
-   * left it) */
+   * ones the factor and ltdl_solve read) */
   for (int k = 0; k < n; k++)
-    for (int t = w->anc_adr[k]; t < w->anc_adr[k + 1]; t++) {
-      int j = w->anc[t];
-      H[k * n + j] = w->M[k * n + j];
-    }
+    for (int t = w->anc_adr[k]; t < w->anc_adr[k + 1]; t++) L[t] = w->M[k * n + w->anc[t]];
   double dmax = 0;
-  for (int k = 0; k < n; k++) dmax = fmax(dmax, fabs(H[k * n + k]));
+  for (int k = 0; k < n; k++) dmax = fmax(dmax, fabs(L[w->anc_adr[k]]));
   for (int k = n - 1; k >= 0; k--) {
-    if (!(H[k * n + k] > 1e-14 * dmax)) return -1 - k;
-    /* i runs up k's chain; its own chain is the rest of k's */
+    double *Lk = L + w->anc_adr[k];
+    if (!(Lk[0] > 1e-14 * dmax)) return -1 - k;
+    /* i runs up k's chain; its own chain is the rest of k's, so row i's
+     * entries are row k's from t on, both contiguous: the updates two at a
+     * time */
     const int *ak = w->anc + w->anc_adr[k], nk = w->anc_adr[k + 1] - w->anc_adr[k];
-    double *Hk = H + (size_t)k * n;
     for (int t = 1; t < nk; t++) {
-      int i = ak[t];
-      double a = Hk[i] / Hk[k], *Hi = H + (size_t)i * n;
-      for (int u = t; u < nk; u++) Hi[ak[u]] -= a * Hk[ak[u]];
-      Hk[i] = a;
+      double a = Lk[t] / Lk[0], *Li = L + w->anc_adr[ak[t]];
+      const double *lk = Lk + t;
+      ssV2 av = {a, a};
+      int u = 0, m = nk - t;
+      for (; u + 2 <= m; u += 2) {
+        ssV2 x, y;
+        memcpy(&x, lk + u, sizeof x);
+        memcpy(&y, Li + u, sizeof y);
+        y -= av * x;
+        memcpy(Li + u, &y, sizeof y);
+      }
+      if (u < m) Li[u] -= a * lk[u];
+      Lk[t] = a;
     }
   }
   return 0;
@@ -437,7 +447,7 @@ static int ltdl_factor(ssArtWork *w)
 static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
 {
   int n = w->nv;
-  const double *H = w->L;
+  const double *L = w->L;
   for (int i = n - 1; i >= 0; i--) {
     const double *xi = X + (size_t)m * i;
     int r = 0;
@@ -445,12 +455,12 @@ static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
     if (r == m) continue;
     for (int t = w->anc_adr[i] + 1; t < w->anc_adr[i + 1]; t++) {
       int j = w->anc[t];
-      double h = H[i * n + j], *xj = X + (size_t)m * j;
+      double h = L[t], *xj = X + (size_t)m * j;
       ss_row_add_scaled(xj, -h, xi, m);
     }
   }
   for (int i = 0; i < n; i++) {
-    double h = H[i * n + i], *xi = X + (size_t)m * i;
+    double h = L[w->anc_adr[i]], *xi = X + (size_t)m * i;
     ss_row_div(xi, h, m);
   }
   for (int i = 0; i < n; i++) {
@@ -465,7 +475,7 @@ static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
       memcpy(&a2, xi + 4, sizeof a2);
       for (int t = w->anc_adr[i] + 1; t < w->anc_adr[i + 1]; t++) {
         int j = w->anc[t];
-        double h = -H[i * n + j];
+        double h = -L[t];
         ssV2 hv = {h, h};
         const double *xj = X + 6 * (size_t)j;
         memcpy(&x0, xj, sizeof x0);
@@ -492,7 +502,7 @@ static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
       memcpy(&a3, xi + c + 6, sizeof a3);
       for (int t = w->anc_adr[i] + 1; t < w->anc_adr[i + 1]; t++) {
         int j = w->anc[t];
-        double h = -H[i * n + j];
+        double h = -L[t];
         ssV2 hv = {h, h};
         const double *xj = X + (size_t)m * j + c;
         memcpy(&x0, xj, sizeof x0);
@@ -512,7 +522,7 @@ static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
     if (c == m) continue;
     for (int t = w->anc_adr[i] + 1; t < w->anc_adr[i + 1]; t++) {
       int j = w->anc[t];
-      double h = H[i * n + j];
+      double h = L[t];
       const double *xj = X + (size_t)m * j;
       ss_row_add_scaled(xi + c, -h, xj + c, m - c);
     }
@@ -985,7 +995,7 @@ typedef struct Probe {
 static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, double *X,
                    double *XD, double *W)
 {
-  int n = w->nv, nr = w->nrow, np = 0;
+  int nr = w->nrow, np = 0;
   for (int t = w->anc_adr[top]; t < w->anc_adr[top + 1]; t++) path[np++] = w->anc[t];
   *npath = np;
   for (int i = 0; i < np; i++) {
@@ -993,16 +1003,17 @@ static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, doubl
     if (ncol == 6) memcpy(X + 6 * k, w->S + 6 * k, 6 * sizeof(double));
     else X[k] = k == top;
   }
-  const double *H = w->L;
+  /* k = path[i]'s chain is the path from i on: L_{k path[t]} at t - i */
   for (int i = 0; i < np; i++) {
     int k = path[i];
-    const double *xk = X + (size_t)ncol * k;
+    const double *xk = X + (size_t)ncol * k, *Lk = w->L + w->anc_adr[k];
     for (int t = i + 1; t < np; t++)
-      ss_row_add_scaled(X + (size_t)ncol * path[t], -H[k * n + path[t]], xk, ncol);
+      ss_row_add_scaled(X + (size_t)ncol * path[t], -Lk[t - i], xk, ncol);
   }
   for (int i = 0; i < np; i++) {
     int k = path[i];
-    for (int c = 0; c < ncol; c++) XD[ncol * k + c] = X[ncol * k + c] / H[k * n + k];
+    double d = w->L[w->anc_adr[k]];
+    for (int c = 0; c < ncol; c++) XD[ncol * k + c] = X[ncol * k + c] / d;
   }
   if (!nr) return;
   if (ncol == 6) {
