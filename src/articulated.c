@@ -26,8 +26,9 @@ struct ssArtWork {
   double *vel;           /* (nb x 6) body spatial velocities */
   double *acc;           /* (nb x 6) bias accelerations */
   double *frc;           /* (nb x 6) RNEA forces */
-  double *I6;            /* (nb x 36) spatial inertias, world */
-  double *Ic;            /* (nb x 36) composite inertias */
+  double *I6;            /* (nb x 36) spatial inertias, world, by columns
+                            (entry ij at 6 j + i: m6v_cols) */
+  double *Ic;            /* (nb x 36) composite inertias, by columns */
   double *M;             /* (nv x nv) M' = M + implicit terms */
   double *L;             /* (sum of depths) LTDL factor of M' on the tree's
                             pattern, row k along k's chain: L[anc_adr[k] + t]
@@ -103,13 +104,41 @@ static inline void m6v(double r[6], const double M[36], const double v[6])
   }
 }
 
+/* r = M v, M (6 x 6) by columns (entry ij at C[6 j + i]): the six sums in
+ * three pairs, each a column at a time, in m6v's order (from the first
+ * product, left to right) */
+static inline void m6v_cols(double r[6], const double C[36], const double v[6])
+{
+  ssV2 r0, r1, r2, c0, c1, c2, vj = {v[0], v[0]};
+  memcpy(&c0, C, sizeof c0);
+  memcpy(&c1, C + 2, sizeof c1);
+  memcpy(&c2, C + 4, sizeof c2);
+  r0 = c0 * vj;
+  r1 = c1 * vj;
+  r2 = c2 * vj;
+  for (int j = 1; j < 6; j++) {
+    const double *cj = C + 6 * j;
+    vj = (ssV2){v[j], v[j]};
+    memcpy(&c0, cj, sizeof c0);
+    memcpy(&c1, cj + 2, sizeof c1);
+    memcpy(&c2, cj + 4, sizeof c2);
+    r0 += c0 * vj;
+    r1 += c1 * vj;
+    r2 += c2 * vj;
+  }
+  memcpy(r, &r0, sizeof r0);
+  memcpy(r + 2, &r1, sizeof r1);
+  memcpy(r + 4, &r2, sizeof r2);
+}
+
 static double dot6(const double a[6], const double b[6])
 {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5];
 }
 
 /* spatial inertia about the origin of mass m, COM c, inertia Ic (world,
- * about the COM):  [[Ic - m [c]x[c]x, m [c]x], [-m [c]x, m 1]] */
+ * about the COM):  [[Ic - m [c]x[c]x, m [c]x], [-m [c]x, m 1]], by columns
+ * (entry ij at I6[6 j + i]) */
 static void spatial_inertia(double I6[36], double mass, const double c[3],
                             const double Ic[9])
 {
@@ -117,10 +146,10 @@ static void spatial_inertia(double I6[36], double mass, const double c[3],
   ss_m3_mul(cc, cx, cx);
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++) {
-      I6[6 * i + j] = Ic[3 * i + j] - mass * cc[3 * i + j];
-      I6[6 * i + 3 + j] = mass * cx[3 * i + j];
-      I6[6 * (3 + i) + j] = -mass * cx[3 * i + j];
-      I6[6 * (3 + i) + 3 + j] = i == j ? mass : 0;
+      I6[6 * j + i] = Ic[3 * i + j] - mass * cc[3 * i + j];
+      I6[6 * (3 + j) + i] = mass * cx[3 * i + j];
+      I6[6 * j + 3 + i] = -mass * cx[3 * i + j];
+      I6[6 * (3 + j) + 3 + i] = i == j ? mass : 0;
     }
 }
 
@@ -837,8 +866,8 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
     ss_m3_mul(Iw, T, Rt);
     spatial_inertia(w->I6 + 36 * lb, m->body_mass[b], d->body_xipos + 3 * b, Iw);
     double Iv[6], Ia[6], vf[6];
-    m6v(Iv, w->I6 + 36 * lb, v);
-    m6v(Ia, w->I6 + 36 * lb, a);
+    m6v_cols(Iv, w->I6 + 36 * lb, v);
+    m6v_cols(Ia, w->I6 + 36 * lb, a);
     fcross(vf, v, Iv);
     for (int i = 0; i < 6; i++) w->frc[6 * lb + i] = Ia[i] + vf[i];
     /* external loads at the centre of mass */
@@ -881,7 +910,7 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
     int k0 = m->body_dofadr[b] - w->v0;
     for (int k = k0; k < k0 + nd; k++) {
       double F[6];
-      m6v(F, w->Ic + 36 * lb, w->S + 6 * k);
+      m6v_cols(F, w->Ic + 36 * lb, w->S + 6 * k);
       for (int t = w->anc_adr[k]; t < w->anc_adr[k + 1]; t++) {
         int j = w->anc[t];
         double v = dot6(w->S + 6 * j, F);
