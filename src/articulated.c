@@ -1048,23 +1048,40 @@ static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, doubl
   if (ncol == 6) {
     /* row r = sum over the path of MiKT_kr S_k, its six sums in registers
      * (three pairs, from +0, in the path's order: the bits of row updates
-     * of a zeroed W) */
-    for (int r = 0; r < nr; r++) {
-      ssV2 w0 = {0, 0}, w1 = {0, 0}, w2 = {0, 0}, s0, s1, s2;
+     * of a zeroed W); rows r to r + 2 together, one pass over the path's
+     * S (past the last row, the others are the last again, not stored) */
+    for (int r = 0; r < nr; r += 3) {
+      int r1 = r + 1 < nr, r2 = r + 2 < nr ? 2 : r1;
+      ssV2 w0 = {0, 0}, w1 = {0, 0}, w2 = {0, 0}, v0 = {0, 0}, v1 = {0, 0}, v2 = {0, 0};
+      ssV2 x0 = {0, 0}, x1 = {0, 0}, x2 = {0, 0};
       for (int i = 0; i < np; i++) {
         int k = path[i];
-        const double *Sk = w->S + 6 * k, mk = w->MiKT[(size_t)k * nr + r];
-        ssV2 mv = {mk, mk};
+        const double *Sk = w->S + 6 * k, *mk = w->MiKT + (size_t)k * nr + r;
+        ssV2 m0 = {mk[0], mk[0]}, m1 = {mk[r1], mk[r1]}, m2 = {mk[r2], mk[r2]}, s0, s1, s2;
         memcpy(&s0, Sk, sizeof s0);
         memcpy(&s1, Sk + 2, sizeof s1);
         memcpy(&s2, Sk + 4, sizeof s2);
-        w0 += mv * s0;
-        w1 += mv * s1;
-        w2 += mv * s2;
+        w0 += m0 * s0;
+        w1 += m0 * s1;
+        w2 += m0 * s2;
+        v0 += m1 * s0;
+        v1 += m1 * s1;
+        v2 += m1 * s2;
+        x0 += m2 * s0;
+        x1 += m2 * s1;
+        x2 += m2 * s2;
       }
       memcpy(W + 6 * r, &w0, sizeof w0);
       memcpy(W + 6 * r + 2, &w1, sizeof w1);
       memcpy(W + 6 * r + 4, &w2, sizeof w2);
+      if (!r1) break;
+      memcpy(W + 6 * r + 6, &v0, sizeof v0);
+      memcpy(W + 6 * r + 8, &v1, sizeof v1);
+      memcpy(W + 6 * r + 10, &v2, sizeof v2);
+      if (r2 < 2) break;
+      memcpy(W + 6 * r + 12, &x0, sizeof x0);
+      memcpy(W + 6 * r + 14, &x1, sizeof x1);
+      memcpy(W + 6 * r + 16, &x2, sizeof x2);
     }
   } else {
     memcpy(W, w->MiKT + (size_t)top * nr, (size_t)nr * sizeof(double));
