@@ -788,6 +788,31 @@ static inline void closure_solve(const ssArtWork *w, double *Z, int m)
   closure_backward(w, Z, m);
 }
 
+/* t = MiKT z (nv), each row's sum from +0 over the closure rows in order;
+ * four rows at a time in two pair registers, their chains of dependent sums
+ * beside each other and each z_r loaded once for the four */
+static void mikt_z(const ssArtWork *w, const double *z, double *t)
+{
+  int n = w->nv, nr = w->nrow, k = 0;
+  for (; k + 4 <= n; k += 4) {
+    const double *m0 = w->MiKT + (size_t)k * nr, *m1 = m0 + nr, *m2 = m1 + nr, *m3 = m2 + nr;
+    ssV2 a = {0, 0}, b = {0, 0};
+    for (int r = 0; r < nr; r++) {
+      ssV2 zr = {z[r], z[r]};
+      a += (ssV2){m0[r], m1[r]} * zr;
+      b += (ssV2){m2[r], m3[r]} * zr;
+    }
+    memcpy(t + k, &a, sizeof a);
+    memcpy(t + k + 2, &b, sizeof b);
+  }
+  for (; k < n; k++) {
+    const double *mk = w->MiKT + (size_t)k * nr;
+    double s = 0;
+    for (int r = 0; r < nr; r++) s += mk[r] * z[r];
+    t[k] = s;
+  }
+}
+
 /* x (already M'^-1 b) <- P x: remove the part that violates K x = 0 */
 static void project(const ssArtWork *w, double *x)
 {
@@ -804,11 +829,9 @@ static void project(const ssArtWork *w, double *x)
     zz[r] = s;
   }
   closure_solve(w, zz, 1);
-  for (int k = 0; k < n; k++) {
-    double s = 0;
-    for (int r = 0; r < nr; r++) s += w->MiKT[(size_t)k * nr + r] * zz[r];
-    x[k] -= s;
-  }
+  double *t = w->y; /* (scratch: no caller projects w->y) */
+  mikt_z(w, zz, t);
+  for (int k = 0; k < n; k++) x[k] -= t[k];
   if (zz != z) free(zz);
 }
 
@@ -1445,11 +1468,8 @@ void ss_art_integrate(const ssModel *m, ssData *d, int s)
     memcpy(zz, w->phi, (size_t)w->nrow * sizeof(double));
     closure_solve(w, zz, 1);
     double *du = w->rhs;
-    for (int k = 0; k < w->nv; k++) {
-      double t = 0;
-      for (int r = 0; r < w->nrow; r++) t += w->MiKT[(size_t)k * w->nrow + r] * zz[r];
-      du[k] = -t;
-    }
+    mikt_z(w, zz, du);
+    for (int k = 0; k < w->nv; k++) du[k] = -du[k];
     advance(m, d, w, du, 1);
   }
   if (err > d->closure_error) d->closure_error = err;
