@@ -788,27 +788,28 @@ static inline void closure_solve(const ssArtWork *w, double *Z, int m)
   closure_backward(w, Z, m);
 }
 
-/* t = MiKT z (nv), each row's sum from +0 over the closure rows in order;
- * four rows at a time in two pair registers, their chains of dependent sums
- * beside each other and each z_r loaded once for the four */
-static void mikt_z(const ssArtWork *w, const double *z, double *t)
+/* t = A z, A (rows x cols, row-major), each row's sum from +0 over the
+ * columns in order; four rows at a time in two pair registers, their chains
+ * of dependent sums beside each other and each z_j loaded once for the four
+ * (MiKT z, M u) */
+static void mat_vec(const double *A, int rows, int cols, const double *z, double *t)
 {
-  int n = w->nv, nr = w->nrow, k = 0;
-  for (; k + 4 <= n; k += 4) {
-    const double *m0 = w->MiKT + (size_t)k * nr, *m1 = m0 + nr, *m2 = m1 + nr, *m3 = m2 + nr;
-    ssV2 a = {0, 0}, b = {0, 0};
-    for (int r = 0; r < nr; r++) {
-      ssV2 zr = {z[r], z[r]};
-      a += (ssV2){m0[r], m1[r]} * zr;
-      b += (ssV2){m2[r], m3[r]} * zr;
+  int k = 0;
+  for (; k + 4 <= rows; k += 4) {
+    const double *a0 = A + (size_t)k * cols, *a1 = a0 + cols, *a2 = a1 + cols, *a3 = a2 + cols;
+    ssV2 s01 = {0, 0}, s23 = {0, 0};
+    for (int j = 0; j < cols; j++) {
+      ssV2 zj = {z[j], z[j]};
+      s01 += (ssV2){a0[j], a1[j]} * zj;
+      s23 += (ssV2){a2[j], a3[j]} * zj;
     }
-    memcpy(t + k, &a, sizeof a);
-    memcpy(t + k + 2, &b, sizeof b);
+    memcpy(t + k, &s01, sizeof s01);
+    memcpy(t + k + 2, &s23, sizeof s23);
   }
-  for (; k < n; k++) {
-    const double *mk = w->MiKT + (size_t)k * nr;
+  for (; k < rows; k++) {
+    const double *ak = A + (size_t)k * cols;
     double s = 0;
-    for (int r = 0; r < nr; r++) s += mk[r] * z[r];
+    for (int j = 0; j < cols; j++) s += ak[j] * z[j];
     t[k] = s;
   }
 }
@@ -830,7 +831,7 @@ static void project(const ssArtWork *w, double *x)
   }
   closure_solve(w, zz, 1);
   double *t = w->y; /* (scratch: no caller projects w->y) */
-  mikt_z(w, zz, t);
+  mat_vec(w->MiKT, n, nr, zz, t);
   for (int k = 0; k < n; k++) x[k] -= t[k];
   if (zz != z) free(zz);
 }
@@ -944,11 +945,7 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
 
   /* rhs = M u + dt (-c + explicit forces); implicit terms go into M' */
   double *Mu = w->x;
-  for (int i = 0; i < n; i++) {
-    double t = 0;
-    for (int j = 0; j < n; j++) t += w->M[i * n + j] * u[j];
-    Mu[i] = t;
-  }
+  mat_vec(w->M, n, n, u, Mu);
   for (int i = 0; i < n; i++) w->rhs[i] = Mu[i] + dt * w->rhs[i];
 
   /* joint dampers and springs, implicit */
@@ -1468,7 +1465,7 @@ void ss_art_integrate(const ssModel *m, ssData *d, int s)
     memcpy(zz, w->phi, (size_t)w->nrow * sizeof(double));
     closure_solve(w, zz, 1);
     double *du = w->rhs;
-    mikt_z(w, zz, du);
+    mat_vec(w->MiKT, w->nv, w->nrow, zz, du);
     for (int k = 0; k < w->nv; k++) du[k] = -du[k];
     advance(m, d, w, du, 1);
   }
