@@ -659,7 +659,8 @@ static void factor_closures(ssArtWork *w)
     for (int r = 0; r < nr; r++) w->MiKT[(size_t)i * nr + r] = w->K[(size_t)r * n + i];
   ltdl_solve(w, w->MiKT, nr);
   /* A = K MiKT (lower triangle, row by row over K's nonzeros; each entry
-   * summed over k in order), mirrored */
+   * summed over k in order): the lower triangle is all that the Cholesky
+   * factor and the closure solves read */
   double *A = w->A, amax = 0;
   for (int i = 0; i < nr; i++) {
     double *Ai = A + (size_t)i * nr;
@@ -673,7 +674,6 @@ static void factor_closures(ssArtWork *w)
       const double *Mk = w->MiKT + (size_t)k * nr;
       for (int j = 0; j <= i; j++) Ai[j] += kik * Mk[j];
     }
-    for (int j = 0; j < i; j++) A[(size_t)j * nr + i] = Ai[j];
     amax = fmax(amax, Ai[i]);
   }
   for (int j = 0; j < nr; j++) {
@@ -687,11 +687,24 @@ static void factor_closures(ssArtWork *w)
     }
     w->row_on[j] = 1;
     double l = sqrt(s);
+    const double *aj = A + j * nr;
     A[j * nr + j] = l;
-    for (int i = j + 1; i < nr; i++) {
-      double t = A[i * nr + j];
-      for (int k = 0; k < j; k++) t -= A[i * nr + k] * A[j * nr + k];
-      A[i * nr + j] = t / l;
+    /* rows i and i + 1 together: each chain of dependent subtractions
+     * beside the other's, the same operations in the same order */
+    int i = j + 1;
+    for (; i + 1 < nr; i += 2) {
+      double *a0 = A + i * nr, *a1 = a0 + nr, t0 = a0[j], t1 = a1[j];
+      for (int k = 0; k < j; k++) {
+        t0 -= a0[k] * aj[k];
+        t1 -= a1[k] * aj[k];
+      }
+      a0[j] = t0 / l;
+      a1[j] = t1 / l;
+    }
+    if (i < nr) {
+      double *a0 = A + i * nr, t = a0[j];
+      for (int k = 0; k < j; k++) t -= a0[k] * aj[k];
+      a0[j] = t / l;
     }
   }
 }
