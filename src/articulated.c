@@ -440,8 +440,13 @@ static int ltdl_factor(ssArtWork *w)
    * ones the factor and ltdl_solve read) */
   for (int k = 0; k < n; k++)
     for (int t = w->anc_adr[k]; t < w->anc_adr[k + 1]; t++) L[t] = w->M[k * n + w->anc[t]];
+  /* the largest pivot: a comparison where fmax would be a call, the same
+   * maximum (a NaN is passed over as fmax does; no -0 comes) */
   double dmax = 0;
-  for (int k = 0; k < n; k++) dmax = fmax(dmax, fabs(L[w->anc_adr[k]]));
+  for (int k = 0; k < n; k++) {
+    double d = fabs(L[w->anc_adr[k]]);
+    dmax = d > dmax ? d : dmax;
+  }
   for (int k = n - 1; k >= 0; k--) {
     double *Lk = L + w->anc_adr[k];
     if (!(Lk[0] > 1e-14 * dmax)) return -1 - k;
@@ -674,7 +679,7 @@ static void factor_closures(ssArtWork *w)
       const double *Mk = w->MiKT + (size_t)k * nr;
       for (int j = 0; j <= i; j++) Ai[j] += kik * Mk[j];
     }
-    amax = fmax(amax, Ai[i]);
+    amax = Ai[i] > amax ? Ai[i] : amax; /* fmax's (a sum from +0 is no -0) */
   }
   for (int j = 0; j < nr; j++) {
     double s = A[j * nr + j];
@@ -1471,7 +1476,10 @@ void ss_art_integrate(const ssModel *m, ssData *d, int s)
     ss_art_forward(m, d, s);
     closures(m, d, w);
     err = 0;
-    for (int r = 0; r < w->nrow; r++) err = fmax(err, fabs(w->phi[r]));
+    for (int r = 0; r < w->nrow; r++) {
+      double e = fabs(w->phi[r]);
+      err = e > err ? e : err; /* fmax's maximum, without its call */
+    }
     if (err < 1e-13) break;
     if (!(err <= 0.25 * prev)) factor_closures(w);
     prev = err;
