@@ -286,7 +286,7 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
   }
   w->anc_adr[w->nv] = nanc;
   /* each closure row's columns, from the dofs closures writes (path_zero
-   * and point_row along both bodies' paths; an equality's two dofs) */
+   * and point_rows along both bodies' paths; an equality's two dofs) */
   unsigned char *on = calloc(nv, 1);
   if (!on) {
     ss_art_work_free(w);
@@ -567,20 +567,24 @@ static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
 /* Jacobians                                                               */
 
 /* r (length nv) += s * (point Jacobian row along dir of world point p on
- * body b): sum over path dofs of dir . (v_k + w_k x p) */
-static void point_row(const ssModel *m, const ssArtWork *w, int b,
-                      const double p[3], const double dir[3], double s,
-                      double *r)
+ * body b): sum over path dofs of dir . (v_k + w_k x p); for nd <= 3
+ * directions at once (dir (nd x 3), row q at r + q ld: a pin's three rows),
+ * in one walk of the path with each S_k loaded once (in a local: the rows'
+ * stores would make it a reload per row) */
+static inline void point_rows(const ssModel *m, const ssArtWork *w, int b, const double p[3],
+                              const double *dir, int nd, double s, double *r, int ld)
 {
-  double pxd[3];
-  ss_v3_cross(pxd, p, dir);
+  double pxd[9];
+  for (int q = 0; q < nd; q++) ss_v3_cross(pxd + 3 * q, p, dir + 3 * q);
   for (int a = b; a >= 0; a = m->body_parent[a]) {
-    int nd = m->body_ndof[a];
-    if (!nd) continue;
+    int na = m->body_ndof[a];
+    if (!na) continue;
     int k0 = m->body_dofadr[a] - w->v0;
-    for (int k = k0; k < k0 + nd; k++) {
-      const double *c = w->S + 6 * k;
-      r[k] += s * (ss_v3_dot(c + 3, dir) + ss_v3_dot(c, pxd));
+    for (int k = k0; k < k0 + na; k++) {
+      double c[6];
+      memcpy(c, w->S + 6 * k, sizeof c);
+      for (int q = 0; q < nd; q++)
+        r[q * ld + k] += s * (ss_v3_dot(c + 3, dir + 3 * q) + ss_v3_dot(c, pxd + 3 * q));
     }
   }
 }
@@ -591,11 +595,12 @@ static void body_point(const ssData *d, int b, const double local[3], double p[3
   ss_v3_add(p, p, d->body_xpos + 3 * b);
 }
 
-/* r[k] = 0 for the dofs k on body b's path (those point_row adds to):
- * the LTDL chain from its last dof */
-static void path_zero(const ssModel *m, const ssArtWork *w, int b, double *r)
+/* r[k] = 0 for the dofs k on body b's path (those point_rows adds to), in
+ * nd rows (row q at r + q ld): the LTDL chain from its last dof */
+static void path_zero(const ssModel *m, const ssArtWork *w, int b, double *r, int nd, int ld)
 {
-  for (int k = last_dof(m, w, b); k >= 0; k = w->dof_parent[k]) r[k] = 0;
+  for (int k = last_dof(m, w, b); k >= 0; k = w->dof_parent[k])
+    for (int q = 0; q < nd; q++) r[q * ld + k] = 0;
 }
 
 /* closure rows K (nrow x nv) and residual phi at the current kinematics.
@@ -614,15 +619,15 @@ static void closures(const ssModel *m, const ssData *d, ssArtWork *w)
       double p1[3], p2[3];
       body_point(d, b1, an, p1);
       body_point(d, b2, an + 3, p2);
-      for (int i = 0; i < 3; i++) {
-        double dir[3] = {i == 0, i == 1, i == 2};
-        w->phi[r] = p1[i] - p2[i];
-        path_zero(m, w, b1, w->K + (size_t)r * n);
-        path_zero(m, w, b2, w->K + (size_t)r * n);
-        point_row(m, w, b1, p1, dir, 1, w->K + (size_t)r * n);
-        point_row(m, w, b2, p2, dir, -1, w->K + (size_t)r * n);
-        r++;
-      }
+      /* its three rows (directions x, y, z) in one walk of each path */
+      const double dir[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+      double *Kr = w->K + (size_t)r * n;
+      for (int i = 0; i < 3; i++) w->phi[r + i] = p1[i] - p2[i];
+      path_zero(m, w, b1, Kr, 3, n);
+      path_zero(m, w, b2, Kr, 3, n);
+      point_rows(m, w, b1, p1, dir, 3, 1, Kr, n);
+      point_rows(m, w, b2, p2, dir, 3, -1, Kr, n);
+      r += 3;
       break;
     }
     case SS_CLOSURE_DISTANCE: {
@@ -632,10 +637,10 @@ static void closures(const ssModel *m, const ssData *d, ssArtWork *w)
       ss_v3_sub(dv, p1, p2);
       double len = ss_v3_normalize(dv);
       w->phi[r] = len - m->eq_data[2 * k];
-      path_zero(m, w, b1, w->K + (size_t)r * n);
-      path_zero(m, w, b2, w->K + (size_t)r * n);
-      point_row(m, w, b1, p1, dv, 1, w->K + (size_t)r * n);
-      point_row(m, w, b2, p2, dv, -1, w->K + (size_t)r * n);
+      path_zero(m, w, b1, w->K + (size_t)r * n, 1, n);
+      path_zero(m, w, b2, w->K + (size_t)r * n, 1, n);
+      point_rows(m, w, b1, p1, dv, 1, 1, w->K + (size_t)r * n, n);
+      point_rows(m, w, b2, p2, dv, 1, -1, w->K + (size_t)r * n, n);
       r++;
       break;
     }
@@ -992,8 +997,8 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
     ss_v3_sub(dv, p1, p2);
     double len = ss_v3_normalize(dv);
     memset(Js, 0, (size_t)n * sizeof(double));
-    point_row(m, w, b1, p1, dv, 1, Js);
-    point_row(m, w, b2, p2, dv, -1, Js);
+    point_rows(m, w, b1, p1, dv, 1, 1, Js, n);
+    point_rows(m, w, b2, p2, dv, 1, -1, Js, n);
     double ldot = 0;
     for (int i = 0; i < n; i++) ldot += Js[i] * u[i];
     double tension = par[0] * (len - par[2]);
