@@ -29,11 +29,12 @@ struct ssArtWork {
   double *I6;            /* (nb x 36) spatial inertias, world, by columns
                             (entry ij at 6 j + i: m6v_cols) */
   double *Ic;            /* (nb x 36) composite inertias, by columns */
-  double *M;             /* (nv x nv) M' = M + implicit terms */
-  double *L;             /* (sum of depths) LTDL factor of M' on the tree's
-                            pattern, row k along k's chain: L[anc_adr[k] + t]
-                            is L_kj, j = anc[anc_adr[k] + t] (t = 0: D_k), so
-                            that row k's tail from t on is row j's start */
+  double *M;             /* (nv x nv) the mass matrix M (the CRBA's) */
+  double *L;             /* (sum of depths) M' = M + implicit terms on the
+                            tree's pattern, then its LTDL factor, row k along
+                            k's chain: L[anc_adr[k] + t] is L_kj, j =
+                            anc[anc_adr[k] + t] (t = 0: D_k), so that row k's
+                            tail from t on is row j's start */
   double *rhs, *x, *y;   /* (nv) scratch */
   double *K;             /* (nrow x nv) closure Jacobian */
   int *kcol, *nkcol;     /* (nrow x nv), (nrow) each row's columns that
@@ -434,12 +435,11 @@ int ss_art_forward_current(const ssModel *m, const ssData *d, int s)
 
 static int ltdl_factor(ssArtWork *w)
 {
+  /* L holds M' on the tree's pattern (k and its ancestors, the only
+   * entries the factor and ltdl_solve read), as ss_art_free_velocity
+   * formed it */
   int n = w->nv;
   double *L = w->L;
-  /* M's entries on the tree's pattern (k and its ancestors, the only
-   * ones the factor and ltdl_solve read) */
-  for (int k = 0; k < n; k++)
-    for (int t = w->anc_adr[k]; t < w->anc_adr[k + 1]; t++) L[t] = w->M[k * n + w->anc[t]];
   /* the largest pivot: a comparison where fmax would be a call, the same
    * maximum (a NaN is passed over as fmax does; no -0 comes) */
   double dmax = 0;
@@ -947,10 +947,11 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
     }
   }
 
-  /* CRBA: M[k][j] = S_j . (Ic_b S_k) for j on the path of k.  These are
-   * the only entries ever written (here, by the dampers on the diagonal
-   * and by the springs along one chain), each step anew: the others
-   * stay the zeros of M's calloc, without a memset a step */
+  /* CRBA: M[k][j] = S_j . (Ic_b S_k) for j on the path of k, into M (for
+   * M u) and into M' on the tree's pattern (L, where the dampers and
+   * springs below add their implicit terms and ltdl_factor factors it).
+   * These are the only entries of M ever written, each step anew: the
+   * others stay the zeros of M's calloc, without a memset a step */
   for (int lb = 0; lb < w->nb; lb++) {
     int b = b0 + lb, nd = m->body_ndof[b];
     if (!nd) continue;
@@ -962,6 +963,7 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
         int j = w->anc[t];
         double v = dot6(w->S + 6 * j, F);
         w->M[k * n + j] = w->M[j * n + k] = v;
+        w->L[t] = v;
       }
     }
   }
@@ -971,15 +973,16 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
   mat_vec(w->M, n, n, u, Mu);
   for (int i = 0; i < n; i++) w->rhs[i] = Mu[i] + dt * w->rhs[i];
 
-  /* joint dampers and springs, implicit */
+  /* joint dampers and springs, implicit (into M' = L: a dof's diagonal
+   * leads its chain) */
   for (int lb = 0; lb < w->nb; lb++) {
     int b = b0 + lb, nd = m->body_ndof[b], t = m->body_jnttype[b];
     if (!nd || t == SS_JOINT_FLOATING) continue;
     int k0 = m->body_dofadr[b] - w->v0;
     double dmp = m->body_jntdamping[b], stf = m->body_jntstiffness[b];
-    for (int k = k0; k < k0 + nd; k++) w->M[k * n + k] += dt * dmp;
+    for (int k = k0; k < k0 + nd; k++) w->L[w->anc_adr[k]] += dt * dmp;
     if (stf > 0 && nd == 1) {
-      w->M[k0 * n + k0] += dt * dt * stf;
+      w->L[w->anc_adr[k0]] += dt * dt * stf;
       w->rhs[k0] -= dt * stf * (d->qpos[m->body_qadr[b]] - m->body_jntref[b]);
     }
   }
@@ -1006,9 +1009,12 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
       double c = dt * (par[1] + dt * par[0]);
       for (int i = 0; i < n; i++) {
         if (Js[i] == 0) continue;
-        /* (the chain's pairs only: M's other entries stay zero) */
-        for (int j = 0; j < n; j++)
-          if (Js[j] != 0) w->M[i * n + j] += c * Js[i] * Js[j];
+        /* (the chain's pairs only, all on the tree's pattern: i and its
+         * ancestors j in L's row i) */
+        for (int t = w->anc_adr[i]; t < w->anc_adr[i + 1]; t++) {
+          int j = w->anc[t];
+          if (Js[j] != 0) w->L[t] += c * Js[i] * Js[j];
+        }
         w->rhs[i] -= dt * tension * Js[i];
       }
     } else {
