@@ -1076,22 +1076,44 @@ static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, doubl
   int nr = w->nrow, np = 0;
   for (int t = w->anc_adr[top]; t < w->anc_adr[top + 1]; t++) path[np++] = w->anc[t];
   *npath = np;
-  for (int i = 0; i < np; i++) {
-    int k = path[i];
-    if (ncol == 6) memcpy(X + 6 * k, w->S + 6 * k, 6 * sizeof(double));
-    else X[k] = k == top;
-  }
-  /* k = path[i]'s chain is the path from i on: L_{k path[t]} at t - i */
-  for (int i = 0; i < np; i++) {
-    int k = path[i];
-    const double *xk = X + (size_t)ncol * k, *Lk = w->L + w->anc_adr[k];
-    for (int t = i + 1; t < np; t++)
-      ss_row_add_scaled(X + (size_t)ncol * path[t], -Lk[t - i], xk, ncol);
-  }
-  for (int i = 0; i < np; i++) {
-    int k = path[i];
+  /* the tree solve's first sweep on the path: row t takes -L_{path[i]
+   * path[t]} X_path[i] from each i < t in turn (path[i]'s chain is the path
+   * from i on: that entry at t - i), the sum of row updates pulled into
+   * registers (the same operations in the same order), then X/D */
+  for (int t = 0; t < np; t++) {
+    int k = path[t];
     double d = w->L[w->anc_adr[k]];
-    for (int c = 0; c < ncol; c++) XD[ncol * k + c] = X[ncol * k + c] / d;
+    if (ncol == 6) {
+      ssV2 a0, a1, a2, x0, x1, x2;
+      memcpy(&a0, w->S + 6 * k, sizeof a0);
+      memcpy(&a1, w->S + 6 * k + 2, sizeof a1);
+      memcpy(&a2, w->S + 6 * k + 4, sizeof a2);
+      for (int i = 0; i < t; i++) {
+        const double *xi = X + 6 * path[i], h = -w->L[w->anc_adr[path[i]] + t - i];
+        ssV2 hv = {h, h};
+        memcpy(&x0, xi, sizeof x0);
+        memcpy(&x1, xi + 2, sizeof x1);
+        memcpy(&x2, xi + 4, sizeof x2);
+        a0 += hv * x0;
+        a1 += hv * x1;
+        a2 += hv * x2;
+      }
+      ssV2 dv = {d, d};
+      memcpy(X + 6 * k, &a0, sizeof a0);
+      memcpy(X + 6 * k + 2, &a1, sizeof a1);
+      memcpy(X + 6 * k + 4, &a2, sizeof a2);
+      a0 /= dv;
+      a1 /= dv;
+      a2 /= dv;
+      memcpy(XD + 6 * k, &a0, sizeof a0);
+      memcpy(XD + 6 * k + 2, &a1, sizeof a1);
+      memcpy(XD + 6 * k + 4, &a2, sizeof a2);
+    } else {
+      double x = k == top;
+      for (int i = 0; i < t; i++) x += -w->L[w->anc_adr[path[i]] + t - i] * X[path[i]];
+      X[k] = x;
+      XD[k] = x / d;
+    }
   }
   if (!nr) return;
   if (ncol == 6) {
