@@ -959,7 +959,20 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
     for (int k = k0; k < k0 + nd; k++) {
       double F[6];
       m6v_cols(F, w->Ic + 36 * lb, w->S + 6 * k);
-      for (int t = w->anc_adr[k]; t < w->anc_adr[k + 1]; t++) {
+      /* two of k's chain at a time, S_j . F and S_j' . F in a pair (each
+       * dot6's products and sums in its order) */
+      ssV2 f[6];
+      for (int i = 0; i < 6; i++) f[i] = (ssV2){F[i], F[i]};
+      int t = w->anc_adr[k], te = w->anc_adr[k + 1];
+      for (; t + 2 <= te; t += 2) {
+        int j0 = w->anc[t], j1 = w->anc[t + 1];
+        const double *s0 = w->S + 6 * j0, *s1 = w->S + 6 * j1;
+        ssV2 v = (ssV2){s0[0], s1[0]} * f[0];
+        for (int i = 1; i < 6; i++) v += (ssV2){s0[i], s1[i]} * f[i];
+        w->M[k * n + j0] = w->M[j0 * n + k] = w->L[t] = v[0];
+        w->M[k * n + j1] = w->M[j1 * n + k] = w->L[t + 1] = v[1];
+      }
+      if (t < te) {
         int j = w->anc[t];
         double v = dot6(w->S + 6 * j, F);
         w->M[k * n + j] = w->M[j * n + k] = v;
