@@ -1158,49 +1158,117 @@ static void newton_matrix(const Setup *s, ssNewtonWork *w, const double *H)
   }
 }
 
-/* LU with partial pivoting of the n x n matrix A, in place; 0 if singular */
+/* lu_factor's pivot of column k: the row below k with the largest
+ * |A_ik| swapped into row k, whole (multipliers included); 0 if that
+ * column is zero there (singular) */
+static int lu_pivot(double *A, int *piv, int n, int k)
+{
+  int p = k;
+  double best = fabs(A[k * n + k]);
+  for (int i = k + 1; i < n; i++)
+    if (fabs(A[i * n + k]) > best) {
+      best = fabs(A[i * n + k]);
+      p = i;
+    }
+  if (!(best > 0)) return 0;
+  piv[k] = p;
+  if (p != k)
+    for (int j = 0; j < n; j++) {
+      double t = A[k * n + j];
+      A[k * n + j] = A[p * n + j];
+      A[p * n + j] = t;
+    }
+  return 1;
+}
+
+/* y0 = (y0 + a0 x) + b0 z and y1 = (y1 + a1 x) + b1 z, two rows in one
+ * pass over x and z (the pivot rows of two elimination steps), two lanes
+ * at a time: each entry's two updates, in the order of the steps, as
+ * ss_row_add_scaled makes them */
+static inline void lu_rows2_steps2(double *y0, double a0, double b0, double *y1, double a1,
+                                   double b1, const double *x, const double *z, int m)
+{
+  ssV2 av0 = {a0, a0}, bv0 = {b0, b0}, av1 = {a1, a1}, bv1 = {b1, b1};
+  int r = 0;
+  for (; r + 2 <= m; r += 2) {
+    ssV2 xv, zv, yv0, yv1;
+    memcpy(&xv, x + r, sizeof xv);
+    memcpy(&zv, z + r, sizeof zv);
+    memcpy(&yv0, y0 + r, sizeof yv0);
+    memcpy(&yv1, y1 + r, sizeof yv1);
+    yv0 += av0 * xv;
+    yv0 += bv0 * zv;
+    yv1 += av1 * xv;
+    yv1 += bv1 * zv;
+    memcpy(y0 + r, &yv0, sizeof yv0);
+    memcpy(y1 + r, &yv1, sizeof yv1);
+  }
+  for (; r < m; r++) {
+    y0[r] += a0 * x[r];
+    y0[r] += b0 * z[r];
+    y1[r] += a1 * x[r];
+    y1[r] += b1 * z[r];
+  }
+}
+
+/* one row's updates of two elimination steps, multipliers f and g, each
+ * skipped where its multiplier is 0 */
+static void lu_row_steps2(double *y, double f, double g, const double *x, const double *z,
+                          int m)
+{
+  if (f != 0) ss_row_add_scaled(y, -f, x, m);
+  if (g != 0) ss_row_add_scaled(y, -g, z, m);
+}
+
+/* LU with partial pivoting of the n x n matrix A, in place; 0 if
+ * singular.  Two elimination steps k, k + 1 at a time: step k's
+ * multipliers, its update of column k + 1 (the next pivot's column) and
+ * then of row k + 1 (the next pivot row, once swapped in: a swap moves
+ * whole rows, a row's multipliers with its pending updates), step
+ * k + 1's multipliers, and then the rows below in one pass for both
+ * steps.  Each entry gets the updates of the one-step-at-a-time
+ * elimination, y + (-f) x (which rounds as y - f x, ss_math.h), in the
+ * same order, each skipped where its multiplier is 0 as there: the same
+ * factors, bit for bit, with one load and store of an entry for two
+ * steps. */
 static int lu_factor(double *A, int *piv, int n)
 {
-  for (int k = 0; k < n; k++) {
-    int p = k;
-    double best = fabs(A[k * n + k]);
-    for (int i = k + 1; i < n; i++)
-      if (fabs(A[i * n + k]) > best) {
-        best = fabs(A[i * n + k]);
-        p = i;
-      }
-    if (!(best > 0)) return 0;
-    piv[k] = p;
-    if (p != k)
-      for (int j = 0; j < n; j++) {
-        double t = A[k * n + j];
-        A[k * n + j] = A[p * n + j];
-        A[p * n + j] = t;
-      }
-    /* the rows below, two at a time (one pass over the pivot row); y - f x
-     * as y + (-f) x, which rounds alike (ss_math.h) */
-    double inv = 1 / A[k * n + k];
-    const double *x = A + k * n + k + 1;
-    int i = k + 1, len = n - k - 1;
+  int k = 0;
+  for (; k + 1 < n; k += 2) {
+    if (!lu_pivot(A, piv, n, k)) return 0;
+    const double *x = A + k * n;
+    double inv = 1 / x[k];
+    for (int i = k + 1; i < n; i++) {
+      double f = A[i * n + k] * inv;
+      A[i * n + k] = f;
+      if (f != 0) A[i * n + k + 1] += -f * x[k + 1];
+    }
+    if (!lu_pivot(A, piv, n, k + 1)) return 0;
+    double *z = A + (k + 1) * n;
+    int len = n - k - 2;
+    if (z[k] != 0) ss_row_add_scaled(z + k + 2, -z[k], x + k + 2, len);
+    double inv1 = 1 / z[k + 1];
+    int i = k + 2;
     for (; i + 1 < n; i += 2) {
-      double f0 = A[i * n + k] * inv, f1 = A[(i + 1) * n + k] * inv;
-      A[i * n + k] = f0;
-      A[(i + 1) * n + k] = f1;
-      double *y0 = A + i * n + k + 1, *y1 = y0 + n;
-      if (f0 != 0 && f1 != 0) {
-        ss_row2_add_scaled(y0, -f0, y1, -f1, x, len);
+      double *y0 = A + i * n, *y1 = y0 + n;
+      double f0 = y0[k], f1 = y1[k], g0 = y0[k + 1] * inv1, g1 = y1[k + 1] * inv1;
+      y0[k + 1] = g0;
+      y1[k + 1] = g1;
+      if (f0 != 0 && g0 != 0 && f1 != 0 && g1 != 0) {
+        lu_rows2_steps2(y0 + k + 2, -f0, -g0, y1 + k + 2, -f1, -g1, x + k + 2, z + k + 2, len);
       } else {
-        if (f0 != 0) ss_row_add_scaled(y0, -f0, x, len);
-        if (f1 != 0) ss_row_add_scaled(y1, -f1, x, len);
+        lu_row_steps2(y0 + k + 2, f0, g0, x + k + 2, z + k + 2, len);
+        lu_row_steps2(y1 + k + 2, f1, g1, x + k + 2, z + k + 2, len);
       }
     }
     if (i < n) {
-      double f = A[i * n + k] * inv;
-      A[i * n + k] = f;
-      if (f != 0) ss_row_add_scaled(A + i * n + k + 1, -f, x, len);
+      double *y = A + i * n, g = y[k + 1] * inv1;
+      y[k + 1] = g;
+      lu_row_steps2(y + k + 2, y[k], g, x + k + 2, z + k + 2, len);
     }
   }
-  return 1;
+  /* (an odd n's last pivot: nothing below it) */
+  return k == n || lu_pivot(A, piv, n, k);
 }
 
 static void lu_solve(const double *A, const int *piv, int n, double *x)
@@ -1548,8 +1616,12 @@ static int predict(const ssModel *m, const ssData *d, const Setup *s, ssNewtonWo
   return 1;
 }
 
-/* this step's answer into d->newton_rec[2], for ss_newton_keep */
-static void record(ssData *d, const Setup *s, const ssNewtonWork *w, uint64_t key)
+/* this step's answer into d->newton_rec[2], for ss_newton_keep (out of
+ * line, where GCC has placed it: inlined into newton_solve it moves that
+ * function's register allocation, and the F-only evaluation's loop there
+ * takes an instruction more a point on the settled plate) */
+static __attribute__((noinline)) void record(ssData *d, const Setup *s, const ssNewtonWork *w,
+                                             uint64_t key)
 {
   ssNewtonRecord *r = d->newton_rec + 2;
   if (s->n > r->cap) {
