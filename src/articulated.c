@@ -732,15 +732,16 @@ static inline void closure_forward(const ssArtWork *w, double *Z, int m)
     if (m == 1 && i + 1 < nr && w->row_on[i] && w->row_on[i + 1]) {
       /* one column: rows i and i + 1 together, each row's chain of
        * dependent sums beside the other's (row i + 1 needs z_i only for
-       * its last term), the same operations in the same order */
+       * its last term), the same operations in the same order (t - a z
+       * rounds as the row update's t + (-a) z: ss_math.h) */
       const double *a0 = A + i * nr, *a1 = a0 + nr;
       double t0 = Z[i], t1 = Z[i + 1];
       for (int k = 0; k < i; k++) {
-        t0 += -a0[k] * Z[k];
-        t1 += -a1[k] * Z[k];
+        t0 -= a0[k] * Z[k];
+        t1 -= a1[k] * Z[k];
       }
       t0 /= a0[i];
-      t1 += -a1[i] * t0;
+      t1 -= a1[i] * t0;
       Z[i] = t0;
       Z[i + 1] = t1 / a1[i + 1];
       i++;
@@ -753,21 +754,21 @@ static inline void closure_forward(const ssArtWork *w, double *Z, int m)
     if (m == 6) {
       /* a link probe's six columns: the row's updates in registers, three
        * pairs (the same products and sums, in the same order, as the row
-       * updates below) */
+       * updates below; z - a x rounds as their z + (-a) x: ss_math.h) */
       ssV2 z0, z1, z2, x0, x1, x2;
       memcpy(&z0, zi, sizeof z0);
       memcpy(&z1, zi + 2, sizeof z1);
       memcpy(&z2, zi + 4, sizeof z2);
       for (int k = 0; k < i; k++) {
-        double a = -A[i * nr + k];
+        double a = A[i * nr + k];
         ssV2 av = {a, a};
         const double *zk = Z + 6 * (size_t)k;
         memcpy(&x0, zk, sizeof x0);
         memcpy(&x1, zk + 2, sizeof x1);
         memcpy(&x2, zk + 4, sizeof x2);
-        z0 += av * x0;
-        z1 += av * x1;
-        z2 += av * x2;
+        z0 -= av * x0;
+        z1 -= av * x1;
+        z2 -= av * x2;
       }
       double d = A[i * nr + i];
       ssV2 dv = {d, d};
@@ -1092,7 +1093,8 @@ static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, doubl
   /* the tree solve's first sweep on the path: row t takes -L_{path[i]
    * path[t]} X_path[i] from each i < t in turn (path[i]'s chain is the path
    * from i on: that entry at t - i), the sum of row updates pulled into
-   * registers (the same operations in the same order), then X/D */
+   * registers (the same operations in the same order: x - h y rounds as
+   * their x + (-h) y, ss_math.h), then X/D */
   for (int t = 0; t < np; t++) {
     int k = path[t];
     double d = w->L[w->anc_adr[k]];
@@ -1102,14 +1104,14 @@ static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, doubl
       memcpy(&a1, w->S + 6 * k + 2, sizeof a1);
       memcpy(&a2, w->S + 6 * k + 4, sizeof a2);
       for (int i = 0; i < t; i++) {
-        const double *xi = X + 6 * path[i], h = -w->L[w->anc_adr[path[i]] + t - i];
+        const double *xi = X + 6 * path[i], h = w->L[w->anc_adr[path[i]] + t - i];
         ssV2 hv = {h, h};
         memcpy(&x0, xi, sizeof x0);
         memcpy(&x1, xi + 2, sizeof x1);
         memcpy(&x2, xi + 4, sizeof x2);
-        a0 += hv * x0;
-        a1 += hv * x1;
-        a2 += hv * x2;
+        a0 -= hv * x0;
+        a1 -= hv * x1;
+        a2 -= hv * x2;
       }
       ssV2 dv = {d, d};
       memcpy(X + 6 * k, &a0, sizeof a0);
@@ -1123,7 +1125,7 @@ static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, doubl
       memcpy(XD + 6 * k + 4, &a2, sizeof a2);
     } else {
       double x = k == top;
-      for (int i = 0; i < t; i++) x += -w->L[w->anc_adr[path[i]] + t - i] * X[path[i]];
+      for (int i = 0; i < t; i++) x -= w->L[w->anc_adr[path[i]] + t - i] * X[path[i]];
       X[k] = x;
       XD[k] = x / d;
     }
@@ -1283,7 +1285,8 @@ probe_pair(const ssArtWork *w, Probe a, Probe b, int ca, int cb, double *out, in
   if (ca == 6 && cb == 6) {
     /* two links: three rows of the block at a time, their 18 sums in
      * registers (nine pairs, from +0), the same products and sums in the
-     * same order as the row updates below */
+     * same order as the row updates below (s - x y rounds as their
+     * s + (-x) y: ss_math.h) */
     for (int r0 = 0; r0 < 6; r0 += 3) {
       ssV2 s[9] = {{0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}};
       for (int k = i; k < a.np; k++) {
@@ -1306,10 +1309,10 @@ probe_pair(const ssArtWork *w, Probe a, Probe b, int ca, int cb, double *out, in
         memcpy(&y1, y + 2, sizeof y1);
         memcpy(&y2, y + 4, sizeof y2);
         for (int r = 0; r < 3; r++) {
-          ssV2 xv = {-x[r], -x[r]};
-          s[3 * r] += xv * y0;
-          s[3 * r + 1] += xv * y1;
-          s[3 * r + 2] += xv * y2;
+          ssV2 xv = {x[r], x[r]};
+          s[3 * r] -= xv * y0;
+          s[3 * r + 1] -= xv * y1;
+          s[3 * r + 2] -= xv * y2;
         }
       }
       for (int r = 0; r < 3; r++) memcpy(out + (size_t)ldo * (r0 + r), s + 3 * r, 6 * sizeof(double));
