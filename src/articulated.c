@@ -473,6 +473,33 @@ static int ltdl_factor(ssArtWork *w)
   return 0;
 }
 
+/* The tree solve's last pass for 2 np columns of row i from c on, in
+ * registers (np pairs): the row over D_i, then less L_ij x_j over i's
+ * ancestors j in turn (the same operations, in the same order, as a
+ * division of the row and then row updates: x - h y rounds as their
+ * x + (-h) y, ss_math.h).  np is a constant at each call, so that the
+ * pairs unroll into registers. */
+static inline __attribute__((always_inline)) void
+chain_sum(const ssArtWork *w, double *X, size_t m, int i, int c, int np)
+{
+  const double *L = w->L;
+  double *xi = X + m * i + c, d = L[w->anc_adr[i]];
+  ssV2 a[8], x, dv = {d, d};
+  for (int q = 0; q < np; q++) {
+    memcpy(&x, xi + 2 * q, sizeof x);
+    a[q] = x / dv;
+  }
+  for (int t = w->anc_adr[i] + 1; t < w->anc_adr[i + 1]; t++) {
+    ssV2 hv = {L[t], L[t]};
+    const double *xj = X + m * w->anc[t] + c;
+    for (int q = 0; q < np; q++) {
+      memcpy(&x, xj + 2 * q, sizeof x);
+      a[q] -= hv * x;
+    }
+  }
+  for (int q = 0; q < np; q++) memcpy(xi + 2 * q, &a[q], sizeof x);
+}
+
 /* X <- M'^-1 X for m columns at once, X (n x m, row k = dof k).  The first
  * pass moves each row into its ancestors only: the zero rows of a sparse X
  * (Jacobian columns, closure rows: a path or two in the tree) cost nothing
@@ -493,72 +520,24 @@ static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
       ss_row_add_scaled(xj, -h, xi, m);
     }
   }
+  /* the division by D and the last pass, row by row towards the leaves
+   * (row i's ancestors are final before it): a response block's six
+   * columns in three pairs; wider blocks (the closure rows' columns, MiKT)
+   * sixteen or eight columns at a time, the rest one at a time, each
+   * column's sum in a register */
   for (int i = 0; i < n; i++) {
-    double h = L[w->anc_adr[i]], *xi = X + (size_t)m * i;
-    ss_row_div(xi, h, m);
-  }
-  for (int i = 0; i < n; i++) {
-    double *xi = X + (size_t)m * i;
     if (m == 6) {
-      /* a response block's six columns: the row's sum over its ancestors
-       * in registers, three pairs (the same products and sums, in the
-       * same order, as the row updates below) */
-      ssV2 a0, a1, a2, x0, x1, x2;
-      memcpy(&a0, xi, sizeof a0);
-      memcpy(&a1, xi + 2, sizeof a1);
-      memcpy(&a2, xi + 4, sizeof a2);
-      for (int t = w->anc_adr[i] + 1; t < w->anc_adr[i + 1]; t++) {
-        int j = w->anc[t];
-        double h = -L[t];
-        ssV2 hv = {h, h};
-        const double *xj = X + 6 * (size_t)j;
-        memcpy(&x0, xj, sizeof x0);
-        memcpy(&x1, xj + 2, sizeof x1);
-        memcpy(&x2, xj + 4, sizeof x2);
-        a0 += hv * x0;
-        a1 += hv * x1;
-        a2 += hv * x2;
-      }
-      memcpy(xi, &a0, sizeof a0);
-      memcpy(xi + 2, &a1, sizeof a1);
-      memcpy(xi + 4, &a2, sizeof a2);
+      chain_sum(w, X, 6, i, 0, 3);
       continue;
     }
-    /* wider blocks (the closure rows' columns, MiKT): eight columns at a
-     * time in registers, four pairs, each column's sum over the ancestors
-     * in the same order as the row updates after them */
     int c = 0;
-    for (; c + 8 <= m; c += 8) {
-      ssV2 a0, a1, a2, a3, x0, x1, x2, x3;
-      memcpy(&a0, xi + c, sizeof a0);
-      memcpy(&a1, xi + c + 2, sizeof a1);
-      memcpy(&a2, xi + c + 4, sizeof a2);
-      memcpy(&a3, xi + c + 6, sizeof a3);
-      for (int t = w->anc_adr[i] + 1; t < w->anc_adr[i + 1]; t++) {
-        int j = w->anc[t];
-        double h = -L[t];
-        ssV2 hv = {h, h};
-        const double *xj = X + (size_t)m * j + c;
-        memcpy(&x0, xj, sizeof x0);
-        memcpy(&x1, xj + 2, sizeof x1);
-        memcpy(&x2, xj + 4, sizeof x2);
-        memcpy(&x3, xj + 6, sizeof x3);
-        a0 += hv * x0;
-        a1 += hv * x1;
-        a2 += hv * x2;
-        a3 += hv * x3;
-      }
-      memcpy(xi + c, &a0, sizeof a0);
-      memcpy(xi + c + 2, &a1, sizeof a1);
-      memcpy(xi + c + 4, &a2, sizeof a2);
-      memcpy(xi + c + 6, &a3, sizeof a3);
-    }
-    if (c == m) continue;
-    for (int t = w->anc_adr[i] + 1; t < w->anc_adr[i + 1]; t++) {
-      int j = w->anc[t];
-      double h = L[t];
-      const double *xj = X + (size_t)m * j;
-      ss_row_add_scaled(xi + c, -h, xj + c, m - c);
+    for (; c + 16 <= m; c += 16) chain_sum(w, X, (size_t)m, i, c, 8);
+    for (; c + 8 <= m; c += 8) chain_sum(w, X, (size_t)m, i, c, 4);
+    for (; c < m; c++) {
+      double *xi = X + (size_t)m * i + c, x = *xi / L[w->anc_adr[i]];
+      for (int t = w->anc_adr[i] + 1; t < w->anc_adr[i + 1]; t++)
+        x -= L[t] * X[(size_t)m * w->anc[t] + c];
+      *xi = x;
     }
   }
 }
