@@ -22,6 +22,12 @@ struct ssArtWork {
                             and solves' loops read their dofs from it: a
                             parent's index is then no load that waits for
                             the last one) */
+  int *dsc, *dsc_adr;    /* (2 (sum of depths - nv)), (nv + 1): the dofs i
+                            whose chains hold dof k below i, descending, at
+                            dsc + 2 dsc_adr[k], each as i and the entry's
+                            index t in anc and L (L_ik = L[t]): the rows a
+                            wide ltdl_solve's first pass gathers into k's */
+  unsigned char *live;   /* (nv) scratch of that pass: rows not all zero */
   double *S;             /* (nv x 6) motion subspace columns, world */
   double *vel;           /* (nb x 6) body spatial velocities */
   double *acc;           /* (nb x 6) bias accelerations */
@@ -183,6 +189,7 @@ void ss_art_work_free(ssArtWork *w)
 {
   if (!w) return;
   free(w->eq); free(w->dof_body); free(w->dof_parent); free(w->anc); free(w->anc_adr);
+  free(w->dsc); free(w->dsc_adr); free(w->live);
   free(w->S);
   free(w->vel); free(w->acc); free(w->frc); free(w->I6); free(w->Ic);
   free(w->M); free(w->L); free(w->rhs); free(w->x); free(w->y);
@@ -286,6 +293,28 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
     for (int j = k; j >= 0; j = w->dof_parent[j]) w->anc[nanc++] = j;
   }
   w->anc_adr[w->nv] = nanc;
+  /* each dof's descendants from the chains, descending (i from the last) */
+  w->dsc = malloc((size_t)(nanc > w->nv ? 2 * (nanc - w->nv) : 1) * sizeof(int));
+  w->dsc_adr = calloc(nv + 1, sizeof(int));
+  w->live = malloc(nv);
+  int *fill = malloc(nv * sizeof(int));
+  if (!w->dsc || !w->dsc_adr || !w->live || !fill) {
+    free(fill);
+    ss_art_work_free(w);
+    return NULL;
+  }
+  for (int t = 0; t < nanc; t++) w->dsc_adr[w->anc[t] + 1]++;
+  for (int k = 0; k < w->nv; k++) {
+    w->dsc_adr[k + 1] += w->dsc_adr[k] - 1; /* less k's own entry */
+    fill[k] = w->dsc_adr[k];
+  }
+  for (int i = w->nv - 1; i >= 0; i--)
+    for (int t = w->anc_adr[i] + 1; t < w->anc_adr[i + 1]; t++) {
+      int q = fill[w->anc[t]]++;
+      w->dsc[2 * q] = i;
+      w->dsc[2 * q + 1] = t;
+    }
+  free(fill);
   /* each closure row's columns, from the dofs closures writes (path_zero
    * and point_rows along both bodies' paths; an equality's two dofs) */
   unsigned char *on = calloc(nv, 1);
@@ -500,6 +529,39 @@ chain_sum(const ssArtWork *w, double *X, size_t m, int i, int c, int np)
   for (int q = 0; q < np; q++) memcpy(xi + 2 * q, &a[q], sizeof x);
 }
 
+/* The tree solve's first pass for 2 np columns of row k from c on, as a
+ * wide ltdl_solve makes it, in registers (np pairs): less L_ik x_i over the
+ * rows i below k, descending, whose rows are not all zero (the row updates
+ * that rows i would make of k, in the order they make them: x - h y rounds
+ * as x + (-h) y, ss_math.h).  Returns whether the result has an entry that
+ * is not zero (a NaN counts). */
+static inline __attribute__((always_inline)) int
+desc_sum(const ssArtWork *w, double *X, size_t m, int k, int c, int np)
+{
+  typedef long long ssM2 __attribute__((vector_size(16))); /* a pair's comparison */
+  const double *L = w->L;
+  double *xk = X + m * k + c;
+  ssV2 a[8], x, zero = {0, 0};
+  for (int q = 0; q < np; q++) memcpy(&a[q], xk + 2 * q, sizeof x);
+  for (int u = w->dsc_adr[k]; u < w->dsc_adr[k + 1]; u++) {
+    int i = w->dsc[2 * u];
+    if (!w->live[i]) continue;
+    double h = L[w->dsc[2 * u + 1]];
+    ssV2 hv = {h, h};
+    const double *xi = X + m * i + c;
+    for (int q = 0; q < np; q++) {
+      memcpy(&x, xi + 2 * q, sizeof x);
+      a[q] -= hv * x;
+    }
+  }
+  ssM2 nz = {0, 0};
+  for (int q = 0; q < np; q++) {
+    memcpy(xk + 2 * q, &a[q], sizeof x);
+    nz |= a[q] != zero;
+  }
+  return (nz[0] | nz[1]) != 0;
+}
+
 /* X <- M'^-1 X for m columns at once, X (n x m, row k = dof k).  The first
  * pass moves each row into its ancestors only: the zero rows of a sparse X
  * (Jacobian columns, closure rows: a path or two in the tree) cost nothing
@@ -509,15 +571,37 @@ static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
 {
   int n = w->nv;
   const double *L = w->L;
-  for (int i = n - 1; i >= 0; i--) {
-    const double *xi = X + (size_t)m * i;
-    int r = 0;
-    while (r < m && xi[r] == 0) r++;
-    if (r == m) continue;
-    for (int t = w->anc_adr[i] + 1; t < w->anc_adr[i + 1]; t++) {
-      int j = w->anc[t];
-      double h = L[t], *xj = X + (size_t)m * j;
-      ss_row_add_scaled(xj, -h, xi, m);
+  if (m >= 8) {
+    /* wide blocks (the closure rows' columns, MiKT): the first pass as
+     * gathers into each row from the rows below it (desc_sum), sixteen or
+     * eight columns at a time, the rest one at a time, each row's sums in
+     * registers instead of row updates in memory */
+    for (int k = n - 1; k >= 0; k--) {
+      int c = 0, live = 0;
+      for (; c + 16 <= m; c += 16) live |= desc_sum(w, X, (size_t)m, k, c, 8);
+      for (; c + 8 <= m; c += 8) live |= desc_sum(w, X, (size_t)m, k, c, 4);
+      for (; c < m; c++) {
+        double *xk = X + (size_t)m * k + c, x = *xk;
+        for (int u = w->dsc_adr[k]; u < w->dsc_adr[k + 1]; u++) {
+          int i = w->dsc[2 * u];
+          if (w->live[i]) x -= L[w->dsc[2 * u + 1]] * X[(size_t)m * i + c];
+        }
+        *xk = x;
+        live |= x != 0;
+      }
+      w->live[k] = live;
+    }
+  } else {
+    for (int i = n - 1; i >= 0; i--) {
+      const double *xi = X + (size_t)m * i;
+      int r = 0;
+      while (r < m && xi[r] == 0) r++;
+      if (r == m) continue;
+      for (int t = w->anc_adr[i] + 1; t < w->anc_adr[i + 1]; t++) {
+        int j = w->anc[t];
+        double h = L[t], *xj = X + (size_t)m * j;
+        ss_row_add_scaled(xj, -h, xi, m);
+      }
     }
   }
   /* the division by D and the last pass, row by row towards the leaves
