@@ -782,6 +782,40 @@ static void factor_closures(ssArtWork *w)
   }
 }
 
+/* closure_forward's row i of six columns (and row i + 1 where two, a
+ * constant at each call) in registers, three pairs a row: row i + 1's sums
+ * beside row i's over k < i, each z_k loaded once for both, then its term
+ * of the finished z_i (the same products and sums, in the same order, as
+ * closure_forward's row updates; z - a x rounds as their z + (-a) x:
+ * ss_math.h) */
+static inline __attribute__((always_inline)) void
+forward_rows6(const double *A, int nr, double *Z, int i, int two)
+{
+  const double *a0 = A + (size_t)nr * i, *a1 = a0 + nr;
+  double *zi = Z + 6 * (size_t)i;
+  ssV2 z[6], x[3];
+  for (int q = 0; q < 3 + 3 * two; q++) memcpy(&z[q], zi + 2 * q, sizeof x[0]);
+  for (int k = 0; k < i; k++) {
+    const double *zk = Z + 6 * (size_t)k;
+    ssV2 av = {a0[k], a0[k]};
+    for (int q = 0; q < 3; q++) {
+      memcpy(&x[q], zk + 2 * q, sizeof x[q]);
+      z[q] -= av * x[q];
+    }
+    if (two) {
+      ssV2 bv = {a1[k], a1[k]};
+      for (int q = 0; q < 3; q++) z[3 + q] -= bv * x[q];
+    }
+  }
+  ssV2 dv = {a0[i], a0[i]};
+  for (int q = 0; q < 3; q++) z[q] /= dv;
+  if (two) {
+    ssV2 av = {a1[i], a1[i]}, ev = {a1[i + 1], a1[i + 1]};
+    for (int q = 0; q < 3; q++) z[3 + q] = (z[3 + q] - av * z[q]) / ev;
+  }
+  for (int q = 0; q < 3 + 3 * two; q++) memcpy(zi + 2 * q, &z[q], sizeof x[0]);
+}
+
 /* Z <- A^-1 Z over the active rows (dropped rows give 0), for m columns
  * at once, Z (nr x m, row i = closure row i); each column sees the same
  * operations in the same order whatever m: closure_solve, in its two
@@ -815,32 +849,13 @@ static inline void closure_forward(const ssArtWork *w, double *Z, int m)
       continue;
     }
     if (m == 6) {
-      /* a link probe's six columns: the row's updates in registers, three
-       * pairs (the same products and sums, in the same order, as the row
-       * updates below; z - a x rounds as their z + (-a) x: ss_math.h) */
-      ssV2 z0, z1, z2, x0, x1, x2;
-      memcpy(&z0, zi, sizeof z0);
-      memcpy(&z1, zi + 2, sizeof z1);
-      memcpy(&z2, zi + 4, sizeof z2);
-      for (int k = 0; k < i; k++) {
-        double a = A[i * nr + k];
-        ssV2 av = {a, a};
-        const double *zk = Z + 6 * (size_t)k;
-        memcpy(&x0, zk, sizeof x0);
-        memcpy(&x1, zk + 2, sizeof x1);
-        memcpy(&x2, zk + 4, sizeof x2);
-        z0 -= av * x0;
-        z1 -= av * x1;
-        z2 -= av * x2;
+      /* a link probe's six columns: with the next row where it is on */
+      if (i + 1 < nr && w->row_on[i + 1]) {
+        forward_rows6(A, nr, Z, i, 1);
+        i++;
+      } else {
+        forward_rows6(A, nr, Z, i, 0);
       }
-      double d = A[i * nr + i];
-      ssV2 dv = {d, d};
-      z0 /= dv;
-      z1 /= dv;
-      z2 /= dv;
-      memcpy(zi, &z0, sizeof z0);
-      memcpy(zi + 2, &z1, sizeof z1);
-      memcpy(zi + 4, &z2, sizeof z2);
       continue;
     }
     for (int k = 0; k < i; k++) {
