@@ -121,6 +121,18 @@ static void link_apply(ssData *d, const ssContact *c, const double *Y,
   }
 }
 
+/* a rigid body's contact: J u = frame (v + omega x r), u = (v; omega), r
+ * from the centre of mass com, without J (formed only for the sweeps) */
+static inline __attribute__((always_inline)) void
+body_point_velocity(const ssContact *c, const double com[3], const double u[6], double v[3])
+{
+  double r[3], w[3];
+  ss_v3_sub(r, c->pos, com);
+  ss_v3_cross(w, u + 3, r);
+  ss_v3_add(w, w, u);
+  ss_contact_frame_mulv(c, v, w);
+}
+
 /* the contact's velocity J u, from the full velocity */
 static inline __attribute__((always_inline)) void
 contact_velocity(const ssModel *m, const ssData *d, const ssContact *c, double v[3])
@@ -133,13 +145,7 @@ contact_velocity(const ssModel *m, const ssData *d, const ssContact *c, double v
   }
   const double *u = d->qvel + c->vadr;
   if (c->type == SS_CONTACT_SOIL || c->type == SS_CONTACT_RIGID) {
-    /* a rigid body: J u = frame (v + omega x r), r from the centre of
-     * mass, without J (formed only for the sweeps) */
-    double r[3], w[3];
-    ss_v3_sub(r, c->pos, d->body_xipos + 3 * m->geom_body[c->geom]);
-    ss_v3_cross(w, u + 3, r);
-    ss_v3_add(w, w, u);
-    ss_contact_frame_mulv(c, v, w);
+    body_point_velocity(c, d->body_xipos + 3 * m->geom_body[c->geom], u, v);
     return;
   }
   /* a joint row: J (3 x nv) stored */
@@ -785,6 +791,38 @@ static void visit(const ssModel *m, ssData *d, ssContact *c, Group *g,
   if (ln > *lmax) *lmax = ln;
 }
 
+/* contact c's end-of-step velocity v kept, and whether it is loaded (a
+ * soil point pressed by its impulse and still below the surface at the
+ * step's end: the soil update's); an unloaded soil point's impulse 0 */
+static inline __attribute__((always_inline)) void
+contact_end(ssContact *c, const double v[3], double dt)
+{
+  memcpy(c->v, v, sizeof c->v);
+  c->loaded = c->type == SS_CONTACT_SOIL && c->lambda[0] > 0 && -(c->g0 + dt * v[0]) > 0;
+  if (c->type == SS_CONTACT_SOIL && !c->loaded)
+    c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
+}
+
+/* The end of the solve (contact_end) for the run of soil points from c on
+ * (before end) that lie on c's collider, a rigid body's; returns the
+ * contact after the run.  The body's velocity and centre of mass are
+ * known for the run (in locals: the contacts' stores could alias them, as
+ * the compiler sees it). */
+static ssContact *body_run_end(const ssModel *m, const ssData *d, ssContact *c,
+                               const ssContact *end)
+{
+  const double dt = m->opt.timestep;
+  const int geom = c->geom;
+  const double *x = d->body_xipos + 3 * m->geom_body[geom], *q = d->qvel + c->vadr;
+  const double com[3] = {x[0], x[1], x[2]}, u[6] = {q[0], q[1], q[2], q[3], q[4], q[5]};
+  for (; c < end && c->type == SS_CONTACT_SOIL && c->geom == geom; c++) {
+    double v[3];
+    body_point_velocity(c, com, u, v);
+    contact_end(c, v, dt);
+  }
+  return c;
+}
+
 ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
 {
   const double dt = m->opt.timestep, tol = m->opt.solver_tolerance;
@@ -916,8 +954,8 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   /* end-of-step contact velocities for the soil update */
   int link = -1;
   double V[6];
-  for (int i = 0; i < d->ncontact; i++) {
-    ssContact *c = d->contact + i;
+  const ssContact *end = d->contact + d->ncontact;
+  for (ssContact *c = d->contact; c < end;) {
     double v[3] = {0, 0, 0};
     if (c->link >= 0) {
       /* one spatial velocity per link run */
@@ -925,13 +963,15 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
       link = c->link;
       link_point_velocity(c, V, v);
     } else if (c->nv) {
+      if (c->type == SS_CONTACT_SOIL) {
+        /* a rigid body's soil points, as one run */
+        c = body_run_end(m, d, c, end);
+        continue;
+      }
       contact_velocity(m, d, c, v);
     }
-    memcpy(c->v, v, sizeof v);
-    c->loaded = c->type == SS_CONTACT_SOIL && c->lambda[0] > 0 &&
-                -(c->g0 + dt * v[0]) > 0;
-    if (c->type == SS_CONTACT_SOIL && !c->loaded)
-      c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
+    contact_end(c, v, dt);
+    c++;
   }
   return SS_OK;
 }
