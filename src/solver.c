@@ -652,9 +652,10 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
     d->cap_warm_next = n;
   }
   /* the entries in contact order into warm_next (the old cache is not
-   * needed any more), then sorted into warm */
-  ssWarmEntry *next = d->warm_next;
-  n = 0;
+   * needed any more), then sorted into warm; end walks past the last one
+   * made (a pointer: from a count, each entry's address took three
+   * instructions more) */
+  ssWarmEntry *next = d->warm_next, *end = next;
   /* A step whose warm start stood as it came (the Newton phase found a
    * settled body's warm impulses within the tolerance of its laws there)
    * keeps the laws' impulses at its velocities instead: as close to the
@@ -681,7 +682,7 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
   for (int i = 0; i < ncontact; i++) {
     const ssContact *c = d->contact + i;
     if (!cached(c)) continue;
-    ssWarmEntry *e = next + n;
+    ssWarmEntry *e = end++;
     e->creep = 0;
     if (c->type == SS_CONTACT_SOIL) {
       double inv = 1.0 / (c->area * dt);
@@ -715,10 +716,10 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
     }
     uint64_t key = warm_key(e->geom, e->vertex);
     e->key = key;
-    if (key < last && run < 0) run = n;
+    if (key < last && run < 0) run = (int)(e - next);
     last = key;
-    n++;
   }
+  n = (int)(end - next);
   /* a creeping collider's points keep no rates */
   int creeping = 0;
   for (int g = 0; g < m->ngeom; g++) {
