@@ -163,6 +163,24 @@ static void axis_side(const double a[3], double w[3])
   }
 }
 
+/* swept_hull's chain of one copy p: its points from index a to b (each
+ * step d, modulo n) onto h from m on, the box (x least, greatest, y least,
+ * greatest) grown over them; returns h's new count */
+static inline int hull_gather(pt2 *h, int m, const pt2 *p, int n, int d, int a, int b,
+                              double box[4])
+{
+  for (int i = a, stop = 0; !stop; i = i + d < n ? i + d : i + d - n) {
+    pt2 v = p[i];
+    stop = i == b;
+    h[m++] = v;
+    if (v.x < box[0]) box[0] = v.x;
+    if (v.x > box[1]) box[1] = v.x;
+    if (v.y < box[2]) box[2] = v.y;
+    if (v.y > box[3]) box[3] = v.y;
+  }
+  return m;
+}
+
 /* The hull of two copies of one convex polygon, p[0, n) and p[n, 2n) (the
  * second the first moved by -2t, t = (tx, ty) != 0; points in the order of
  * the circle table, counter-clockwise when ccw, else clockwise), without a
@@ -196,26 +214,10 @@ static int swept_hull(const pt2 *p, int n, int ccw, double tx, double ty, ssPoly
   /* B to A on the first copy (its edges face +t), A to B on the second,
    * and their bounding box (begun at the first point, as they come) */
   pt2 h[HULL_IN_MAX + 2];
-  int m = 0;
-  double xlo = p[kb].x, xhi = p[kb].x, ylo = p[kb].y, yhi = p[kb].y;
-  for (int i = kb, stop = 0; !stop; i = i + d < n ? i + d : i + d - n) {
-    pt2 v = p[i];
-    stop = i == ka;
-    h[m++] = v;
-    if (v.x < xlo) xlo = v.x;
-    if (v.x > xhi) xhi = v.x;
-    if (v.y < ylo) ylo = v.y;
-    if (v.y > yhi) yhi = v.y;
-  }
-  for (int i = ka, stop = 0; !stop; i = i + d < n ? i + d : i + d - n) {
-    pt2 v = p[n + i];
-    stop = i == kb;
-    h[m++] = v;
-    if (v.x < xlo) xlo = v.x;
-    if (v.x > xhi) xhi = v.x;
-    if (v.y < ylo) ylo = v.y;
-    if (v.y > yhi) yhi = v.y;
-  }
+  double box[4] = {p[kb].x, p[kb].x, p[kb].y, p[kb].y};
+  int m = hull_gather(h, 0, p, n, d, kb, ka, box);
+  m = hull_gather(h, m, p + n, n, d, ka, kb, box);
+  double xlo = box[0], xhi = box[1], ylo = box[2], yhi = box[3];
   double ext = xhi - xlo > yhi - ylo ? xhi - xlo : yhi - ylo;
   if (!(ext > 0)) return 0;
   double tol = HULL_COLLINEAR_EPS * ext * ext;
