@@ -87,8 +87,10 @@ static inline double pow_near(Law *L, double s)
 }
 
 /* Normal pressure at end-of-step normal velocity vn (DESIGN 3.1) and its
- * first two derivatives in vn (P' <= 0; P'' from the envelope only). */
-static inline double law_pressure(Law *L, double vn, double *dP, double *d2P)
+ * first two derivatives in vn (P' <= 0; P'' from the envelope only);
+ * linear: L->linear, a constant where the caller is specialised for it. */
+static inline double law_pressure_as(Law *L, double vn, double *dP, double *d2P,
+                                     const int linear)
 {
   double delta = -(L->g0 + L->dt * vn);
   if (!(delta > 0)) {
@@ -97,7 +99,7 @@ static inline double law_pressure(Law *L, double vn, double *dP, double *d2P)
   }
   double s = L->sp + delta;
   /* one power for the envelope and its slope: s^n = s s^(n-1) */
-  double sn1 = L->linear ? 1.0 : pow_near(L, s);
+  double sn1 = linear ? 1.0 : pow_near(L, s);
   double pe = L->Ke * delta, py = L->k * s * sn1;
   double p, slope, curv = 0;
   if (pe <= py) {
@@ -106,7 +108,7 @@ static inline double law_pressure(Law *L, double vn, double *dP, double *d2P)
   } else {
     p = py;
     slope = L->k * L->n * sn1;
-    if (!L->linear) curv = slope * L->m1 / s;
+    if (!linear) curv = slope * L->m1 / s;
   }
   double dpdv = -L->dt * slope;
   if (vn < 0) {
@@ -116,6 +118,11 @@ static inline double law_pressure(Law *L, double vn, double *dP, double *d2P)
   *dP = dpdv;
   *d2P = L->dt * L->dt * curv;
   return p;
+}
+
+static inline double law_pressure(Law *L, double vn, double *dP, double *d2P)
+{
+  return law_pressure_as(L, vn, dP, d2P, L->linear);
 }
 
 /* n = 1: the root of x = A dt P(a + g x) from the four affine pieces of P
@@ -482,10 +489,13 @@ static void solve_tangent(const TBlock *B, Mobil *J, double tf, double tl,
  * the same point (and the point does not stick there); 0 leaves the point
  * to the safeguarded loop, e.g. when an iterate leaves lambda_n > 0,
  * 0 < sigma <= |c_t|.  sure = 0: the start is not known to slip; the
- * first evaluation tests that on its bound first (0 if it may stick). */
-static int coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu,
-                        const double v0[3], const double G[9], double tol,
-                        double x, double sigma, int sure, double lam[3], int *iters)
+ * first evaluation tests that on its bound first (0 if it may stick).
+ * linear: L->linear, a constant, so that each law has a loop of its own
+ * without the other's branches and registers. */
+static inline __attribute__((always_inline)) int
+coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu, const double v0[3],
+             const double G[9], double tol, double x, double sigma, int sure, double lam[3],
+             int *iters, const int linear)
 {
   /* slip_eval and slip_slope written out on scalars (the same
    * expressions, so the same iterates): this loop is most of a warm
@@ -515,7 +525,7 @@ static int coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu
     double wn = ra * id, w0 = wa0 * id, w1 = wa1 * id;
     double lt0 = -T * w0, lt1 = -T * w1;
     double dP, d2P, vn = v0[0] + G[0] * x + G[1] * lt0 + G[2] * lt1;
-    double F1 = x - S * law_pressure(L, vn, &dP, &d2P);
+    double F1 = x - S * law_pressure_as(L, vn, &dP, &d2P, linear);
     if (fabs(F1) <= tol * x && fabs(wn - 1) <= tol) {
       /* a slip solution excludes sticking for SPD G; checked all the same,
        * with m(sigma) >= m0 deciding most cases without m0 */
@@ -553,60 +563,21 @@ static int coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu
   return 0;
 }
 
-/* one point's solve (strategy above) with its state set up (point_setup) */
-int ss_point_soil(ssContact *c, const double v0[3], double tol)
+/* The safeguarded loop of one point's solve (strategy above) from the
+ * impulse (ln, lt), iters evaluations made so far.  A function of its own,
+ * the impulse passed by value: the arrays that solve_tangent writes are
+ * then this loop's alone, and the coupled fast path before it spills less
+ * (out of line, a warm nonlinear visit took more instructions). */
+static int soil_loop(ssContact *c, const double v0[3], double tol, double ln, double lt0,
+                     double lt1, int coupled, int iters)
 {
   const double *G = c->G;
   Law *L = &c->cache.law;
   Mobil *J = &c->cache.mob;
   const TBlock *B = &c->cache.tb;
-  /* the shear bound is tf m(sigma), tf = A dt (c + mu p_n) = A dt c + mu lambda_n */
   double tf0 = c->cache.tf0, mu = c->cache.mu;
-
-  int iters = 0, at_guess, coupled = G[1] != 0 || G[2] != 0;
-  double ln = c->lambda[0], lt[2] = {c->lambda[1], c->lambda[2]}, dl[2] = {0, 0};
-  double sigma = 0, dsig = 0;
-  int have_lt = 0;
-  /* a point without impulse that does not reach the soil at v0 keeps none:
-   * lambda = 0 meets both laws (no sinkage, no pressure; no normal
-   * impulse, no shear) -- what the general path below returns, at the
-   * cost of one test (the points of a patch's margin, most visits of
-   * which are these) */
-  if (ln == 0 && lt[0] == 0 && lt[1] == 0 && !(-(L->g0 + L->dt * v0[0]) > 0)) return 1;
-  if (coupled && !B->inert) {
-    /* cold: a start for the normal impulse with the shear held */
-    if (!(ln > 0)) ln = normal_start(L, v0[0] + G[1] * lt[0] + G[2] * lt[1], G[0], &iters);
-    double ct[2] = {v0[1] + G[3] * ln, v0[2] + G[6] * ln};
-    double vt0 = ct[0] + B->G[0] * lt[0] + B->G[1] * lt[1];
-    double vt1 = ct[1] + B->G[2] * lt[0] + B->G[3] * lt[1];
-    double sig0 = sqrt(vt0 * vt0 + vt1 * vt1), tf = tf0 + mu * ln, lam[3], e;
-    /* cheap stick test first: beyond the bound at the guessed slip speed
-     * (>= the bound at zero slip) it surely slips: the coupled Newton.
-     * Warm, its first evaluation is at sig0 and makes the test itself on
-     * the bound it forms there (sure = 0) */
-    if (ln > 0 && sig0 > 0) {
-      int sure = 0;
-      if (!(lt[0] != 0 || lt[1] != 0)) {
-        /* no shear to go by: sigma + T(sigma) gamma = |c_t| for an
-         * isotropic block of the block's compliance gamma along c_t */
-        double Gc[2], Ts = tf * mobil_at(J, sig0, &e);
-        mul2(B->G, ct, Gc);
-        double s1 = sig0 - Ts * (ct[0] * Gc[0] + ct[1] * Gc[1]) / (sig0 * sig0);
-        if (s1 > 0.5 * sig0) sig0 = s1;
-        sure = !stick_fits(B, ct, Ts);
-        if (!sure) sig0 = 0; /* it may stick: not the coupled Newton */
-      }
-      if (sig0 > 0 && coupled_slip(L, B, J, tf0, mu, v0, G, tol, ln, sig0, sure, lam, &iters)) {
-        memcpy(c->lambda, lam, sizeof lam);
-        return iters;
-      }
-    }
-    if (!(c->lambda[0] > 0)) {
-      /* the general loop starts cold */
-      ln = 0;
-      lt[0] = lt[1] = 0;
-    }
-  }
+  double lt[2] = {lt0, lt1}, dl[2] = {0, 0}, sigma = 0, dsig = 0;
+  int at_guess, have_lt = 0;
   if (ln > 0 && coupled) {
     /* warm: the shear at the previous normal impulse, from the slip speed
      * the previous shear impulse gives now */
@@ -651,6 +622,63 @@ int ss_point_soil(ssContact *c, const double v0[3], double tol)
   c->lambda[1] = lt[0];
   c->lambda[2] = lt[1];
   return iters;
+}
+
+/* one point's solve (strategy above) with its state set up (point_setup) */
+int ss_point_soil(ssContact *c, const double v0[3], double tol)
+{
+  const double *G = c->G;
+  Law *L = &c->cache.law;
+  Mobil *J = &c->cache.mob;
+  const TBlock *B = &c->cache.tb;
+  /* the shear bound is tf m(sigma), tf = A dt (c + mu p_n) = A dt c + mu lambda_n */
+  double tf0 = c->cache.tf0, mu = c->cache.mu;
+
+  int iters = 0, coupled = G[1] != 0 || G[2] != 0;
+  double ln = c->lambda[0], lt[2] = {c->lambda[1], c->lambda[2]};
+  /* a point without impulse that does not reach the soil at v0 keeps none:
+   * lambda = 0 meets both laws (no sinkage, no pressure; no normal
+   * impulse, no shear) -- what the general path below returns, at the
+   * cost of one test (the points of a patch's margin, most visits of
+   * which are these) */
+  if (ln == 0 && lt[0] == 0 && lt[1] == 0 && !(-(L->g0 + L->dt * v0[0]) > 0)) return 1;
+  if (coupled && !B->inert) {
+    /* cold: a start for the normal impulse with the shear held */
+    if (!(ln > 0)) ln = normal_start(L, v0[0] + G[1] * lt[0] + G[2] * lt[1], G[0], &iters);
+    double ct[2] = {v0[1] + G[3] * ln, v0[2] + G[6] * ln};
+    double vt0 = ct[0] + B->G[0] * lt[0] + B->G[1] * lt[1];
+    double vt1 = ct[1] + B->G[2] * lt[0] + B->G[3] * lt[1];
+    double sig0 = sqrt(vt0 * vt0 + vt1 * vt1), tf = tf0 + mu * ln, lam[3], e;
+    /* cheap stick test first: beyond the bound at the guessed slip speed
+     * (>= the bound at zero slip) it surely slips: the coupled Newton.
+     * Warm, its first evaluation is at sig0 and makes the test itself on
+     * the bound it forms there (sure = 0) */
+    if (ln > 0 && sig0 > 0) {
+      int sure = 0;
+      if (!(lt[0] != 0 || lt[1] != 0)) {
+        /* no shear to go by: sigma + T(sigma) gamma = |c_t| for an
+         * isotropic block of the block's compliance gamma along c_t */
+        double Gc[2], Ts = tf * mobil_at(J, sig0, &e);
+        mul2(B->G, ct, Gc);
+        double s1 = sig0 - Ts * (ct[0] * Gc[0] + ct[1] * Gc[1]) / (sig0 * sig0);
+        if (s1 > 0.5 * sig0) sig0 = s1;
+        sure = !stick_fits(B, ct, Ts);
+        if (!sure) sig0 = 0; /* it may stick: not the coupled Newton */
+      }
+      if (sig0 > 0 &&
+          (L->linear ? coupled_slip(L, B, J, tf0, mu, v0, G, tol, ln, sig0, sure, lam, &iters, 1)
+                     : coupled_slip(L, B, J, tf0, mu, v0, G, tol, ln, sig0, sure, lam, &iters, 0))) {
+        memcpy(c->lambda, lam, sizeof lam);
+        return iters;
+      }
+    }
+    if (!(c->lambda[0] > 0)) {
+      /* the general loop starts cold */
+      ln = 0;
+      lt[0] = lt[1] = 0;
+    }
+  }
+  return soil_loop(c, v0, tol, ln, lt[0], lt[1], coupled, iters);
 }
 
 /* The point's law from the contact and its material (ssPointCache): the
