@@ -5,7 +5,6 @@
 
 #include <float.h>
 #include <math.h>
-#include <string.h>
 
 /* ---------------------------------------------------------------------- */
 /* the soil point                                                          */
@@ -107,7 +106,7 @@ static inline double law_pressure_as(Law *L, double vn, double *dP, double *d2P,
     slope = L->Ke;
   } else {
     p = py;
-    slope = L->k * L->n * sn1;
+    slope = linear ? L->k : L->k * L->n * sn1; /* k n s^(n-1) = k for n = 1 */
     if (!linear) curv = slope * L->m1 / s;
   }
   double dpdv = -L->dt * slope;
@@ -486,7 +485,8 @@ static void solve_tangent(const TBlock *B, Mobil *J, double tf, double tl,
  * start: both equations, F1 = lambda_n - A dt P(v_n) with v_n including
  * the shear impulse -T w, and F2 = 1/|w| - 1, with their full 2x2
  * Jacobian.  Returns 1 with the impulse in lam once both residuals pass at
- * the same point (and the point does not stick there); 0 leaves the point
+ * the same point (and the point does not stick there; lam is written only
+ * then, so it may be the contact's own); 0 leaves the point
  * to the safeguarded loop, e.g. when an iterate leaves lambda_n > 0,
  * 0 < sigma <= |c_t|.  sure = 0: the start is not known to slip; the
  * first evaluation tests that on its bound first (0 if it may stick).
@@ -648,7 +648,7 @@ int ss_point_soil(ssContact *c, const double v0[3], double tol)
     double ct[2] = {v0[1] + G[3] * ln, v0[2] + G[6] * ln};
     double vt0 = ct[0] + B->G[0] * lt[0] + B->G[1] * lt[1];
     double vt1 = ct[1] + B->G[2] * lt[0] + B->G[3] * lt[1];
-    double sig0 = sqrt(vt0 * vt0 + vt1 * vt1), tf = tf0 + mu * ln, lam[3], e;
+    double sig0 = sqrt(vt0 * vt0 + vt1 * vt1), tf = tf0 + mu * ln, e;
     /* cheap stick test first: beyond the bound at the guessed slip speed
      * (>= the bound at zero slip) it surely slips: the coupled Newton.
      * Warm, its first evaluation is at sig0 and makes the test itself on
@@ -666,9 +666,10 @@ int ss_point_soil(ssContact *c, const double v0[3], double tol)
         if (!sure) sig0 = 0; /* it may stick: not the coupled Newton */
       }
       if (sig0 > 0 &&
-          (L->linear ? coupled_slip(L, B, J, tf0, mu, v0, G, tol, ln, sig0, sure, lam, &iters, 1)
-                     : coupled_slip(L, B, J, tf0, mu, v0, G, tol, ln, sig0, sure, lam, &iters, 0))) {
-        memcpy(c->lambda, lam, sizeof lam);
+          (L->linear ? coupled_slip(L, B, J, tf0, mu, v0, G, tol, ln, sig0, sure, c->lambda,
+                                    &iters, 1)
+                     : coupled_slip(L, B, J, tf0, mu, v0, G, tol, ln, sig0, sure, c->lambda,
+                                    &iters, 0))) {
         return iters;
       }
     }
