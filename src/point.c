@@ -488,22 +488,23 @@ static void solve_tangent(const TBlock *B, Mobil *J, double tf, double tl,
  * the same point (and the point does not stick there; lam is written only
  * then, so it may be the contact's own); 0 leaves the point
  * to the safeguarded loop, e.g. when an iterate leaves lambda_n > 0,
- * 0 < sigma <= |c_t|.  sure = 0: the start is not known to slip; the
- * first evaluation tests that on its bound first (0 if it may stick).
- * linear: L->linear, a constant, so that each law has a loop of its own
- * without the other's branches and registers. */
+ * 0 < sigma <= |c_t|.  ct0, ct1 and tf: c_t = v0_t + G_tn x and the bound's
+ * tf0 + mu x at the start x, which the caller has formed (the same
+ * expressions; each step forms them for the next).  sure = 0: the start
+ * is not known to slip; the first evaluation tests that on its bound
+ * first (0 if it may stick).  linear: L->linear, a constant, so that each
+ * law has a loop of its own without the other's branches and registers. */
 static inline __attribute__((always_inline)) int
 coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu, const double v0[3],
-             const double G[9], double tol, double x, double sigma, int sure, double lam[3],
-             int *iters, const int linear)
+             const double G[9], double tol, double x, double sigma, double ct0, double ct1,
+             double tf, int sure, double lam[3], int *iters, const int linear)
 {
   /* slip_eval and slip_slope written out on scalars (the same
    * expressions, so the same iterates): this loop is most of a warm
    * coupled visit, and the Slip record would live in memory */
   const double S = L->S, *Gt = B->G, e0 = B->e[0], e1 = B->e[1];
   for (int it = 0; it < 6; it++) {
-    double ct0 = v0[1] + e0 * x, ct1 = v0[2] + e1 * x;
-    double tf = tf0 + mu * x, e = 0, m = 0;
+    double e = 0, m = 0;
     int out = !(sigma > 0) || sigma * sigma > ct0 * ct0 + ct1 * ct1;
     if (!out || !sure) m = mobil_at(J, sigma, &e);
     if (!sure) {
@@ -559,6 +560,10 @@ coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu, const dou
     x -= (J22 * F1 - J12 * F2) / jdet;
     sigma -= (J11 * F2 - J21 * F1) / jdet;
     if (!(x > 0)) return 0;
+    /* the next evaluation's c_t and tf, at the new x */
+    ct0 = v0[1] + e0 * x;
+    ct1 = v0[2] + e1 * x;
+    tf = tf0 + mu * x;
   }
   return 0;
 }
@@ -645,7 +650,8 @@ int ss_point_soil(ssContact *c, const double v0[3], double tol)
   if (coupled && !B->inert) {
     /* cold: a start for the normal impulse with the shear held */
     if (!(ln > 0)) ln = normal_start(L, v0[0] + G[1] * lt[0] + G[2] * lt[1], G[0], &iters);
-    double ct[2] = {v0[1] + G[3] * ln, v0[2] + G[6] * ln};
+    /* c_t as coupled_slip forms it (G_tn from B), which starts from it */
+    double ct[2] = {v0[1] + B->e[0] * ln, v0[2] + B->e[1] * ln};
     double vt0 = ct[0] + B->G[0] * lt[0] + B->G[1] * lt[1];
     double vt1 = ct[1] + B->G[2] * lt[0] + B->G[3] * lt[1];
     double sig0 = sqrt(vt0 * vt0 + vt1 * vt1), tf = tf0 + mu * ln, e;
@@ -666,10 +672,10 @@ int ss_point_soil(ssContact *c, const double v0[3], double tol)
         if (!sure) sig0 = 0; /* it may stick: not the coupled Newton */
       }
       if (sig0 > 0 &&
-          (L->linear ? coupled_slip(L, B, J, tf0, mu, v0, G, tol, ln, sig0, sure, c->lambda,
-                                    &iters, 1)
-                     : coupled_slip(L, B, J, tf0, mu, v0, G, tol, ln, sig0, sure, c->lambda,
-                                    &iters, 0))) {
+          (L->linear ? coupled_slip(L, B, J, tf0, mu, v0, G, tol, ln, sig0, ct[0], ct[1], tf, sure,
+                                    c->lambda, &iters, 1)
+                     : coupled_slip(L, B, J, tf0, mu, v0, G, tol, ln, sig0, ct[0], ct[1], tf, sure,
+                                    c->lambda, &iters, 0))) {
         return iters;
       }
     }
