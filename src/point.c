@@ -568,21 +568,27 @@ coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu, const dou
   return 0;
 }
 
-/* The safeguarded loop of one point's solve (strategy above) from the
- * impulse (ln, lt), iters evaluations made so far.  A function of its own,
- * the impulse passed by value: the arrays that solve_tangent writes are
- * then this loop's alone, and the coupled fast path before it spills less
+/* The safeguarded loop of one point's solve (strategy above), from the
+ * impulse c->lambda or, cold, from none; iters evaluations made so far.
+ * A function of its own that reads its start from the contact: the arrays
+ * that solve_tangent writes are then this loop's alone, and the coupled
+ * fast path before it keeps no copy of the impulse, so it spills less
  * (out of line, a warm nonlinear visit took more instructions). */
-static int soil_loop(ssContact *c, const double v0[3], double tol, double ln, double lt0,
-                     double lt1, int coupled, int iters)
+static int soil_loop(ssContact *c, const double v0[3], double tol, int cold, int coupled,
+                     int iters)
 {
   const double *G = c->G;
   Law *L = &c->cache.law;
   Mobil *J = &c->cache.mob;
   const TBlock *B = &c->cache.tb;
   double tf0 = c->cache.tf0, mu = c->cache.mu;
-  double lt[2] = {lt0, lt1}, dl[2] = {0, 0}, sigma = 0, dsig = 0;
+  double ln = 0, lt[2] = {0, 0}, dl[2] = {0, 0}, sigma = 0, dsig = 0;
   int at_guess, have_lt = 0;
+  if (!cold) {
+    ln = c->lambda[0];
+    lt[0] = c->lambda[1];
+    lt[1] = c->lambda[2];
+  }
   if (ln > 0 && coupled) {
     /* warm: the shear at the previous normal impulse, from the slip speed
      * the previous shear impulse gives now */
@@ -639,7 +645,7 @@ int ss_point_soil(ssContact *c, const double v0[3], double tol)
   /* the shear bound is tf m(sigma), tf = A dt (c + mu p_n) = A dt c + mu lambda_n */
   double tf0 = c->cache.tf0, mu = c->cache.mu;
 
-  int iters = 0, coupled = G[1] != 0 || G[2] != 0;
+  int iters = 0, cold = 0, coupled = G[1] != 0 || G[2] != 0;
   double ln = c->lambda[0], lt[2] = {c->lambda[1], c->lambda[2]};
   /* a point without impulse that does not reach the soil at v0 keeps none:
    * lambda = 0 meets both laws (no sinkage, no pressure; no normal
@@ -679,13 +685,10 @@ int ss_point_soil(ssContact *c, const double v0[3], double tol)
         return iters;
       }
     }
-    if (!(c->lambda[0] > 0)) {
-      /* the general loop starts cold */
-      ln = 0;
-      lt[0] = lt[1] = 0;
-    }
+    /* the general loop starts cold where the fast path found no start */
+    cold = !(c->lambda[0] > 0);
   }
-  return soil_loop(c, v0, tol, ln, lt[0], lt[1], coupled, iters);
+  return soil_loop(c, v0, tol, cold, coupled, iters);
 }
 
 /* The point's law from the contact and its material (ssPointCache): the
