@@ -651,8 +651,12 @@ int ss_point_soil(ssContact *c, const double v0[3], double tol)
    * lambda = 0 meets both laws (no sinkage, no pressure; no normal
    * impulse, no shear) -- what the general path below returns, at the
    * cost of one test (the points of a patch's margin, most visits of
-   * which are these) */
-  if (ln == 0 && lt[0] == 0 && lt[1] == 0 && !(-(L->g0 + L->dt * v0[0]) > 0)) return 1;
+   * which are these).  Made only where ln > 0 fails, so that a loaded
+   * point passes over it in one branch (GCC would otherwise form the
+   * three comparisons and combine them before branching). */
+  if (!(ln > 0)) {
+    if (ln == 0 && lt[0] == 0 && lt[1] == 0 && !(-(L->g0 + L->dt * v0[0]) > 0)) return 1;
+  }
   if (coupled && !B->inert) {
     /* cold: a start for the normal impulse with the shear held */
     if (!(ln > 0)) ln = normal_start(L, v0[0] + G[1] * lt[0] + G[2] * lt[1], G[0], &iters);
