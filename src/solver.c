@@ -955,7 +955,9 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   /* end-of-step contact velocities for the soil update */
   int link = -1;
   double V[6];
-  const ssContact *end = d->contact + d->ncontact;
+  /* (no contacts: the array may not exist yet, and no arithmetic on its
+   * NULL) */
+  const ssContact *end = d->ncontact ? d->contact + d->ncontact : d->contact;
   for (ssContact *c = d->contact; c < end;) {
     double v[3] = {0, 0, 0};
     if (c->link >= 0) {
