@@ -738,12 +738,14 @@ static inline __attribute__((always_inline)) void h_sums(const NPoint *pt, const
 {
   ssV2 sK[6] = {0}, vw[9] = {0}, wv[9] = {0}, ww[9] = {0};
   for (int k = 0; k < nl; k += 2) {
+    /* (the offsets 6 i in size_t: formed in 64 bits at once, not in
+     * int's 32 and then widened, an instruction less a point) */
     const int i = live[k];
-    const double *ra = pt[i].r, *Ka = Ks + 6 * i;
+    const double *ra = pt[i].r, *Ka = Ks + 6 * (size_t)i;
     ssV2 r0, r1, r2, kn, k1n, k2n, k11, k12, k22;
     if (k + 1 < nl) {
       const int j = live[k + 1];
-      const double *rb = pt[j].r, *Kb = Ks + 6 * j;
+      const double *rb = pt[j].r, *Kb = Ks + 6 * (size_t)j;
       r0 = (ssV2){ra[0], rb[0]};
       r1 = (ssV2){ra[1], rb[1]};
       r2 = (ssV2){ra[2], rb[2]};
@@ -877,7 +879,8 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
     double f0 = A->F[0], f1 = A->F[1], f2 = A->F[2], f3 = A->F[3], f4 = A->F[4], f5 = A->F[5];
     for (int k = 0; k < nl; k++) {
       const int i = live[k];
-      const double *r = w->pt[i].r, *lam = lam_out + 3 * i;
+      /* (3 i in size_t, as in h_sums) */
+      const double *r = w->pt[i].r, *lam = lam_out + 3 * (size_t)i;
       const double r0 = r[0], r1 = r[1], r2 = r[2], ln = lam[0], l1 = lam[1], l2 = lam[2];
       f0 += r1 * l2 - r2 * l1;
       f1 += r2 * ln - r0 * l2;
