@@ -862,7 +862,8 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
     memcpy(V, A->V, sizeof V);
     for (int i = i0; i < i1; i++) {
       NPoint *P = w->pt + i;
-      double *lam = lam_out + 3 * i, *K = with_H ? K_out + 6 * i : NULL;
+      /* (the offsets in size_t, as in h_sums) */
+      double *lam = lam_out + 3 * (size_t)i, *K = with_H ? K_out + 6 * (size_t)i : NULL;
       int st = !(with_imp && P->imp) ? point_law(&M, P, V, lam, K, 0)
                                      : imp_law(&M, P, V, mu + 2 * i, lam, K, ie + i);
       if (st == UNLOADED) continue;
