@@ -1523,8 +1523,9 @@ static double apply_linear(const ssModel *m, ssData *d, const Setup *s, ssNewton
     double V[6];
     memcpy(V, w->sum[w->group_of[w->run[u]]].V, sizeof V);
     for (int i = w->run[u]; i < i1; i++) {
-      const double *l = w->lam + 3 * i, *K = w->K + 6 * i;
-      double *lt = w->lamtry + 3 * i, dv[3];
+      /* (the offsets in size_t, as in h_sums) */
+      const double *l = w->lam + 3 * (size_t)i, *K = w->K + 6 * (size_t)i;
+      double *lt = w->lamtry + 3 * (size_t)i, dv[3];
       lt[0] = lt[1] = lt[2] = 0;
       if (!(l[0] > 0)) continue;
       point_velocity(w->pt[i].r, V, dv);
