@@ -725,6 +725,17 @@ static void imp_step(const NPoint *P, const NImpEval *ie, double scale, const do
   dmu[1] = -(A[0] * g1 - A[2] * g0) / det;
 }
 
+/* s[0] += a[0] + a[1] and s[1] += b[0] + b[1] (two of h_sums' sums, its
+ * halves added at the end) in one pair of doubles: in each half the same
+ * additions, and fewer instructions than one sum at a time */
+static inline void add_halves(double s[2], ssV2 a, ssV2 b)
+{
+  ssV2 v;
+  memcpy(&v, s, sizeof v);
+  v += (ssV2){a[0], b[0]} + (ssV2){a[1], b[1]};
+  memcpy(s, &v, sizeof v);
+}
+
 /* The Jacobian's sums over the loaded points live[0, nl) of a group, into
  * A: with K = [[kn, 0, 0], [k1n, k11, k12], [k2n, k12, k22]] and the
  * point's J = [-[r]x, I], the blocks of J^T K J written out: K, K (-[r]x),
@@ -808,12 +819,15 @@ static inline __attribute__((always_inline)) void h_sums(const NPoint *pt, const
     wv[7] += r0 * k11;
     wv[8] += r0 * k12;
   }
-  for (int k = 0; k < 6; k++) A->K[k] += sK[k][0] + sK[k][1];
-  for (int k = 0; k < 9; k++) {
-    A->vw[k] += vw[k][0] + vw[k][1];
-    A->wv[k] += wv[k][0] + wv[k][1];
-    A->ww[k] += ww[k][0] + ww[k][1];
+  for (int k = 0; k < 6; k += 2) add_halves(A->K + k, sK[k], sK[k + 1]);
+  for (int k = 0; k < 8; k += 2) {
+    add_halves(A->vw + k, vw[k], vw[k + 1]);
+    add_halves(A->wv + k, wv[k], wv[k + 1]);
+    add_halves(A->ww + k, ww[k], ww[k + 1]);
   }
+  A->vw[8] += vw[8][0] + vw[8][1];
+  A->wv[8] += wv[8][0] + wv[8][1];
+  A->ww[8] += ww[8][0] + ww[8][1];
 }
 
 /* F(y, mu) and H(y) = dF/dy over all contacts, the soil points' impulses
