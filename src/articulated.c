@@ -1153,7 +1153,9 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
 
 /* A link (six columns, J_b^T = its path's S rows) or a dof k (one column,
  * e_k) as the factored route sees it: its path dofs, descending, X and X/D
- * on them (row k at k ncol, ncol its columns), and W (nr x ncol) */
+ * on them in the path's order (path[t]'s row at t ncol, ncol its columns,
+ * so that the sweeps over the path index them without reading the path),
+ * and W (nr x ncol) */
 typedef struct Probe {
   const int *path;
   int np;
@@ -1182,7 +1184,7 @@ static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, doubl
       memcpy(&a1, w->S + 6 * k + 2, sizeof a1);
       memcpy(&a2, w->S + 6 * k + 4, sizeof a2);
       for (int i = 0; i < t; i++) {
-        const double *xi = X + 6 * path[i], h = w->L[w->anc_adr[path[i]] + t - i];
+        const double *xi = X + 6 * i, h = w->L[w->anc_adr[path[i]] + t - i];
         ssV2 hv = {h, h};
         memcpy(&x0, xi, sizeof x0);
         memcpy(&x1, xi + 2, sizeof x1);
@@ -1192,20 +1194,20 @@ static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, doubl
         a2 -= hv * x2;
       }
       ssV2 dv = {d, d};
-      memcpy(X + 6 * k, &a0, sizeof a0);
-      memcpy(X + 6 * k + 2, &a1, sizeof a1);
-      memcpy(X + 6 * k + 4, &a2, sizeof a2);
+      memcpy(X + 6 * t, &a0, sizeof a0);
+      memcpy(X + 6 * t + 2, &a1, sizeof a1);
+      memcpy(X + 6 * t + 4, &a2, sizeof a2);
       a0 /= dv;
       a1 /= dv;
       a2 /= dv;
-      memcpy(XD + 6 * k, &a0, sizeof a0);
-      memcpy(XD + 6 * k + 2, &a1, sizeof a1);
-      memcpy(XD + 6 * k + 4, &a2, sizeof a2);
+      memcpy(XD + 6 * t, &a0, sizeof a0);
+      memcpy(XD + 6 * t + 2, &a1, sizeof a1);
+      memcpy(XD + 6 * t + 4, &a2, sizeof a2);
     } else {
       double x = k == top;
-      for (int i = 0; i < t; i++) x -= w->L[w->anc_adr[path[i]] + t - i] * X[path[i]];
-      X[k] = x;
-      XD[k] = x / d;
+      for (int i = 0; i < t; i++) x -= w->L[w->anc_adr[path[i]] + t - i] * X[i];
+      X[t] = x;
+      XD[t] = x / d;
     }
   }
   if (!nr) return;
@@ -1355,7 +1357,8 @@ static inline __attribute__((always_inline)) void
 probe_pair(const ssArtWork *w, Probe a, Probe b, int ca, int cb, double *out, int ldo)
 {
   int i = 0, j = 0, nr = w->nrow;
-  /* the shared part of two paths to the root is the tail of both */
+  /* the shared part of two paths to the root is the tail of both (from i
+   * on in a's, from j on in b's) */
   while (i < a.np && j < b.np && a.path[i] != b.path[j]) {
     if (a.path[i] > b.path[j]) i++;
     else j++;
@@ -1367,8 +1370,8 @@ probe_pair(const ssArtWork *w, Probe a, Probe b, int ca, int cb, double *out, in
      * s + (-x) y: ss_math.h) */
     for (int r0 = 0; r0 < 6; r0 += 3) {
       ssV2 s[9] = {{0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}};
-      for (int k = i; k < a.np; k++) {
-        const double *x = a.X + 6 * a.path[k] + r0, *y = b.XD + 6 * a.path[k];
+      for (int k = i, l = j; k < a.np; k++, l++) {
+        const double *x = a.X + 6 * k + r0, *y = b.XD + 6 * l;
         ssV2 y0, y1, y2;
         memcpy(&y0, y, sizeof y0);
         memcpy(&y1, y + 2, sizeof y1);
@@ -1398,8 +1401,8 @@ probe_pair(const ssArtWork *w, Probe a, Probe b, int ca, int cb, double *out, in
     return;
   }
   double acc[36] = {0};
-  for (; i < a.np; i++) {
-    const double *x = a.X + ca * a.path[i], *y = b.XD + cb * a.path[i];
+  for (; i < a.np; i++, j++) {
+    const double *x = a.X + ca * i, *y = b.XD + cb * j;
     for (int r = 0; r < ca; r++) ss_row_add_scaled(acc + cb * r, x[r], y, cb);
   }
   for (int k = 0; k < nr; k++)
