@@ -1255,7 +1255,12 @@ static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, doubl
   closure_forward(w, W, ncol);
 }
 
-static Probe link_probe(const ssModel *m, ssArtWork *w, int b)
+/* A link's or a dof's probe, reduced on its first use in a step.  Both are
+ * inlined into their callers, the pairs' entry points: most calls find the
+ * probe ready, and the check costs less than a call returning the Probe
+ * through memory (reduce, the rare case, stays a call). */
+static inline __attribute__((always_inline)) Probe
+link_probe(const ssModel *m, ssArtWork *w, int b)
 {
   size_t lb = (size_t)(b - w->b0), n = (size_t)w->nv, nr = (size_t)w->nrow;
   int *path = w->path + lb * n;
@@ -1267,7 +1272,8 @@ static Probe link_probe(const ssModel *m, ssArtWork *w, int b)
   return (Probe){path, w->npath[lb], X, XD, W};
 }
 
-static Probe dof_probe(ssArtWork *w, int k)
+static inline __attribute__((always_inline)) Probe
+dof_probe(ssArtWork *w, int k)
 {
   size_t n = (size_t)w->nv, nr = (size_t)w->nrow;
   int *path = w->dpath + (size_t)k * n;
