@@ -32,9 +32,9 @@ struct ssArtWork {
   double *vel;           /* (nb x 6) body spatial velocities */
   double *acc;           /* (nb x 6) bias accelerations */
   double *frc;           /* (nb x 6) RNEA forces */
-  double *I6;            /* (nb x 36) spatial inertias, world, by columns
-                            (entry ij at 6 j + i: m6v_cols) */
-  double *Ic;            /* (nb x 36) composite inertias, by columns */
+  double *Ic;            /* (nb x 36) composite inertias, world, by columns
+                            (entry ij at 6 j + i: m6v_cols); the bodies'
+                            own spatial inertias until the backward pass */
   double *M;             /* (nv x nv) the mass matrix M (the CRBA's) */
   double *L;             /* (sum of depths) M' = M + implicit terms on the
                             tree's pattern, then its LTDL factor, row k along
@@ -191,7 +191,7 @@ void ss_art_work_free(ssArtWork *w)
   free(w->eq); free(w->dof_body); free(w->dof_parent); free(w->anc); free(w->anc_adr);
   free(w->dsc); free(w->dsc_adr); free(w->live);
   free(w->S);
-  free(w->vel); free(w->acc); free(w->frc); free(w->I6); free(w->Ic);
+  free(w->vel); free(w->acc); free(w->frc); free(w->Ic);
   free(w->M); free(w->L); free(w->rhs); free(w->x); free(w->y);
   free(w->K); free(w->phi); free(w->MiKT); free(w->A); free(w->Z); free(w->row_on);
   free(w->Y); free(w->Lam); free(w->Yok);
@@ -219,7 +219,6 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
   w->vel = calloc(nb * 6, sizeof(double));
   w->acc = calloc(nb * 6, sizeof(double));
   w->frc = calloc(nb * 6, sizeof(double));
-  w->I6 = calloc(nb * 36, sizeof(double));
   w->Ic = calloc(nb * 36, sizeof(double));
   w->M = calloc(nv * nv, sizeof(double));
   w->rhs = calloc(nv, sizeof(double));
@@ -256,7 +255,7 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
     return NULL;
   }
   if (!w->eq || !w->dof_body || !w->dof_parent || !w->S || !w->vel || !w->acc ||
-      !w->frc || !w->I6 || !w->Ic || !w->M || !w->rhs || !w->x || !w->y ||
+      !w->frc || !w->Ic || !w->M || !w->rhs || !w->x || !w->y ||
       !w->K || !w->phi || !w->MiKT || !w->A || !w->Z || !w->row_on || !w->Y || !w->Lam ||
       !w->Yok) {
     ss_art_work_free(w);
@@ -990,10 +989,10 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
     ss_m3_transpose(Rt, R);
     ss_m3_mul(T, R, m->body_inertia + 9 * b);
     ss_m3_mul(Iw, T, Rt);
-    spatial_inertia(w->I6 + 36 * lb, m->body_mass[b], d->body_xipos + 3 * b, Iw);
+    spatial_inertia(w->Ic + 36 * lb, m->body_mass[b], d->body_xipos + 3 * b, Iw);
     double Iv[6], Ia[6], vf[6];
-    m6v_cols(Iv, w->I6 + 36 * lb, v);
-    m6v_cols(Ia, w->I6 + 36 * lb, a);
+    m6v_cols(Iv, w->Ic + 36 * lb, v);
+    m6v_cols(Ia, w->Ic + 36 * lb, a);
     fcross(vf, v, Iv);
     for (int i = 0; i < 6; i++) w->frc[6 * lb + i] = Ia[i] + vf[i];
     /* external loads at the centre of mass */
@@ -1010,8 +1009,9 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
     }
   }
 
-  /* backward pass: bias forces c (in rhs, negated) and composite inertias */
-  memcpy(w->Ic, w->I6, (size_t)w->nb * 36 * sizeof(double));
+  /* backward pass: bias forces c (in rhs, negated) and composite inertias
+   * (each body's Ic, its spatial inertia from the forward pass, takes its
+   * children's before it is added to its parent's) */
   for (int lb = w->nb - 1; lb >= 0; lb--) {
     int b = b0 + lb, par = m->body_parent[b], nd = m->body_ndof[b];
     const double *f = w->frc + 6 * lb;
