@@ -138,6 +138,19 @@ static inline void m6v_cols(double r[6], const double C[36], const double v[6])
   memcpy(r + 4, &r2, sizeof r2);
 }
 
+/* r += a, in three pairs (the same sums as an element loop, whose
+ * vectorised form would first check whether r and a overlap) */
+static inline void add6(double r[6], const double a[6])
+{
+  for (int i = 0; i < 6; i += 2) {
+    ssV2 x, y;
+    memcpy(&x, r + i, sizeof x);
+    memcpy(&y, a + i, sizeof y);
+    x += y;
+    memcpy(r + i, &x, sizeof x);
+  }
+}
+
 static double dot6(const double a[6], const double b[6])
 {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5];
@@ -1020,9 +1033,11 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
       for (int k = 0; k < nd; k++) w->rhs[k0 + k] = -dot6(w->S + 6 * (k0 + k), f);
     }
     if (par >= 0) {
+      /* the parent's force and inertia (a column at a time) take the
+       * child's */
       int lp = par - b0;
-      for (int i = 0; i < 6; i++) w->frc[6 * lp + i] += f[i];
-      for (int i = 0; i < 36; i++) w->Ic[36 * lp + i] += w->Ic[36 * lb + i];
+      add6(w->frc + 6 * lp, f);
+      for (int j = 0; j < 6; j++) add6(w->Ic + 36 * lp + 6 * j, w->Ic + 36 * lb + 6 * j);
     }
   }
 
