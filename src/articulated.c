@@ -970,7 +970,7 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
   /* body velocities, bias accelerations and spatial inertias (RNEA forward) */
   for (int lb = 0; lb < w->nb; lb++) {
     int b = b0 + lb, par = m->body_parent[b], nd = m->body_ndof[b];
-    double *v = w->vel + 6 * lb, *a = w->acc + 6 * lb, su[6] = {0, 0, 0, 0, 0, 0};
+    double *v = w->vel + 6 * lb, *a = w->acc + 6 * lb;
     if (par >= 0) {
       memcpy(v, w->vel + 6 * (par - b0), 6 * sizeof(double));
       memcpy(a, w->acc + 6 * (par - b0), 6 * sizeof(double));
@@ -982,9 +982,17 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
     }
     if (nd) {
       int k0 = m->body_dofadr[b] - w->v0;
-      for (int k = 0; k < nd; k++)
-        for (int i = 0; i < 6; i++) su[i] += w->S[6 * (k0 + k) + i] * u[k0 + k];
-      double c[6];
+      /* su = S qdot over the joint's dofs, three pairs of sums from +0 */
+      ssV2 p[3] = {{0, 0}, {0, 0}, {0, 0}}, sk;
+      for (int k = k0; k < k0 + nd; k++) {
+        ssV2 uk = {u[k], u[k]};
+        for (int i = 0; i < 3; i++) {
+          memcpy(&sk, w->S + 6 * k + 2 * i, sizeof sk);
+          p[i] += sk * uk;
+        }
+      }
+      double su[6], c[6];
+      memcpy(su, p, sizeof su);
       if (m->body_jnttype[b] == SS_JOINT_FLOATING) {
         /* d/dt of the base's columns: only the origin term moves */
         memset(c, 0, sizeof c);
@@ -992,10 +1000,8 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
       } else {
         mcross(c, v, su); /* v_parent x S qdot */
       }
-      for (int i = 0; i < 6; i++) {
-        v[i] += su[i];
-        a[i] += c[i];
-      }
+      add6(v, su);
+      add6(a, c);
     }
     double R[9], Rt[9], T[9], Iw[9];
     memcpy(R, d->body_xmat + 9 * b, sizeof R);
