@@ -1009,11 +1009,12 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
     ss_m3_mul(T, R, m->body_inertia + 9 * b);
     ss_m3_mul(Iw, T, Rt);
     spatial_inertia(w->Ic + 36 * lb, m->body_mass[b], d->body_xipos + 3 * b, Iw);
-    double Iv[6], Ia[6], vf[6];
+    /* f = I a + v x* I v, I a formed in f */
+    double Iv[6], vf[6], *f = w->frc + 6 * lb;
     m6v_cols(Iv, w->Ic + 36 * lb, v);
-    m6v_cols(Ia, w->Ic + 36 * lb, a);
+    m6v_cols(f, w->Ic + 36 * lb, a);
     fcross(vf, v, Iv);
-    for (int i = 0; i < 6; i++) w->frc[6 * lb + i] = Ia[i] + vf[i];
+    add6(f, vf);
     /* external loads at the centre of mass */
     for (int k = 0; k < m->nxforce; k++) {
       if (m->xforce_body[k] != b) continue;
@@ -1022,8 +1023,8 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
       double cxf[3];
       ss_v3_cross(cxf, d->body_xipos + 3 * b, F);
       for (int i = 0; i < 3; i++) {
-        w->frc[6 * lb + i] -= Tq[i] + cxf[i];
-        w->frc[6 * lb + 3 + i] -= F[i];
+        f[i] -= Tq[i] + cxf[i];
+        f[3 + i] -= F[i];
       }
     }
   }
