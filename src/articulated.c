@@ -156,6 +156,19 @@ static double dot6(const double a[6], const double b[6])
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5];
 }
 
+/* out = R I R^T (out neither R nor I): ss_m3_mul's T = R I, then T R^T
+ * with the terms of R^T's columns read from R's rows, the products and
+ * sums of ss_m3_mul's, without a transposed copy of R */
+static inline void rotate_inertia(double out[9], const double R[9], const double I[9])
+{
+  double T[9];
+  ss_m3_mul(T, R, I);
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      out[3 * i + j] =
+          T[3 * i] * R[3 * j] + T[3 * i + 1] * R[3 * j + 1] + T[3 * i + 2] * R[3 * j + 2];
+}
+
 /* spatial inertia about the origin of mass m, COM c, inertia Ic (world,
  * about the COM):  [[Ic - m [c]x[c]x, m [c]x], [-m [c]x, m 1]], by columns
  * (entry ij at I6[6 j + i]) */
@@ -1003,11 +1016,8 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
       add6(v, su);
       add6(a, c);
     }
-    double R[9], Rt[9], T[9], Iw[9];
-    memcpy(R, d->body_xmat + 9 * b, sizeof R);
-    ss_m3_transpose(Rt, R);
-    ss_m3_mul(T, R, m->body_inertia + 9 * b);
-    ss_m3_mul(Iw, T, Rt);
+    double Iw[9];
+    rotate_inertia(Iw, d->body_xmat + 9 * b, m->body_inertia + 9 * b);
     spatial_inertia(w->Ic + 36 * lb, m->body_mass[b], d->body_xipos + 3 * b, Iw);
     /* f = I a + v x* I v, I a formed in f */
     double Iv[6], vf[6], *f = w->frc + 6 * lb;
@@ -1674,11 +1684,9 @@ int ss_model_find_body(const ssModel *m, int s, const char *name)
 static void rot_inertia(double out[9], const double q[4], const double v[6])
 {
   double I[9] = {v[0], v[1], v[2], v[1], v[3], v[4], v[2], v[4], v[5]};
-  double R[9], Rt[9], T[9];
+  double R[9];
   ss_quat_to_mat(R, q);
-  ss_m3_transpose(Rt, R);
-  ss_m3_mul(T, R, I);
-  ss_m3_mul(out, T, Rt);
+  rotate_inertia(out, R, I);
 }
 
 /* each mesh geom loads its own copy: scale is baked into the vertices */
