@@ -58,14 +58,13 @@ struct ssArtWork {
    * (ss_art_link_pair): b's path dofs, descending, and on them X_b = T J_b^T
    * and X_b / D (M'^-1 = T^T D^-1 T, T = L^-T the tree solve's first
    * sweep), and W_b = L_A^-1 K M'^-1 J_b^T (nr x 6, A = L_A L_A^T) */
-  int *path, *npath;     /* (nb x nv), (nb) */
+  int *padr, *npath;     /* (nb) b's path, its last dof's chain: npath dofs of anc from padr */
   double *Xp, *XD;       /* (nb x nv x 6), rows on the path */
   double *Wp;            /* (nb x nr x 6) */
   unsigned char *Xok;    /* (nb) valid for this step */
   double *fsum;          /* (nv) sum of J_b^T F_b (ss_art_force_add) */
-  /* the same for single dofs (a joint row's e_k): dpath, Xd and XDd (nv x
-   * nv), dnp and dok (nv), Wd (nv x nr) */
-  int *dpath, *dnp;
+  /* the same for single dofs (a joint row's e_k, its path k's chain): Xd
+   * and XDd (nv x nv), dok (nv), Wd (nv x nr) */
   double *Xd, *XDd, *Wd;
   unsigned char *dok;
   int rank_deficient;    /* rows dropped in the last factorization */
@@ -221,8 +220,8 @@ void ss_art_work_free(ssArtWork *w)
   free(w->M); free(w->L); free(w->rhs); free(w->x); free(w->y);
   free(w->K); free(w->phi); free(w->MiKT); free(w->A); free(w->Z); free(w->row_on);
   free(w->Y); free(w->Lam); free(w->Yok);
-  free(w->path); free(w->npath); free(w->Xp); free(w->XD); free(w->Wp); free(w->Xok);
-  free(w->fsum); free(w->dpath); free(w->dnp); free(w->Xd); free(w->XDd); free(w->Wd);
+  free(w->padr); free(w->npath); free(w->Xp); free(w->XD); free(w->Wp); free(w->Xok);
+  free(w->fsum); free(w->Xd); free(w->XDd); free(w->Wd);
   free(w->dok); free(w->kin_q); free(w->kcol); free(w->nkcol);
   free(w);
 }
@@ -259,15 +258,13 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
   w->Y = calloc(nb * nv * 6, sizeof(double));
   w->Lam = calloc(nb * 36, sizeof(double));
   w->Yok = calloc(nb, 1);
-  w->path = calloc(nb * nv, sizeof(int));
+  w->padr = calloc(nb ? nb : 1, sizeof(int));
   w->npath = calloc(nb ? nb : 1, sizeof(int));
   w->Xp = calloc(nb * nv * 6, sizeof(double));
   w->XD = calloc(nb * nv * 6, sizeof(double));
   w->Wp = calloc(nb * nr * 6, sizeof(double));
   w->Xok = calloc(nb ? nb : 1, 1);
   w->fsum = calloc(nv, sizeof(double));
-  w->dpath = calloc(nv * nv, sizeof(int));
-  w->dnp = calloc(nv, sizeof(int));
   w->Xd = calloc(nv * nv, sizeof(double));
   w->XDd = calloc(nv * nv, sizeof(double));
   w->Wd = calloc(nv * nr, sizeof(double));
@@ -275,8 +272,8 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
   w->kin_q = calloc(m->sys_nq[s] ? (size_t)m->sys_nq[s] : 1, sizeof(double));
   w->kcol = calloc(nr * nv, sizeof(int));
   w->nkcol = calloc(nr, sizeof(int));
-  if (!w->kin_q || !w->kcol || !w->nkcol || !w->path || !w->npath || !w->Xp || !w->XD ||
-      !w->Wp || !w->Xok || !w->fsum || !w->dpath || !w->dnp || !w->Xd || !w->XDd || !w->Wd || !w->dok) {
+  if (!w->kin_q || !w->kcol || !w->nkcol || !w->padr || !w->npath || !w->Xp || !w->XD ||
+      !w->Wp || !w->Xok || !w->fsum || !w->Xd || !w->XDd || !w->Wd || !w->dok) {
     ss_art_work_free(w);
     return NULL;
   }
@@ -318,6 +315,13 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
     for (int j = k; j >= 0; j = w->dof_parent[j]) w->anc[nanc++] = j;
   }
   w->anc_adr[w->nv] = nanc;
+  /* each link's path: the chain of its last dof (none: empty) */
+  for (int lb = 0; lb < w->nb; lb++) {
+    int top = last_dof(m, w, w->b0 + lb);
+    if (top < 0) continue;
+    w->padr[lb] = w->anc_adr[top];
+    w->npath[lb] = w->anc_adr[top + 1] - w->anc_adr[top];
+  }
   /* each dof's descendants from the chains, descending (i from the last) */
   w->dsc = malloc((size_t)(nanc > w->nv ? 2 * (nanc - w->nv) : 1) * sizeof(int));
   w->dsc_adr = calloc(nv + 1, sizeof(int));
@@ -1194,14 +1198,12 @@ typedef struct Probe {
   const double *X, *XD, *W;
 } Probe;
 
-/* X = T J^T, X/D and W = L_A^-1 K M'^-1 J^T of a probe whose path starts at
- * dof top (J's rows: S on the path for a link, e_top for a dof) */
-static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, double *X,
-                   double *XD, double *W)
+/* X = T J^T, X/D and W = L_A^-1 K M'^-1 J^T of a probe on path (np dofs, a
+ * chain in anc; J's rows: S on the path for a link, e_path[0] for a dof) */
+static void reduce(ssArtWork *w, const int *path, int np, int ncol, double *X, double *XD,
+                   double *W)
 {
-  int nr = w->nrow, np = 0;
-  for (int t = w->anc_adr[top]; t < w->anc_adr[top + 1]; t++) path[np++] = w->anc[t];
-  *npath = np;
+  int nr = w->nrow;
   /* the tree solve's first sweep on the path: row t takes -L_{path[i]
    * path[t]} X_path[i] from each i < t in turn (path[i]'s chain is the path
    * from i on: that entry at t - i), the sum of row updates pulled into
@@ -1236,7 +1238,7 @@ static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, doubl
       memcpy(XD + 6 * t + 2, &a1, sizeof a1);
       memcpy(XD + 6 * t + 4, &a2, sizeof a2);
     } else {
-      double x = k == top;
+      double x = t == 0;
       for (int i = 0; i < t; i++) x -= w->L[w->anc_adr[path[i]] + t - i] * X[i];
       X[t] = x;
       XD[t] = x / d;
@@ -1282,7 +1284,7 @@ static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, doubl
       memcpy(W + 6 * r + 16, &x2, sizeof x2);
     }
   } else {
-    memcpy(W, w->MiKT + (size_t)top * nr, (size_t)nr * sizeof(double));
+    memcpy(W, w->MiKT + (size_t)path[0] * nr, (size_t)nr * sizeof(double));
   }
   closure_forward(w, W, ncol);
 }
@@ -1292,13 +1294,13 @@ static void reduce(ssArtWork *w, int top, int ncol, int *path, int *npath, doubl
  * probe ready, and the check costs less than a call returning the Probe
  * through memory (reduce, the rare case, stays a call). */
 static inline __attribute__((always_inline)) Probe
-link_probe(const ssModel *m, ssArtWork *w, int b)
+link_probe(ssArtWork *w, int b)
 {
   size_t lb = (size_t)(b - w->b0), n = (size_t)w->nv, nr = (size_t)w->nrow;
-  int *path = w->path + lb * n;
+  const int *path = w->anc + w->padr[lb];
   double *X = w->Xp + lb * n * 6, *XD = w->XD + lb * n * 6, *W = w->Wp + lb * nr * 6;
   if (!w->Xok[lb]) {
-    reduce(w, last_dof(m, w, b), 6, path, w->npath + lb, X, XD, W);
+    reduce(w, path, w->npath[lb], 6, X, XD, W);
     w->Xok[lb] = 1;
   }
   return (Probe){path, w->npath[lb], X, XD, W};
@@ -1308,13 +1310,14 @@ static inline __attribute__((always_inline)) Probe
 dof_probe(ssArtWork *w, int k)
 {
   size_t n = (size_t)w->nv, nr = (size_t)w->nrow;
-  int *path = w->dpath + (size_t)k * n;
+  const int *path = w->anc + w->anc_adr[k];
+  int np = w->anc_adr[k + 1] - w->anc_adr[k];
   double *X = w->Xd + (size_t)k * n, *XD = w->XDd + (size_t)k * n, *W = w->Wd + (size_t)k * nr;
   if (!w->dok[k]) {
-    reduce(w, k, 1, path, w->dnp + k, X, XD, W);
+    reduce(w, path, np, 1, X, XD, W);
     w->dok[k] = 1;
   }
-  return (Probe){path, w->dnp[k], X, XD, W};
+  return (Probe){path, np, X, XD, W};
 }
 
 /* Y_b = P M'^-1 J_b^T (nv x 6) and Lam_b = J_b Y_b, once per step.  The
@@ -1339,7 +1342,7 @@ static void body_response(const ssModel *m, ssArtWork *w, int lb)
     /* Z = A^-1 (J_b MiKT)^T, row i = closure row i, from the link's
      * W = L_A^-1 (J_b MiKT)^T (link_probe); then Y -= MiKT Z */
     double *Z = w->Z;
-    memcpy(Z, link_probe(m, w, b).W, 6 * (size_t)nr * sizeof(double));
+    memcpy(Z, link_probe(w, b).W, 6 * (size_t)nr * sizeof(double));
     closure_backward(w, Z, 6);
     /* each row's sum t = (MiKT Z)_k in registers, three pairs (the same
      * products and sums, in order, as six-wide row updates of t) */
@@ -1451,13 +1454,13 @@ probe_pair(const ssArtWork *w, Probe a, Probe b, int ca, int cb, double *out, in
 void ss_art_link_pair(const ssModel *m, ssData *d, int a, int b, double *out, int ldo)
 {
   ssArtWork *w = d->art[m->body_sys[a]];
-  probe_pair(w, link_probe(m, w, a), link_probe(m, w, b), 6, 6, out, ldo);
+  probe_pair(w, link_probe(w, a), link_probe(w, b), 6, 6, out, ldo);
 }
 
 void ss_art_link_dof_pair(const ssModel *m, ssData *d, int b, int dof, double out[6])
 {
   ssArtWork *w = d->art[m->body_sys[b]];
-  probe_pair(w, link_probe(m, w, b), dof_probe(w, dof - w->v0), 6, 1, out, 1);
+  probe_pair(w, link_probe(w, b), dof_probe(w, dof - w->v0), 6, 1, out, 1);
 }
 
 double ss_art_dof_pair(ssData *d, int sys, int dof1, int dof2)
