@@ -1397,12 +1397,14 @@ void ss_art_link_block(const ssModel *m, ssData *d, int b, const double **Y,
 static inline __attribute__((always_inline)) void
 probe_pair(const ssArtWork *w, Probe a, Probe b, int ca, int cb, double *out, int ldo)
 {
-  int i = 0, j = 0, nr = w->nrow;
   /* the shared part of two paths to the root is the tail of both (from i
-   * on in a's, from j on in b's) */
-  while (i < a.np && j < b.np && a.path[i] != b.path[j]) {
-    if (a.path[i] > b.path[j]) i++;
-    else j++;
+   * on in a's, from j on in b's), a common dof's chain, so as long in each:
+   * the paths compared aligned at their ends, its first dof is the first
+   * match (any dof of both stands as far from either end) */
+  int nr = w->nrow, i = a.np > b.np ? a.np - b.np : 0, j = i + b.np - a.np;
+  while (i < a.np && a.path[i] != b.path[j]) {
+    i++;
+    j++;
   }
   if (ca == 6 && cb == 6) {
     /* two links: three rows of the block at a time, their 18 sums in
