@@ -150,6 +150,20 @@ static inline void add6(double r[6], const double a[6])
   }
 }
 
+/* p += S_k u_k (u_k at u[ldu k]) for the dofs k0 to k0 + nd - 1 in turn,
+ * the six sums in three pairs */
+static inline void add_motion(ssV2 p[3], const double *S, int k0, int nd, const double *u,
+                              size_t ldu)
+{
+  for (int k = k0; k < k0 + nd; k++) {
+    ssV2 uk = {u[ldu * k], u[ldu * k]}, sk;
+    for (int i = 0; i < 3; i++) {
+      memcpy(&sk, S + 6 * k + 2 * i, sizeof sk);
+      p[i] += sk * uk;
+    }
+  }
+}
+
 static double dot6(const double a[6], const double b[6])
 {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5];
@@ -1000,14 +1014,8 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
     if (nd) {
       int k0 = m->body_dofadr[b] - w->v0;
       /* su = S qdot over the joint's dofs, three pairs of sums from +0 */
-      ssV2 p[3] = {{0, 0}, {0, 0}, {0, 0}}, sk;
-      for (int k = k0; k < k0 + nd; k++) {
-        ssV2 uk = {u[k], u[k]};
-        for (int i = 0; i < 3; i++) {
-          memcpy(&sk, w->S + 6 * k + 2 * i, sizeof sk);
-          p[i] += sk * uk;
-        }
-      }
+      ssV2 p[3] = {{0, 0}, {0, 0}, {0, 0}};
+      add_motion(p, w->S, k0, nd, u, 1);
       double su[6], c[6];
       memcpy(su, p, sizeof su);
       if (m->body_jnttype[b] == SS_JOINT_FLOATING) {
@@ -1561,14 +1569,14 @@ void ss_art_link_motion_cols(const ssModel *m, const ssData *d, int b, const dou
 {
   const ssArtWork *w = d->art[m->body_sys[b]];
   for (int c = 0; c < ncol; c++) {
-    double V[6] = {0, 0, 0, 0, 0, 0};
+    /* each body's dofs in turn from b's, the sums from +0 */
+    ssV2 p[3] = {{0, 0}, {0, 0}, {0, 0}};
     for (int a = b; a >= 0; a = m->body_parent[a]) {
       int nd = m->body_ndof[a];
-      if (!nd) continue;
-      int k0 = m->body_dofadr[a] - w->v0;
-      for (int k = k0; k < k0 + nd; k++)
-        for (int i = 0; i < 6; i++) V[i] += w->S[6 * k + i] * U[(size_t)ldu * k + c];
+      if (nd) add_motion(p, w->S, m->body_dofadr[a] - w->v0, nd, U + c, (size_t)ldu);
     }
+    double V[6];
+    memcpy(V, p, sizeof V);
     for (int i = 0; i < 6; i++) out[(size_t)ldo * i + c] = V[i];
   }
 }
