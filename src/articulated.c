@@ -1263,8 +1263,8 @@ static void reduce(ssArtWork *w, const int *path, int np, int ncol, double *X, d
       ssV2 w0 = {0, 0}, w1 = {0, 0}, w2 = {0, 0}, v0 = {0, 0}, v1 = {0, 0}, v2 = {0, 0};
       ssV2 x0 = {0, 0}, x1 = {0, 0}, x2 = {0, 0};
       for (int i = 0; i < np; i++) {
-        int k = path[i];
-        const double *Sk = w->S + 6 * k, *mk = w->MiKT + (size_t)k * nr + r;
+        size_t k = (size_t)path[i]; /* (its offsets without a sign extension each) */
+        const double *Sk = w->S + 6 * k, *mk = w->MiKT + k * nr + r;
         ssV2 m0 = {mk[0], mk[0]}, m1 = {mk[r1], mk[r1]}, m2 = {mk[r2], mk[r2]}, s0, s1, s2;
         memcpy(&s0, Sk, sizeof s0);
         memcpy(&s1, Sk + 2, sizeof s1);
