@@ -774,9 +774,10 @@ static void factor_closures(ssArtWork *w)
   for (int i = 0; i < n; i++)
     for (int r = 0; r < nr; r++) w->MiKT[(size_t)i * nr + r] = w->K[(size_t)r * n + i];
   ltdl_solve(w, w->MiKT, nr);
-  /* A = K MiKT (lower triangle, row by row over K's nonzeros; each entry
-   * summed over k in order): the lower triangle is all that the Cholesky
-   * factor and the closure solves read */
+  /* A = K MiKT (lower triangle, row by row over K's nonzeros, in pairs
+   * (ss_row_add_scaled, whose loop the compiler need not guard against
+   * overlap); each entry summed over k in order): the lower triangle is all
+   * that the Cholesky factor and the closure solves read */
   double *A = w->A, amax = 0;
   for (int i = 0; i < nr; i++) {
     double *Ai = A + (size_t)i * nr;
@@ -787,8 +788,7 @@ static void factor_closures(ssArtWork *w)
       int k = col[c];
       double kik = Ki[k];
       if (kik == 0) continue;
-      const double *Mk = w->MiKT + (size_t)k * nr;
-      for (int j = 0; j <= i; j++) Ai[j] += kik * Mk[j];
+      ss_row_add_scaled(Ai, kik, w->MiKT + (size_t)k * nr, i + 1);
     }
     amax = Ai[i] > amax ? Ai[i] : amax; /* fmax's (a sum from +0 is no -0) */
   }
