@@ -1451,6 +1451,27 @@ probe_pair(const ssArtWork *w, Probe a, Probe b, int ca, int cb, double *out, in
     }
     return;
   }
+  if (ca == 6 && cb == 1) {
+    /* a link and a dof: the six sums in three pairs (from +0), each the
+     * same products and sums in the same order as the row updates below */
+    ssV2 s[3] = {{0, 0}, {0, 0}, {0, 0}}, xv;
+    for (; i < a.np; i++, j++) {
+      ssV2 yv = {b.XD[j], b.XD[j]};
+      for (int r = 0; r < 3; r++) {
+        memcpy(&xv, a.X + 6 * i + 2 * r, sizeof xv);
+        s[r] += xv * yv;
+      }
+    }
+    for (int k = 0; k < nr; k++) {
+      ssV2 yv = {b.W[k], b.W[k]};
+      for (int r = 0; r < 3; r++) {
+        memcpy(&xv, a.W + 6 * k + 2 * r, sizeof xv);
+        s[r] -= xv * yv;
+      }
+    }
+    for (int r = 0; r < 6; r++) out[(size_t)ldo * r] = s[r / 2][r % 2];
+    return;
+  }
   double acc[36] = {0};
   for (; i < a.np; i++, j++) {
     const double *x = a.X + ca * i, *y = b.XD + cb * j;
