@@ -1472,7 +1472,8 @@ probe_pair(const ssArtWork *w, Probe a, Probe b, int ca, int cb, double *out, in
     for (int r = 0; r < 6; r++) out[(size_t)ldo * r] = s[r / 2][r % 2];
     return;
   }
-  double acc[36] = {0};
+  double acc[36];
+  memset(acc, 0, (size_t)ca * cb * sizeof(double)); /* (the block's entries only) */
   for (; i < a.np; i++, j++) {
     const double *x = a.X + ca * i, *y = b.XD + cb * j;
     for (int r = 0; r < ca; r++) ss_row_add_scaled(acc + cb * r, x[r], y, cb);
