@@ -525,7 +525,8 @@ static int ltdl_factor(ssArtWork *w)
     /* i runs up k's chain; its own chain is the rest of k's, so row i's
      * entries are row k's from t on, both contiguous: the updates two at a
      * time */
-    const int *ak = w->anc + w->anc_adr[k], nk = w->anc_adr[k + 1] - w->anc_adr[k];
+    const int *ak = w->anc + w->anc_adr[k];
+    const int nk = w->anc_adr[k + 1] - w->anc_adr[k];
     for (int t = 1; t < nk; t++) {
       double a = Lk[t] / Lk[0], *Li = L + w->anc_adr[ak[t]];
       const double *lk = Lk + t;
