@@ -1401,6 +1401,29 @@ void ss_art_link_block(const ssModel *m, ssData *d, int b, const double **Y,
   *Lam = w->Lam + 36 * lb;
 }
 
+/* probe_pair's three rows of a 6 x 6 block, s (nine pairs, row r in
+ * s[3 r, 3 r + 3)): s_r += x_r y, or -= with sub, y six wide */
+static inline __attribute__((always_inline)) void rows3_sum(ssV2 s[9], const double *x,
+                                                           const double *y, const int sub)
+{
+  ssV2 y0, y1, y2;
+  memcpy(&y0, y, sizeof y0);
+  memcpy(&y1, y + 2, sizeof y1);
+  memcpy(&y2, y + 4, sizeof y2);
+  for (int r = 0; r < 3; r++) {
+    ssV2 xv = {x[r], x[r]};
+    if (sub) {
+      s[3 * r] -= xv * y0;
+      s[3 * r + 1] -= xv * y1;
+      s[3 * r + 2] -= xv * y2;
+    } else {
+      s[3 * r] += xv * y0;
+      s[3 * r + 1] += xv * y1;
+      s[3 * r + 2] += xv * y2;
+    }
+  }
+}
+
 /* J_a P M'^-1 J_b^T (ca x cb, row i at out + ldo i; ca, cb: a's and b's
  * column counts, constants at each call so that the row updates unroll) */
 static inline __attribute__((always_inline)) void
@@ -1422,33 +1445,11 @@ probe_pair(const ssArtWork *w, Probe a, Probe b, int ca, int cb, double *out, in
      * s + (-x) y: ss_math.h) */
     for (int r0 = 0; r0 < 6; r0 += 3) {
       ssV2 s[9] = {{0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}};
-      for (int k = i, l = j; k < a.np; k++, l++) {
-        const double *x = a.X + 6 * k + r0, *y = b.XD + 6 * l;
-        ssV2 y0, y1, y2;
-        memcpy(&y0, y, sizeof y0);
-        memcpy(&y1, y + 2, sizeof y1);
-        memcpy(&y2, y + 4, sizeof y2);
-        for (int r = 0; r < 3; r++) {
-          ssV2 xv = {x[r], x[r]};
-          s[3 * r] += xv * y0;
-          s[3 * r + 1] += xv * y1;
-          s[3 * r + 2] += xv * y2;
-        }
-      }
-      for (int k = 0; k < nr; k++) {
-        const double *x = a.W + 6 * k + r0, *y = b.W + 6 * k;
-        ssV2 y0, y1, y2;
-        memcpy(&y0, y, sizeof y0);
-        memcpy(&y1, y + 2, sizeof y1);
-        memcpy(&y2, y + 4, sizeof y2);
-        for (int r = 0; r < 3; r++) {
-          ssV2 xv = {x[r], x[r]};
-          s[3 * r] -= xv * y0;
-          s[3 * r + 1] -= xv * y1;
-          s[3 * r + 2] -= xv * y2;
-        }
-      }
-      for (int r = 0; r < 3; r++) memcpy(out + (size_t)ldo * (r0 + r), s + 3 * r, 6 * sizeof(double));
+      for (int k = i, l = j; k < a.np; k++, l++)
+        rows3_sum(s, a.X + 6 * k + r0, b.XD + 6 * l, 0);
+      for (int k = 0; k < nr; k++) rows3_sum(s, a.W + 6 * k + r0, b.W + 6 * k, 1);
+      for (int r = 0; r < 3; r++)
+        memcpy(out + (size_t)ldo * (r0 + r), s + 3 * r, 6 * sizeof(double));
     }
     return;
   }
