@@ -408,6 +408,17 @@ body_run_add(const ssContact *c, const double com[3], const double lam[3], doubl
   }
 }
 
+/* a rigid body b's run opens where the last contacts' group or another
+ * body's run was open (closed first), or goes on */
+static inline void body_run_open(const ssModel *m, ssData *d, WarmApply *a, int b)
+{
+  group_close(d, &a->g);
+  if (a->br.body != b) {
+    body_run_close(m, d, &a->br);
+    a->br.body = b;
+  }
+}
+
 /* contact c's warm impulse, and its velocity change into a */
 static inline __attribute__((always_inline)) void
 warm_one(const ssModel *m, ssData *d, ssContact *c, const ssWarmEntry *e, int creep_rates,
@@ -419,12 +430,8 @@ warm_one(const ssModel *m, ssData *d, ssContact *c, const ssWarmEntry *e, int cr
   BodyRun *br = &a->br;
   if (c->link < 0 && c->type == SS_CONTACT_SOIL) {
     /* a rigid body's run likewise, as J^T lambda */
-    group_close(d, g);
     int b = m->geom_body[c->geom];
-    if (br->body != b) {
-      body_run_close(m, d, br);
-      br->body = b;
-    }
+    body_run_open(m, d, a, b);
     body_run_add(c, d->body_xipos + 3 * b, c->lambda, br->F);
   } else if (c->link >= 0 && !d->solver_full) {
     body_run_close(m, d, br);
@@ -507,11 +514,7 @@ static int warm_body_run(const ssModel *m, ssData *d, int i, int nwarm, int conv
     memcpy(c->lambda, lam, sizeof lam);
     if (!open) {
       /* the run's first impulse: the body's run opens (or goes on) */
-      group_close(d, &a->g);
-      if (a->br.body != b) {
-        body_run_close(m, d, &a->br);
-        a->br.body = b;
-      }
+      body_run_open(m, d, a, b);
       memcpy(F, a->br.F, sizeof F);
       open = 1;
     }
