@@ -753,7 +753,10 @@ typedef struct BandChain {
  * y^2; their factors 1/2, 1/6 and 1/3 are left to the caller, which needs
  * one division a cell instead of six (they sat on the edge cells' chain
  * of dependent operations).  c->k, the first edge that may reach past a,
- * moves on as the cells do. */
+ * moves on as the cells do.  An edge piece is the edge from s = max(xa, a)
+ * to t = min(xb, b): its ends' y are the vertices' own where the edge is
+ * not cut (xa >= a, xb <= b: the piece is the whole edge, of positive
+ * width), and only a cut edge needs its slope and a test of its width. */
 static inline void chain_integrals(BandChain *c, double a, double b, double sh, double I[3])
 {
   const double *x = c->x, *y = c->y;
@@ -768,12 +771,21 @@ static inline void chain_integrals(BandChain *c, double a, double b, double sh, 
   for (; k < m - 1 && x[k] < b; k++) {
     double xa = x[k], xb = x[k + 1];
     if (!(xb > xa)) continue; /* an edge along y adds nothing */
-    double s = xa > a ? xa : a, t = xb < b ? xb : b, w = t - s;
-    if (!(w > 0)) continue;
-    double slope = (y[k + 1] - y[k]) / (xb - xa);
-    double ys = s == xa ? y[k] : y[k] + (s - xa) * slope;
-    double yt = t == xb ? y[k + 1] : y[k] + (t - xa) * slope;
-    double su = s - sh, tu = t - sh;
+    double ya = y[k], yb = y[k + 1];
+    double s = xa, t = xb, ys = ya, yt = yb;
+    if (xa < a || xb > b) {
+      double slope = (yb - ya) / (xb - xa);
+      if (xa < a) {
+        s = a;
+        ys = ya + (a - xa) * slope;
+      }
+      if (xb > b) {
+        t = b;
+        yt = ya + (b - xa) * slope;
+      }
+      if (!(t > s)) continue;
+    }
+    double w = t - s, su = s - sh, tu = t - sh;
     i0 += w * (ys + yt);
     i1 += w * (su * (2 * ys + yt) + tu * (ys + 2 * yt));
     i2 += w * (ys * ys + ys * yt + yt * yt);
