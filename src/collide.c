@@ -598,32 +598,30 @@ int ss_poly_ychains(const ssPoly2 *p, ssPolyChains *c)
   return mono_chains(p->y, p->n, c);
 }
 
-/* whether sgn (x[start + k] - v) >= 0 (> 0 when strict), indices modulo
- * n */
-static inline int chain_pred(const double *x, int n, int start, int k, double v,
-                             double sgn, int strict)
+/* whether sgn (v[k] - val) >= 0 (> 0 when strict), as a comparison of
+ * v[k] with val (the same outcome: a difference of doubles is 0 only for
+ * equal ones, and a NaN fails both) */
+static inline int run_pred(const double *v, int k, double val, double sgn, int strict)
 {
-  int i = start + k;
-  if (i >= n) i -= n;
-  double dv = sgn * (x[i] - v);
-  return strict ? dv > 0 : dv >= 0;
+  if (sgn > 0) return strict ? v[k] > val : v[k] >= val;
+  return strict ? v[k] < val : v[k] <= val;
 }
 
-/* first k in [0, cnt) where chain_pred holds; cnt when none.  sgn x is
- * non-decreasing along the chain, so the predicate is monotone and the
- * answer unique: galloping from *hint to bracket it, then bisecting, finds
- * the one bisection alone finds; *hint receives it. */
-static int chain_search(const double *x, int n, int start, int cnt, double v,
-                        double sgn, int strict, int *hint)
+/* first k in [0, cnt) where run_pred holds on the plain array v; cnt when
+ * none.  sgn v is non-decreasing along it, so the predicate is monotone and
+ * the answer unique: galloping from h to bracket it, then bisecting, finds
+ * the one bisection alone finds. */
+static inline int run_search(const double *v, int cnt, double val, double sgn, int strict,
+                             int h)
 {
-  int a = 0, b = cnt, h = *hint;
+  int a = 0, b = cnt;
   if (h >= 0 && h < cnt) {
-    if (chain_pred(x, n, start, h, v, sgn, strict)) {
+    if (run_pred(v, h, val, sgn, strict)) {
       b = h;
       for (int step = 1;; step *= 2) {
         int k = b - step;
         if (k < 0) break;
-        if (!chain_pred(x, n, start, k, v, sgn, strict)) {
+        if (!run_pred(v, k, val, sgn, strict)) {
           a = k + 1;
           break;
         }
@@ -634,7 +632,7 @@ static int chain_search(const double *x, int n, int start, int cnt, double v,
       for (int step = 1;; step *= 2) {
         int k = a - 1 + step;
         if (k >= cnt) break;
-        if (chain_pred(x, n, start, k, v, sgn, strict)) {
+        if (run_pred(v, k, val, sgn, strict)) {
           b = k;
           break;
         }
@@ -643,12 +641,29 @@ static int chain_search(const double *x, int n, int start, int cnt, double v,
     }
   }
   while (a < b) {
-    int mid = (a + b) / 2;
-    if (chain_pred(x, n, start, mid, v, sgn, strict)) b = mid;
+    int mid = (int)((unsigned)(a + b) / 2);
+    if (run_pred(v, mid, val, sgn, strict)) b = mid;
     else a = mid + 1;
   }
-  *hint = a;
   return a;
+}
+
+/* first k in [0, cnt) where sgn (x[start + k] - v) >= 0 (> 0 when strict),
+ * indices modulo n; cnt when none; *hint (where to start) receives it.  A
+ * chain that wraps past n - 1 is searched in the one of its two plain runs
+ * that holds the answer (its first run's last entry tells which), so that
+ * no step forms an index modulo n. */
+static inline int chain_search(const double *x, int n, int start, int cnt, double v,
+                               double sgn, int strict, int *hint)
+{
+  int len1 = n - start, h = *hint, k;
+  if (cnt <= len1) k = run_search(x + start, cnt, v, sgn, strict, h);
+  else if (run_pred(x + start, len1 - 1, v, sgn, strict))
+    k = run_search(x + start, len1, v, sgn, strict, h);
+  else
+    k = len1 + run_search(x, cnt - len1, v, sgn, strict, h - len1);
+  *hint = k;
+  return k;
 }
 
 /* the edges (index of their end vertex) of chain start -> start + cnt of
@@ -710,8 +725,13 @@ static int slab_edges(const double *co, int n, ssPolyChains *c, double c0, doubl
   int l = c->l, r = c->r, nr = 0;
   double tol = 1e-9 * (fabs(c0) + fabs(c1));
   double lo = c0 - tol, hi = c1 + tol;
-  nr += chain_edges(co, n, l, (r - l + n) % n, 1, lo, hi, c->hint, rg);
-  nr += chain_edges(co, n, r, (l - r + n) % n, -1, lo, hi, c->hint + 2, rg + 2 * nr);
+  /* the chains' edge counts, (r - l) and (l - r) modulo n (0 <= l, r < n:
+   * one of them takes n, without a division) */
+  int up = r - l, down = l - r;
+  if (up < 0) up += n;
+  else down += n;
+  nr += chain_edges(co, n, l, up, 1, lo, hi, c->hint, rg);
+  nr += chain_edges(co, n, r, down, -1, lo, hi, c->hint + 2, rg + 2 * nr);
   /* ascending, as the clip visits them */
   for (int i = 1; i < nr; i++)
     for (int k = i; k > 0 && rg[2 * k - 2] > rg[2 * k]; k--) {
