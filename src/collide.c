@@ -163,22 +163,68 @@ static void axis_side(const double a[3], double w[3])
   }
 }
 
-/* swept_hull's chain of one copy p: its points from index a to b (each
- * step d, modulo n) onto h from m on, the box (x least, greatest, y least,
- * greatest) grown over them; returns h's new count */
-static inline int hull_gather(pt2 *h, int m, const pt2 *p, int n, int d, int a, int b,
-                              double box[4])
+/* points i = i0, i0 + step, ..., i1 of p onto h from m on, in a run that
+ * does not wrap, the box (x least, greatest, y least, greatest) grown over
+ * them; returns h's new count */
+static inline int gather_run(pt2 *h, int m, const pt2 *p, int i0, int i1, int step,
+                             double box[4])
 {
-  for (int i = a, stop = 0; !stop; i = i + d < n ? i + d : i + d - n) {
+  for (int i = i0;; i += step) {
     pt2 v = p[i];
-    stop = i == b;
     h[m++] = v;
     if (v.x < box[0]) box[0] = v.x;
     if (v.x > box[1]) box[1] = v.x;
     if (v.y < box[2]) box[2] = v.y;
     if (v.y > box[3]) box[3] = v.y;
+    if (i == i1) return m;
   }
-  return m;
+}
+
+/* swept_hull's chain of one copy p: its points from index a to b, forwards
+ * (fwd) or backwards, modulo n, onto h from m on (gather_run; a chain that
+ * wraps takes two runs, so that no point tests for the wrap); returns h's
+ * new count */
+static inline int hull_gather(pt2 *h, int m, const pt2 *p, int n, int fwd, int a, int b,
+                              double box[4])
+{
+  if (fwd) {
+    if (a > b) {
+      m = gather_run(h, m, p, a, n - 1, 1, box);
+      a = 0;
+    }
+    return gather_run(h, m, p, a, b, 1, box);
+  }
+  if (a < b) {
+    m = gather_run(h, m, p, a, 0, -1, box);
+    a = n - 1;
+  }
+  return gather_run(h, m, p, a, b, -1, box);
+}
+
+/* swept_hull's extents e = tx y - ty x of the points i = i0, i0 + step,
+ * ..., i1 of p (a run that does not wrap): the least and greatest so far,
+ * *lo and *hi, and the first points that reach them, *kb and *ka */
+static inline void extent_run(const pt2 *p, int i0, int i1, int step, double tx, double ty,
+                              double *lo, double *hi, int *kb, int *ka)
+{
+  double l = *lo, h = *hi;
+  int b = *kb, a = *ka;
+  for (int i = i0;; i += step) {
+    double e = tx * p[i].y - ty * p[i].x;
+    if (e < l) {
+      l = e;
+      b = i;
+    }
+    if (e > h) {
+      h = e;
+      a = i;
+    }
+    if (i == i1) break;
+  }
+  *lo = l;
+  *hi = h;
+  *kb = b;
+  *ka = a;
 }
 
 /* The hull of two copies of one convex polygon, p[0, n) and p[n, 2n) (the
@@ -196,27 +242,22 @@ static int swept_hull(const pt2 *p, int n, int ccw, double tx, double ty, ssPoly
   /* the points counter-clockwise, read in place: the first copy's k-th is
    * p[i] with i = k d (mod n), d = 1 when ccw, else n - 1 (p[0], then
    * backwards), the second copy's p[n + i]; B, A: least and greatest
-   * extent along the normal (-ty, tx) */
-  const int d = ccw ? 1 : n - 1;
+   * extent along the normal (-ty, tx), the first of them in that order
+   * (its runs: p[0, n) when ccw, else p[0], then p[n - 1] down to p[1]) */
   int kb = 0, ka = 0;
   double lo = INFINITY, hi = -INFINITY;
-  for (int k = 0, i = 0; k < n; k++, i = i + d < n ? i + d : i + d - n) {
-    double e = tx * p[i].y - ty * p[i].x;
-    if (e < lo) {
-      lo = e;
-      kb = i;
-    }
-    if (e > hi) {
-      hi = e;
-      ka = i;
-    }
+  if (ccw) {
+    extent_run(p, 0, n - 1, 1, tx, ty, &lo, &hi, &kb, &ka);
+  } else {
+    extent_run(p, 0, 0, 1, tx, ty, &lo, &hi, &kb, &ka);
+    extent_run(p, n - 1, 1, -1, tx, ty, &lo, &hi, &kb, &ka);
   }
   /* B to A on the first copy (its edges face +t), A to B on the second,
    * and their bounding box (begun at the first point, as they come) */
   pt2 h[HULL_IN_MAX + 2];
   double box[4] = {p[kb].x, p[kb].x, p[kb].y, p[kb].y};
-  int m = hull_gather(h, 0, p, n, d, kb, ka, box);
-  m = hull_gather(h, m, p + n, n, d, ka, kb, box);
+  int m = hull_gather(h, 0, p, n, ccw, kb, ka, box);
+  m = hull_gather(h, m, p + n, n, ccw, ka, kb, box);
   double xlo = box[0], xhi = box[1], ylo = box[2], yhi = box[3];
   double ext = xhi - xlo > yhi - ylo ? xhi - xlo : yhi - ylo;
   if (!(ext > 0)) return 0;
