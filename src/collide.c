@@ -270,8 +270,9 @@ static int swept_hull(const pt2 *p, int n, int ccw, double tx, double ty, ssPoly
   for (int i = 0; i < m; i++) {
     while (k >= 2) {
       double t = cross3(&h[k - 2], &h[k - 1], &h[i]);
+      if (t > tol) break;
       if (!(t <= tol)) {
-        odd |= !(t > tol);
+        odd = 1; /* neither: a NaN */
         break;
       }
       k--;
@@ -304,9 +305,12 @@ static int swept_hull(const pt2 *p, int n, int ccw, double tx, double ty, ssPoly
       if (!(cross3(c + i, c + i1, c + i2) > tol)) return 0;
     }
   }
+  /* the least point (pt_less), most points failing at their x alone */
   int start = 0;
-  for (int i = 1; i < cnt; i++)
-    if (pt_less(c + i, c + start)) start = i;
+  for (int i = 1; i < cnt; i++) {
+    if (!(c[i].x <= c[start].x)) continue;
+    if (c[i].x < c[start].x || c[i].y < c[start].y) start = i;
+  }
   /* from the least point to the end, then the rest */
   out->n = cnt;
   for (int i = start; i < cnt; i++) {
