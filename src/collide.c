@@ -652,20 +652,21 @@ static inline int run_pred(const double *v, int k, double val, double sgn, int s
   return strict ? v[k] < val : v[k] <= val;
 }
 
-/* first k in [0, cnt) where run_pred holds on the plain array v; cnt when
- * none.  sgn v is non-decreasing along it, so the predicate is monotone and
- * the answer unique: galloping from h to bracket it, then bisecting, finds
- * the one bisection alone finds. */
-static inline int run_search(const double *v, int cnt, double val, double sgn, int strict,
-                             int h)
+/* first k in [from, cnt) where run_pred holds on the plain array v (it
+ * holds at none before from); cnt when none.  sgn v is non-decreasing
+ * along it, so the predicate is monotone and the answer unique: galloping
+ * from h to bracket it, then bisecting, finds the one bisection alone
+ * finds. */
+static inline int run_search(const double *v, int from, int cnt, double val, double sgn,
+                             int strict, int h)
 {
-  int a = 0, b = cnt;
-  if (h >= 0 && h < cnt) {
+  int a = from, b = cnt;
+  if (h >= from && h < cnt) {
     if (run_pred(v, h, val, sgn, strict)) {
       b = h;
       for (int step = 1;; step *= 2) {
         int k = b - step;
-        if (k < 0) break;
+        if (k < from) break;
         if (!run_pred(v, k, val, sgn, strict)) {
           a = k + 1;
           break;
@@ -693,20 +694,22 @@ static inline int run_search(const double *v, int cnt, double val, double sgn, i
   return a;
 }
 
-/* first k in [0, cnt) where sgn (x[start + k] - v) >= 0 (> 0 when strict),
- * indices modulo n; cnt when none; *hint (where to start) receives it.  A
- * chain that wraps past n - 1 is searched in the one of its two plain runs
- * that holds the answer (its first run's last entry tells which), so that
- * no step forms an index modulo n. */
-static inline int chain_search(const double *x, int n, int start, int cnt, double v,
-                               double sgn, int strict, int *hint)
+/* first k in [from, cnt) where sgn (x[start + k] - v) >= 0 (> 0 when
+ * strict; it holds at none before from), indices modulo n; cnt when none;
+ * *hint (where to start) receives it.  A chain that wraps past n - 1 is
+ * searched in the one of its two plain runs that holds the answer (its
+ * first run's last entry tells which), so that no step forms an index
+ * modulo n. */
+static inline int chain_search(const double *x, int n, int start, int from, int cnt,
+                               double v, double sgn, int strict, int *hint)
 {
   int len1 = n - start, h = *hint, k;
-  if (cnt <= len1) k = run_search(x + start, cnt, v, sgn, strict, h);
-  else if (run_pred(x + start, len1 - 1, v, sgn, strict))
-    k = run_search(x + start, len1, v, sgn, strict, h);
+  if (cnt <= len1) k = run_search(x + start, from, cnt, v, sgn, strict, h);
+  else if (from < len1 && run_pred(x + start, len1 - 1, v, sgn, strict))
+    k = run_search(x + start, from, len1, v, sgn, strict, h);
   else
-    k = len1 + run_search(x, cnt - len1, v, sgn, strict, h - len1);
+    k = len1 + run_search(x, from > len1 ? from - len1 : 0, cnt - len1, v, sgn, strict,
+                          h - len1);
   *hint = k;
   return k;
 }
@@ -720,9 +723,13 @@ static inline int chain_edges(const double *co, int n, int start, int cnt, doubl
   int s1 = start + 1 < n ? start + 1 : 0;
   /* sgn = 1: co rises along the chain; edge k runs from vertex k to k + 1 */
   double enter = sgn > 0 ? x0 : x1, leave = sgn > 0 ? x1 : x0;
-  int k0 = chain_search(co, n, s1, cnt, enter, sgn, 0, hint);
-  int k1 = chain_search(co, n, start, cnt, leave, sgn, 1, hint + 1);
-  if (k1 <= k0) return 0;
+  int k0 = chain_search(co, n, s1, 0, cnt, enter, sgn, 0, hint);
+  if (k0 >= cnt) return 0;
+  /* vertices start .. start + k0 come before the enter bound, so before
+   * the leave bound: k1 > k0, searched from k0 + 1 on (one test, where
+   * the edge k0 leaves the slab) */
+  hint[1] = k0 + 1;
+  int k1 = chain_search(co, n, start, k0 + 1, cnt, leave, sgn, 1, hint + 1);
   int a = s1 + k0;
   if (a >= n) a -= n;
   int b = a + (k1 - k0);
