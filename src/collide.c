@@ -955,16 +955,21 @@ static int chord_of(const ssPoly2 *p, const int *rg, int nr, double y, double *x
       int j = i > 0 ? i - 1 : p->n - 1;
       double ya = p->y[j], yb = p->y[i];
       if ((ya > y && yb > y) || (ya < y && yb < y)) continue;
+      /* fmin and fmax as comparisons, bit for bit theirs (glibc's: a
+       * NaN argument loses, and of equal ones the second wins; lo and hi
+       * are never NaN), without a call each */
       double x;
       if (ya == yb) {
         /* an edge along the line: both ends */
-        lo = fmin(lo, fmin(p->x[i], p->x[j]));
-        hi = fmax(hi, fmax(p->x[i], p->x[j]));
+        double xi = p->x[i], xj = p->x[j];
+        double e0 = xi < xj || xj != xj ? xi : xj, e1 = xi > xj || xj != xj ? xi : xj;
+        if (e0 <= lo) lo = e0;
+        if (e1 >= hi) hi = e1;
         continue;
       }
       x = p->x[j] + (y - ya) / (yb - ya) * (p->x[i] - p->x[j]);
-      lo = fmin(lo, x);
-      hi = fmax(hi, x);
+      if (x <= lo) lo = x;
+      if (x >= hi) hi = x;
     }
   if (!(hi >= lo)) return 0;
   *x0 = lo;
