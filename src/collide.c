@@ -163,14 +163,31 @@ static void axis_side(const double a[3], double w[3])
   }
 }
 
-/* points i = i0, i0 + step, ..., i1 of p onto h from m on, in a run that
+/* one copy's points for swept_hull: p[i], or where p is NULL the ellipse
+ * (ox, oy) + u c_i + v s_i of the circle table, formed as put_ellipse
+ * forms it (only the points the hull gathers) */
+typedef struct PtSrc {
+  const pt2 *p;
+  double ox, oy;
+  const double *u, *v;
+} PtSrc;
+
+static inline pt2 src_point(const PtSrc *src, int i)
+{
+  if (src->p) return src->p[i];
+  pt2 q = {src->ox + src->u[0] * circle_c[i] + src->v[0] * circle_s[i],
+           src->oy + src->u[1] * circle_c[i] + src->v[1] * circle_s[i]};
+  return q;
+}
+
+/* points i = i0, i0 + step, ..., i1 of src onto h from m on, in a run that
  * does not wrap, the box (x least, greatest, y least, greatest) grown over
  * them; returns h's new count */
-static inline int gather_run(pt2 *h, int m, const pt2 *p, int i0, int i1, int step,
+static inline int gather_run(pt2 *h, int m, const PtSrc *src, int i0, int i1, int step,
                              double box[4])
 {
   for (int i = i0;; i += step) {
-    pt2 v = p[i];
+    pt2 v = src_point(src, i);
     h[m++] = v;
     if (v.x < box[0]) box[0] = v.x;
     if (v.x > box[1]) box[1] = v.x;
@@ -180,25 +197,25 @@ static inline int gather_run(pt2 *h, int m, const pt2 *p, int i0, int i1, int st
   }
 }
 
-/* swept_hull's chain of one copy p: its points from index a to b, forwards
- * (fwd) or backwards, modulo n, onto h from m on (gather_run; a chain that
- * wraps takes two runs, so that no point tests for the wrap); returns h's
- * new count */
-static inline int hull_gather(pt2 *h, int m, const pt2 *p, int n, int fwd, int a, int b,
+/* swept_hull's chain of one copy src: its points from index a to b,
+ * forwards (fwd) or backwards, modulo n, onto h from m on (gather_run; a
+ * chain that wraps takes two runs, so that no point tests for the wrap);
+ * returns h's new count */
+static inline int hull_gather(pt2 *h, int m, const PtSrc *src, int n, int fwd, int a, int b,
                               double box[4])
 {
   if (fwd) {
     if (a > b) {
-      m = gather_run(h, m, p, a, n - 1, 1, box);
+      m = gather_run(h, m, src, a, n - 1, 1, box);
       a = 0;
     }
-    return gather_run(h, m, p, a, b, 1, box);
+    return gather_run(h, m, src, a, b, 1, box);
   }
   if (a < b) {
-    m = gather_run(h, m, p, a, 0, -1, box);
+    m = gather_run(h, m, src, a, 0, -1, box);
     a = n - 1;
   }
-  return gather_run(h, m, p, a, b, -1, box);
+  return gather_run(h, m, src, a, b, -1, box);
 }
 
 /* swept_hull's extents e = tx y - ty x of the points i = i0, i0 + step,
@@ -227,9 +244,11 @@ static inline void extent_run(const pt2 *p, int i0, int i1, int step, double tx,
   *ka = a;
 }
 
-/* The hull of two copies of one convex polygon, p[0, n) and p[n, 2n) (the
- * second the first moved by -2t, t = (tx, ty) != 0; points in the order of
- * the circle table, counter-clockwise when ccw, else clockwise), without a
+/* The hull of two copies of one convex polygon, p[0, n) and the ellipse
+ * (ox, oy) + u c_i + v s_i (put_ellipse's points, formed here only where
+ * the hull takes them: the second copy, the first moved by -2t, t = (tx,
+ * ty) != 0; points in the order of the circle table, counter-clockwise
+ * when ccw, else clockwise), without a
  * sort: it is the polygon swept along t, the first copy's chain between
  * its extreme points across t followed by the second copy's other chain.
  * Collinear and repeated points are dropped with convex_hull's tolerance,
@@ -237,13 +256,15 @@ static inline void extent_run(const pt2 *p, int i0, int i1, int step, double tx,
  * does, so that where convex_hull keeps the same points the polygon is the
  * same, bit for bit.  Returns 0 (out untouched) when the sweep is not
  * cleanly convex; convex_hull then decides. */
-static int swept_hull(const pt2 *p, int n, int ccw, double tx, double ty, ssPoly2 *out)
+static int swept_hull(const pt2 *p, int n, int ccw, double tx, double ty, double ox,
+                      double oy, const double u[2], const double v[2], ssPoly2 *out)
 {
   /* the points counter-clockwise, read in place: the first copy's k-th is
    * p[i] with i = k d (mod n), d = 1 when ccw, else n - 1 (p[0], then
-   * backwards), the second copy's p[n + i]; B, A: least and greatest
-   * extent along the normal (-ty, tx), the first of them in that order
-   * (its runs: p[0, n) when ccw, else p[0], then p[n - 1] down to p[1]) */
+   * backwards), the second copy's the ellipse's point i; B, A: least and
+   * greatest extent along the normal (-ty, tx), the first of them in that
+   * order (its runs: p[0, n) when ccw, else p[0], then p[n - 1] down to
+   * p[1]) */
   int kb = 0, ka = 0;
   double lo = INFINITY, hi = -INFINITY;
   if (ccw) {
@@ -256,8 +277,9 @@ static int swept_hull(const pt2 *p, int n, int ccw, double tx, double ty, ssPoly
    * and their bounding box (begun at the first point, as they come) */
   pt2 h[HULL_IN_MAX + 2];
   double box[4] = {p[kb].x, p[kb].x, p[kb].y, p[kb].y};
-  int m = hull_gather(h, 0, p, n, ccw, kb, ka, box);
-  m = hull_gather(h, m, p + n, n, ccw, ka, kb, box);
+  const PtSrc copy0 = {p, 0, 0, NULL, NULL}, copy1 = {NULL, ox, oy, u, v};
+  int m = hull_gather(h, 0, &copy0, n, ccw, kb, ka, box);
+  m = hull_gather(h, m, &copy1, n, ccw, ka, kb, box);
   double xlo = box[0], xhi = box[1], ylo = box[2], yhi = box[3];
   double ext = xhi - xlo > yhi - ylo ? xhi - xlo : yhi - ylo;
   if (!(ext > 0)) return 0;
@@ -368,16 +390,18 @@ void ss_shape_footprint(const ssShape *s, ssPoly2 *out)
       v[0] = -r * w[1]; v[1] = r * w[0];
     }
     np = put_ellipse(p, np, circle_c, circle_s, c[0] + hl * a[0], c[1] + hl * a[1], u, v);
-    np = put_ellipse(p, np, circle_c, circle_s, c[0] - hl * a[0], c[1] - hl * a[1], u, v);
     /* two copies of one convex polygon: swept, no sort (a wheel's
-     * footprint in half the instructions), unless the caps are (nearly)
-     * edge-on or the axis (nearly) vertical, where the copies' points
-     * nearly coincide and only the sort tells them apart */
+     * footprint in half the instructions; the second copy formed where
+     * the hull takes it), unless the caps are (nearly) edge-on or the axis
+     * (nearly) vertical, where the copies' points nearly coincide and only
+     * the sort tells them apart */
+    double ox = c[0] - hl * a[0], oy = c[1] - hl * a[1];
     double det = u[0] * v[1] - u[1] * v[0], tx = hl * a[0], ty = hl * a[1];
     double lu = hypot(u[0], u[1]), lv = hypot(v[0], v[1]);
     if (fabs(det) > 1e-9 * lu * lv && hypot(tx, ty) > 1e-6 * fmax(lu, lv) &&
-        swept_hull(p, SS_FOOTPRINT_SEGMENTS, det > 0, tx, ty, out))
+        swept_hull(p, SS_FOOTPRINT_SEGMENTS, det > 0, tx, ty, ox, oy, u, v, out))
       return;
+    np = put_ellipse(p, np, circle_c, circle_s, ox, oy, u, v);
     break;
   }
   default:
