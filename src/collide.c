@@ -584,17 +584,19 @@ static inline int put_cut(double *oc, double *oo, int m, double b, double pc,
  * the slab.  Input is shifted by (-offc, -offo) as it is read.  Only the
  * edges j (ending at vertex j) in the ascending ranges [rg[2r], rg[2r+1])
  * are visited: the others must contribute nothing, so that the output is
- * that of visiting all n. */
-static int clip_slab(const double *ic, const double *io, int n, const int *rg,
-                     int nr, double offc, double offo, double *oc, double *oo,
-                     double lo, double hi)
+ * that of visiting all n.  An edge begins only with room for its two
+ * points (m <= CLIP_MAX - 2), tested per edge where guard is set (clip_slab
+ * sets it only where the ranges hold enough edges to fill the room). */
+static inline int clip_ranges(const double *ic, const double *io, int n, const int *rg,
+                              int nr, double offc, double offo, double *oc, double *oo,
+                              double lo, double hi, int guard)
 {
   int m = 0;
-  if (n <= 0) return 0;
   for (int r = 0; r < nr; r++) {
     int j = rg[2 * r], pj = j > 0 ? j - 1 : n - 1;
     double pc = ic[pj] - offc, po = io[pj] - offo;
-    for (; j < rg[2 * r + 1] && m <= CLIP_MAX - 2; j++) {
+    for (; j < rg[2 * r + 1]; j++) {
+      if (guard && m > CLIP_MAX - 2) break;
       double qc = ic[j] - offc, qo = io[j] - offo;
       if (qc >= lo && qc <= hi) {
         /* entering (unless Q itself is the entry), then Q */
@@ -625,6 +627,21 @@ static int clip_slab(const double *ic, const double *io, int n, const int *rg,
     }
   }
   return m;
+}
+
+/* clip_ranges, its room test per edge only where it can fail: an edge adds
+ * at most two points, so that with e edges in all the last begins with at
+ * most 2 (e - 1) <= CLIP_MAX - 2 when e <= CLIP_MAX / 2 */
+static int clip_slab(const double *ic, const double *io, int n, const int *rg,
+                     int nr, double offc, double offo, double *oc, double *oo,
+                     double lo, double hi)
+{
+  if (n <= 0) return 0;
+  int e = 0;
+  for (int r = 0; r < nr; r++) e += rg[2 * r + 1] - rg[2 * r];
+  if (e <= CLIP_MAX / 2)
+    return clip_ranges(ic, io, n, rg, nr, offc, offo, oc, oo, lo, hi, 0);
+  return clip_ranges(ic, io, n, rg, nr, offc, offo, oc, oo, lo, hi, 1);
 }
 
 /* whether co never falls (rise) or never rises (!rise) along the vertices
