@@ -875,7 +875,7 @@ static inline void chain_integrals(BandChain *c, double a, double b, double sh, 
   const double *x = c->x, *y = c->y;
   const int m = c->m;
   int k = c->k;
-  if (k > 0 && x[k] > a) k = 0;
+  if (x[k] > a) k = 0; /* (k = 0 again where it is 0: no test for it) */
   while (k < m - 2 && x[k + 1] <= a) k++;
   c->k = k;
   /* the sums in locals, stored once: stored as they grow, each would be
@@ -966,13 +966,19 @@ double ss_poly_band_area(ssPolyBand *b, double x0, double x1, double *cx, double
    * polygon runs forwards (lower, when counter-clockwise) counts
    * negatively, the other (run backwards here) positively */
   double mx = 0.5 * (x0 + x1), sh = mx - b->ox, a = x0 - b->ox, e = x1 - b->ox;
-  BandChain f = {b->l, b->k[0], b->x, b->y};
-  BandChain r = {b->n - b->l, b->k[1], b->x + b->l, b->y + b->l};
   double If[3], Ir[3];
-  chain_integrals(&f, a, e, sh, If);
-  chain_integrals(&r, a, e, sh, Ir);
-  b->k[0] = f.k;
-  b->k[1] = r.k;
+  /* each chain's place stored as soon as its integrals are done: one value
+   * fewer held in a register across the other chain's */
+  {
+    BandChain f = {b->l, b->k[0], b->x, b->y};
+    chain_integrals(&f, a, e, sh, If);
+    b->k[0] = f.k;
+  }
+  {
+    BandChain r = {b->n - b->l, b->k[1], b->x + b->l, b->y + b->l};
+    chain_integrals(&r, a, e, sh, Ir);
+    b->k[1] = r.k;
+  }
   /* (the integrals of chain_integrals times 2, 6 and 3: area A, then
    * int x dA / A and int y dA / A = (1/2) int y^2 dx / A both over 6 A) */
   double A = 0.5 * (Ir[0] - If[0]);
