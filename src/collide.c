@@ -685,8 +685,10 @@ int ss_poly_ychains(const ssPoly2 *p, ssPolyChains *c)
 }
 
 /* whether sgn (v[k] - val) >= 0 (> 0 when strict), as a comparison of
- * v[k] with val (the same outcome: a difference of doubles is 0 only for
- * equal ones, and a NaN fails both) */
+ * v[k] with val: the same outcome for a finite val, as the slabs' bounds
+ * are (a difference of doubles is then 0 only for equal ones, infinite
+ * only with v[k], and a NaN fails both; an infinite val would compare
+ * equal to itself where the difference is a NaN) */
 static inline int run_pred(const double *v, int k, double val, double sgn, int strict)
 {
   if (sgn > 0) return strict ? v[k] > val : v[k] >= val;
