@@ -165,10 +165,11 @@ static void frame_from_normal(const double n[3], double frame[9])
   memcpy(frame + 6, t2, 3 * sizeof(double));
 }
 
-/* quadrature points of geom g on soil bed h */
-static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
-                              int sys, const double R[9], const double p[3],
-                              ssError *err)
+/* quadrature points of geom g on soil bed h, whose type is type
+ * (m->geom_type[g]; soil_contacts passes the common ones as constants) */
+static inline __attribute__((always_inline)) ssStatus
+soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const double R[9],
+                 const double p[3], ssError *err, const int type)
 {
   ssShape s;
   shape_in_frame(m, d, g, R, p, &s);
@@ -204,13 +205,19 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
 
   ssPoly2 fp;
   ss_shape_footprint(&s, &fp);
-  const int mesh = m->geom_type[g] == SS_GEOM_MESH;
-  /* a mesh's depth comes from mesh_depth: the cast of its stand-in box
-   * is made to miss (the type it does not cast), so that a cell tests
-   * for the mesh only where the cast missed */
+  const int mesh = type == SS_GEOM_MESH;
+  /* formed in a copy: cast's address then reaches no call, so the calls
+   * in the loop below (the band's, the reserve) cannot change it, and
+   * the casts keep its fields without reloading them.  Its type is set
+   * at each cast (below): a mesh's depth comes from mesh_depth, the cast
+   * of its stand-in box is made to miss (the type it does not cast), so
+   * that a cell tests for the mesh only where the cast missed */
   ssShapeCast cast;
-  ss_shape_cast_init(&cast, &s);
-  if (mesh) cast.type = SS_GEOM_MESH;
+  {
+    ssShapeCast c0;
+    ss_shape_cast_init(&c0, &s);
+    cast = c0;
+  }
   /* a row's cells on the footprint's edge: area and centroid integrated
    * along the row's band of the footprint (ss_poly_band, formed at the
    * row's first such cell), the full clip where the band cannot be split
@@ -303,7 +310,12 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
           qrow = &cq;
         }
       }
+      /* the type (the geom's: the mesh's, not its box's) stored just
+       * before the cast reads it: the compiler sees the value it reads,
+       * and where soil_contacts passes a constant the cast's tests of
+       * the type fold away */
       double zl;
+      cast.type = type;
       if (!ss_shape_cast_lowest_z(&cast, qrow, qx, &zl) &&
           !(mesh && mesh_depth(m, d, g, R, p, qx, qy, lo[2], &zl)))
         continue;
@@ -332,6 +344,24 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g,
     }
   }
   return SS_OK;
+}
+
+/* soil_contacts_as for each common type apart, the type a constant: each
+ * cell's cast (ss_shape_cast_lowest_z, inline) then tests no type; the
+ * others (capsule, mesh) share one copy that tests it */
+static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g, int sys,
+                              const double R[9], const double p[3], ssError *err)
+{
+  switch (m->geom_type[g]) {
+  case SS_GEOM_CYLINDER:
+    return soil_contacts_as(m, d, h, g, sys, R, p, err, SS_GEOM_CYLINDER);
+  case SS_GEOM_BOX:
+    return soil_contacts_as(m, d, h, g, sys, R, p, err, SS_GEOM_BOX);
+  case SS_GEOM_SPHERE:
+    return soil_contacts_as(m, d, h, g, sys, R, p, err, SS_GEOM_SPHERE);
+  default:
+    return soil_contacts_as(m, d, h, g, sys, R, p, err, m->geom_type[g]);
+  }
 }
 
 /* bilinear height and upward normal of rigid height map h at local (x, y);
