@@ -235,6 +235,9 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
    * sign of a zero) */
   static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   int turned = memcmp(R, I3, sizeof I3) != 0;
+  /* (read once: through p, every point would reload them, as the
+   * compiler sees the points' stores) */
+  const double p0 = p[0], p1 = p[1], p2 = p[2];
   long njac = contact_jlen(m, sys);
   const Attach at = attach_of(m, g, sys);
   /* the head its points share (ss_contact_add_head), and where their
@@ -248,6 +251,7 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
   head.bed_axes = !turned;
   attach_head(&at, &head);
   long jadr = ss_contact_jac_end(d);
+  const int first = d->ncontact;
   const double *z0 = m->hfield_data + adr;
   const double *sp = d->soil_plastic + adr, *jj = d->soil_shear + adr;
   double tiny = 1e-12 * dx * dy, hdx = 0.5 * dx;
@@ -330,9 +334,9 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
         ss_m3_mulv(c->pos, R, pl);
         ss_v3_add(c->pos, c->pos, p);
       } else {
-        c->pos[0] = qx + p[0];
-        c->pos[1] = qy + p[1];
-        c->pos[2] = zl + p[2];
+        c->pos[0] = qx + p0;
+        c->pos[1] = qy + p1;
+        c->pos[2] = zl + p2;
       }
       memcpy(c->frame, frame, sizeof frame);
       c->area = area;
@@ -340,9 +344,12 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
       c->g0 = g0;
       c->sp = spr[i];
       c->j = jr[i];
-      attach_response(&at, c);
     }
   }
+  /* a static body's responses, once its points are made (not a test of
+   * the body at every point) */
+  if (!(at.nv > 0))
+    for (int k = first; k < d->ncontact; k++) attach_response(&at, d->contact + k);
   return SS_OK;
 }
 
