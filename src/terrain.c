@@ -491,6 +491,66 @@ ssStatus ss_terrain_contacts(const ssModel *m, ssData *d, ssError *err)
 static int int_less(const int *a, const int *b) { return *a < *b; }
 SS_SORT_RUNS(merge_sort_runs, int, int_less)
 
+/* The loaded vertices' runs whose starts the soil update keeps (one per
+ * collider, each strictly ascending): merged pairwise where they are
+ * known, so that no pass scans for them, and the last merge drops the
+ * vertices two colliders share as it goes (no pass of its own); more
+ * runs than this: the sort (merge_sort_runs) */
+#define LOADED_RUNS_MAX 16
+
+/* o = the ascending merge of ascending [a, ea) and [b, eb); its end */
+static int *merge_two(int *o, const int *a, const int *ea, const int *b, const int *eb)
+{
+  while (a < ea && b < eb) *o++ = *b < *a ? *b++ : *a++;
+  memcpy(o, a, (size_t)(ea - a) * sizeof *o);
+  o += ea - a;
+  memcpy(o, b, (size_t)(eb - b) * sizeof *o);
+  return o + (eb - b);
+}
+
+/* merge_two, each vertex once (no vertex is -1) */
+static int *merge_two_unique(int *o, const int *a, const int *ea, const int *b, const int *eb)
+{
+  int last = -1;
+  while (a < ea && b < eb) {
+    int x = *b < *a ? *b++ : *a++;
+    if (x != last) *o++ = last = x;
+  }
+  for (; a < ea; a++)
+    if (*a != last) *o++ = last = *a;
+  for (; b < eb; b++)
+    if (*b != last) *o++ = last = *b;
+  return o;
+}
+
+/* v[0, n): the k runs that begin at bd[0] = 0 < bd[1] < ... < bd[k - 1]
+ * (2 <= k <= LOADED_RUNS_MAX; bd has room for k + 1), with the scratch
+ * v + n: merged into v, each vertex once; its count */
+static int merge_loaded(int *v, int n, int *bd, int k)
+{
+  int *src = v, *dst = v + n;
+  bd[k] = n;
+  for (; k > 2; k = (k + 1) / 2) {
+    /* a pass: runs 2r and 2r + 1 into run r of dst (the last one
+     * copied where k is odd) */
+    for (int r = 0; r < k; r += 2) {
+      int e = r + 2 <= k ? bd[r + 2] : n;
+      if (r + 1 < k)
+        merge_two(dst + bd[r], src + bd[r], src + bd[r + 1], src + bd[r + 1], src + e);
+      else
+        memcpy(dst + bd[r], src + bd[r], (size_t)(e - bd[r]) * sizeof *v);
+      bd[r / 2] = bd[r];
+    }
+    bd[(k + 1) / 2] = n;
+    int *t = src;
+    src = dst;
+    dst = t;
+  }
+  int u = (int)(merge_two_unique(dst, src, src + bd[1], src + bd[1], src + n) - dst);
+  if (dst != v) memcpy(v, dst, (size_t)u * sizeof *v);
+  return u;
+}
+
 void ss_terrain_update(const ssModel *m, ssData *d)
 {
   const double dt = m->opt.timestep;
@@ -527,9 +587,11 @@ void ss_terrain_update(const ssModel *m, ssData *d)
    * stores could alias them, as the compiler sees it) */
   int nrigid = 0, nsoil = 0;
   double area = 0, normal = 0;
-  /* the end of the loaded vertices' first strictly ascending run, -1
-   * while it goes on (one collider's vertices come so) */
-  int run = -1, last = -1;
+  /* where the loaded vertices' strictly ascending runs begin (one
+   * collider's vertices come so), run[0] = 0, nrun of them (those after
+   * LOADED_RUNS_MAX counted, not kept) */
+  int run[LOADED_RUNS_MAX + 1], nrun = 1, last = -1;
+  run[0] = 0;
   for (int i = 0; i < ncontact; i++) {
     const ssContact *c = contact + i;
     if (c->type != SS_CONTACT_SOIL) {
@@ -558,7 +620,10 @@ void ss_terrain_update(const ssModel *m, ssData *d)
     area += c->area;
     normal += c->lambda[0] / dt;
     if (collect) loaded[nload] = v;
-    if (v <= last && run < 0) run = nload;
+    if (v <= last) {
+      if (nrun < LOADED_RUNS_MAX) run[nrun] = nload;
+      nrun++;
+    }
     last = v;
     nload++;
   }
@@ -571,12 +636,16 @@ void ss_terrain_update(const ssModel *m, ssData *d)
   /* the new list of loaded vertices (unique): as they came where they
    * ascend strictly (one collider's, or none loaded, when the list may
    * not exist yet: no arithmetic on its NULL), else merged from their
-   * runs (one per collider, the first known) */
-  if (run < 0) {
+   * runs (one per collider), by their known starts where they were kept */
+  if (nrun == 1) {
     d->nsoil_loaded = nload;
     return;
   }
-  const int *v = merge_sort_runs_from(loaded, loaded + nload, nload, run);
+  if (nrun <= LOADED_RUNS_MAX) {
+    d->nsoil_loaded = merge_loaded(loaded, nload, run, nrun);
+    return;
+  }
+  const int *v = merge_sort_runs_from(loaded, loaded + nload, nload, run[1]);
   int u = 0;
   for (int i = 0; i < nload; i++)
     if (u == 0 || loaded[u - 1] != v[i]) loaded[u++] = v[i];
