@@ -551,47 +551,35 @@ static int merge_loaded(int *v, int n, int *bd, int k)
   return u;
 }
 
-void ss_terrain_update(const ssModel *m, ssData *d)
+/* the soil update's sums over the contacts (ss_terrain_update) */
+typedef struct PointSums {
+  int nrigid, nsoil, nload, nrun;
+  double area, normal;
+} PointSums;
+
+/* The soil update's loop over the contacts: every loaded point's vertex
+ * updated and the statistics summed; where collect, the loaded vertices
+ * listed into loaded and the starts of their strictly ascending runs
+ * (one collider's vertices come so) into run (run[0] = 0; those after
+ * LOADED_RUNS_MAX counted, not kept).  collect a constant: the loop is
+ * made twice, not tested at every point. */
+static inline __attribute__((always_inline)) PointSums
+update_points(const ssModel *m, ssData *d, int *loaded, int *run, const int collect)
 {
   const double dt = m->opt.timestep;
-  ssStepStats *st = &d->stats;
-
-  /* unloaded vertices recover elastically to the rut floor at once */
-  for (int k = 0; k < d->nsoil_loaded; k++) {
-    int v = d->soil_loaded[k];
-    d->soil_sinkage[v] = d->soil_plastic[v];
-    d->soil_shear[v] = 0;
-  }
-  /* room for the new list of loaded vertices (at most one per contact)
-   * and the scratch of its sort after it; without it the old list stays
-   * (worst case some vertices recover a step late) */
   const int ncontact = d->ncontact;
-  if (2 * ncontact > d->cap_soil_loaded) {
-    int *p = realloc(d->soil_loaded, (size_t)ncontact * 2 * sizeof(int));
-    if (p) {
-      d->soil_loaded = p;
-      d->cap_soil_loaded = 2 * ncontact;
-    }
-  }
-  const int collect = 2 * ncontact <= d->cap_soil_loaded;
-  int *loaded = d->soil_loaded;
   const ssContact *contact = d->contact;
   /* the material of bed `bed` and s^(n-1) for it: 1 where n = 1, else
    * by its table (solver.h), else libm, as the law forms it */
-  int nload = 0, bed = -1;
+  int bed = -1;
   const ssSoilMaterial *mat = NULL;
   const ssPowTable *pt = NULL;
   double n1 = 0;
   ssModulusMemo mod = {NAN, 0};
   /* the statistics' sums in locals, in the same order (the soil arrays'
    * stores could alias them, as the compiler sees it) */
-  int nrigid = 0, nsoil = 0;
+  int nrigid = 0, nsoil = 0, nload = 0, nrun = 1, last = -1;
   double area = 0, normal = 0;
-  /* where the loaded vertices' strictly ascending runs begin (one
-   * collider's vertices come so), run[0] = 0, nrun of them (those after
-   * LOADED_RUNS_MAX counted, not kept) */
-  int run[LOADED_RUNS_MAX + 1], nrun = 1, last = -1;
-  run[0] = 0;
   for (int i = 0; i < ncontact; i++) {
     const ssContact *c = contact + i;
     if (c->type != SS_CONTACT_SOIL) {
@@ -619,19 +607,52 @@ void ss_terrain_update(const ssModel *m, ssData *d)
     if (jn > d->soil_shear[v]) d->soil_shear[v] = jn;
     area += c->area;
     normal += c->lambda[0] / dt;
-    if (collect) loaded[nload] = v;
-    if (v <= last) {
-      if (nrun < LOADED_RUNS_MAX) run[nrun] = nload;
-      nrun++;
+    if (collect) {
+      loaded[nload] = v;
+      if (v <= last) {
+        if (nrun < LOADED_RUNS_MAX) run[nrun] = nload;
+        nrun++;
+      }
+      last = v;
     }
-    last = v;
     nload++;
   }
-  st->rigid_contacts = nrigid;
-  st->soil_contacts = nsoil;
+  return (PointSums){nrigid, nsoil, nload, nrun, area, normal};
+}
+
+void ss_terrain_update(const ssModel *m, ssData *d)
+{
+  ssStepStats *st = &d->stats;
+
+  /* unloaded vertices recover elastically to the rut floor at once */
+  for (int k = 0; k < d->nsoil_loaded; k++) {
+    int v = d->soil_loaded[k];
+    d->soil_sinkage[v] = d->soil_plastic[v];
+    d->soil_shear[v] = 0;
+  }
+  /* room for the new list of loaded vertices (at most one per contact)
+   * and the scratch of its sort after it; without it the old list stays
+   * (worst case some vertices recover a step late) */
+  const int ncontact = d->ncontact;
+  if (2 * ncontact > d->cap_soil_loaded) {
+    int *p = realloc(d->soil_loaded, (size_t)ncontact * 2 * sizeof(int));
+    if (p) {
+      d->soil_loaded = p;
+      d->cap_soil_loaded = 2 * ncontact;
+    }
+  }
+  const int collect = 2 * ncontact <= d->cap_soil_loaded;
+  int *loaded = d->soil_loaded;
+  int run[LOADED_RUNS_MAX + 1];
+  run[0] = 0;
+  const PointSums sum = collect ? update_points(m, d, loaded, run, 1)
+                                : update_points(m, d, NULL, NULL, 0);
+  const int nload = sum.nload, nrun = sum.nrun;
+  st->rigid_contacts = sum.nrigid;
+  st->soil_contacts = sum.nsoil;
   st->soil_loaded = nload;
-  st->soil_contact_area = area;
-  st->soil_normal_force = normal;
+  st->soil_contact_area = sum.area;
+  st->soil_normal_force = sum.normal;
   if (!collect) return;
   /* the new list of loaded vertices (unique): as they came where they
    * ascend strictly (one collider's, or none loaded, when the list may
