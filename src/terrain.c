@@ -232,12 +232,15 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
   /* a bed not turned (most: R from the unit quaternion is exactly I): a
    * point's world position is its bed position moved, without the
    * product by R's ones and zeros (which gives the same sums, up to the
-   * sign of a zero) */
+   * sign of a zero).  Every point is stored moved by (p0, p1, p2): p on
+   * such a bed (read once: through p, every point would reload it, as
+   * the compiler sees the points' stores), -0 on a turned one, which
+   * leaves the bed position as it is (x + -0 is x, -0 included) for
+   * the pass that turns and moves its points once they are made (no
+   * test at every point) */
   static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   int turned = memcmp(R, I3, sizeof I3) != 0;
-  /* (read once: through p, every point would reload them, as the
-   * compiler sees the points' stores) */
-  const double p0 = p[0], p1 = p[1], p2 = p[2];
+  const double p0 = turned ? -0.0 : p[0], p1 = turned ? -0.0 : p[1], p2 = turned ? -0.0 : p[2];
   long njac = contact_jlen(m, sys);
   const Attach at = attach_of(m, g, sys);
   /* the head its points share (ss_contact_add_head), and where their
@@ -329,15 +332,9 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
       ssContact *c = ss_contact_add_head(d, &head, jadr);
       jadr += njac;
       c->vertex = vr + i;
-      if (turned) {
-        double pl[3] = {qx, qy, zl};
-        ss_m3_mulv(c->pos, R, pl);
-        ss_v3_add(c->pos, c->pos, p);
-      } else {
-        c->pos[0] = qx + p0;
-        c->pos[1] = qy + p1;
-        c->pos[2] = zl + p2;
-      }
+      c->pos[0] = qx + p0;
+      c->pos[1] = qy + p1;
+      c->pos[2] = zl + p2;
       memcpy(c->frame, frame, sizeof frame);
       c->area = area;
       c->width = width;
@@ -346,8 +343,17 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
       c->j = jr[i];
     }
   }
-  /* a static body's responses, once its points are made (not a test of
-   * the body at every point) */
+  /* once the points are made, the rarer cases' passes (not a test at
+   * every point): a turned bed's points turned and moved into the world,
+   * a static body's responses */
+  if (turned)
+    for (int k = first; k < d->ncontact; k++) {
+      ssContact *c = d->contact + k;
+      double pl[3];
+      ss_v3_copy(pl, c->pos);
+      ss_m3_mulv(c->pos, R, pl);
+      ss_v3_add(c->pos, c->pos, p);
+    }
   if (!(at.nv > 0))
     for (int k = first; k < d->ncontact; k++) attach_response(&at, d->contact + k);
   return SS_OK;
