@@ -291,9 +291,13 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
     /* room for the row's points at once (ss_contact_add below) */
     if (!ss_contact_reserve(d, i1 - i0 + 1, njac))
       return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
+    /* the cell's half width to the left: 0 for the bed's first vertex,
+     * which only the row's first cell can be (x - 0 is x) */
+    double hl = i0 == 0 ? 0 : hdx;
     for (int i = i0; i <= i1; i++) {
       double x = x0 + i * dx;
-      double cx0 = i == 0 ? x : x - hdx, cx1 = i == nx - 1 ? x : x + hdx;
+      double cx0 = x - hl, cx1 = i == nx - 1 ? x : x + hdx;
+      hl = hdx;
       double qx = x, qy = y, full = (cx1 - cx0) * (cy1 - cy0), area = full;
       const ssCastRow *qrow = &crow;
       if (!(cx0 > in0 && cx1 < in1)) {
