@@ -166,15 +166,17 @@ static void frame_from_normal(const double n[3], double frame[9])
 }
 
 /* quadrature points of geom g on soil bed h, whose type is type
- * (m->geom_type[g]; soil_contacts passes the common ones as constants) */
+ * (m->geom_type[g]) and which is s in the bed's frame; oblique: no slab
+ * of its cast is parallel to the lines (ssShapeCast.par all 0: a box's
+ * three, a cylinder's caps).  soil_contacts passes the common types, and
+ * oblique where it holds, as constants. */
 static inline __attribute__((always_inline)) ssStatus
 soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const double R[9],
-                 const double p[3], ssError *err, const int type)
+                 const double p[3], ssError *err, const ssShape *s, const int type,
+                 const int oblique)
 {
-  ssShape s;
-  shape_in_frame(m, d, g, R, p, &s);
   double lo[3], hi[3];
-  ss_shape_aabb(&s, lo, hi);
+  ss_shape_aabb(s, lo, hi);
   double nz[3] = {R[2], R[5], R[8]};
   double margin = geom_margin(m, d, g, sys, nz);
   double ztop = m->hfield_zrange[2 * h + 1];
@@ -184,7 +186,7 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
    * the top plus the margin: a wheel's contact patch, not its whole
    * footprint (the cells beyond would be visited only to be dropped) */
   double blo[2], bhi[2];
-  if (!ss_shape_low_bounds(&s, ztop + margin, blo, bhi)) return SS_OK;
+  if (!ss_shape_low_bounds(s, ztop + margin, blo, bhi)) return SS_OK;
   for (int k = 0; k < 2; k++) {
     lo[k] = fmax(lo[k], blo[k]);
     hi[k] = fmin(hi[k], bhi[k]);
@@ -204,7 +206,7 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
   int j0 = fj0 > 0 ? (int)fj0 : 0, j1 = fj1 < ny - 1 ? (int)fj1 : ny - 1;
 
   ssPoly2 fp;
-  ss_shape_footprint(&s, &fp);
+  ss_shape_footprint(s, &fp);
   const int mesh = type == SS_GEOM_MESH;
   /* formed in a copy: cast's address then reaches no call, so the calls
    * in the loop below (the band's, the reserve) cannot change it, and
@@ -215,7 +217,7 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
   ssShapeCast cast;
   {
     ssShapeCast c0;
-    ss_shape_cast_init(&c0, &s);
+    ss_shape_cast_init(&c0, s);
     cast = c0;
   }
   /* a row's cells on the footprint's edge: area and centroid integrated
@@ -226,7 +228,7 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
   ssPolyBand band;
   int banded = ss_poly_ychains(&fp, &ych);
   double up[3] = {0, 0, 1};
-  double width = ss_shape_width(&s, up);
+  double width = ss_shape_width(s, up);
   double frame[9];
   frame_from_bed(R, frame);
   /* a bed not turned (most: R from the unit quaternion is exactly I): a
@@ -321,12 +323,13 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
           qrow = &cq;
         }
       }
-      /* the type (the geom's: the mesh's, not its box's) stored just
-       * before the cast reads it: the compiler sees the value it reads,
-       * and where soil_contacts passes a constant the cast's tests of
-       * the type fold away */
+      /* the type (the geom's: the mesh's, not its box's) and, where
+       * oblique, the slabs' par stored just before the cast reads them:
+       * the compiler sees the values it reads, and where soil_contacts
+       * passes constants the cast's tests of them fold away */
       double zl;
       cast.type = type;
+      if (oblique) cast.par[0] = cast.par[1] = cast.par[2] = 0;
       if (!ss_shape_cast_lowest_z(&cast, qrow, qx, &zl) &&
           !(mesh && mesh_depth(m, d, g, R, p, qx, qy, lo[2], &zl)))
         continue;
@@ -363,22 +366,31 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
   return SS_OK;
 }
 
-/* soil_contacts_as for each common type apart, the type a constant: each
- * cell's cast (ss_shape_cast_lowest_z, inline) then tests no type; the
- * others (capsule, mesh) share one copy that tests it */
+/* soil_contacts_as for each common type apart, the type a constant, and
+ * a box or cylinder apart where oblique (most: exactly level is rare):
+ * each cell's cast (ss_shape_cast_lowest_z, inline) then tests neither
+ * the type nor the slabs' par; the others (capsule, mesh, a level
+ * cylinder) share one copy that tests them */
 static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g, int sys,
                               const double R[9], const double p[3], ssError *err)
 {
+  ssShape s;
+  shape_in_frame(m, d, g, R, p, &s);
+  /* the lines' direction in the shape's frame (ss_shape_cast_init: d),
+   * whose zeros are the slabs parallel to them */
+  const double *dl = s.R + 6;
   switch (m->geom_type[g]) {
   case SS_GEOM_CYLINDER:
-    return soil_contacts_as(m, d, h, g, sys, R, p, err, SS_GEOM_CYLINDER);
+    if (dl[2] != 0) return soil_contacts_as(m, d, h, g, sys, R, p, err, &s, SS_GEOM_CYLINDER, 1);
+    break;
   case SS_GEOM_BOX:
-    return soil_contacts_as(m, d, h, g, sys, R, p, err, SS_GEOM_BOX);
+    if (dl[0] != 0 && dl[1] != 0 && dl[2] != 0)
+      return soil_contacts_as(m, d, h, g, sys, R, p, err, &s, SS_GEOM_BOX, 1);
+    return soil_contacts_as(m, d, h, g, sys, R, p, err, &s, SS_GEOM_BOX, 0);
   case SS_GEOM_SPHERE:
-    return soil_contacts_as(m, d, h, g, sys, R, p, err, SS_GEOM_SPHERE);
-  default:
-    return soil_contacts_as(m, d, h, g, sys, R, p, err, m->geom_type[g]);
+    return soil_contacts_as(m, d, h, g, sys, R, p, err, &s, SS_GEOM_SPHERE, 0);
   }
+  return soil_contacts_as(m, d, h, g, sys, R, p, err, &s, m->geom_type[g], 0);
 }
 
 /* bilinear height and upward normal of rigid height map h at local (x, y);
