@@ -261,6 +261,7 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
   const double *sp = d->soil_plastic + adr, *jj = d->soil_shear + adr;
   double tiny = 1e-12 * dx * dy, hdx = 0.5 * dx;
 
+  ssStatus status = SS_OK;
   /* the chord at the last row's upper boundary, which is (to round-off)
    * this row's lower one */
   double b0 = 0, b1 = 0;
@@ -290,9 +291,12 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
     /* the row's vertices (vr: the first one's absolute index) */
     const int kr = j * nx, vr = adr + kr;
     const double *zr = z0 + kr, *spr = sp + kr, *jr = jj + kr;
-    /* room for the row's points at once (ss_contact_add below) */
-    if (!ss_contact_reserve(d, i1 - i0 + 1, njac))
-      return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
+    /* room for the row's points at once (ss_contact_add below); without
+     * it the points made so far are finished (below) and the error kept */
+    if (!ss_contact_reserve(d, i1 - i0 + 1, njac)) {
+      status = ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
+      break;
+    }
     /* the cell's half width to the left: 0 for the bed's first vertex,
      * which only the row's first cell can be (x - 0 is x) */
     double hl = i0 == 0 ? 0 : hdx;
@@ -363,7 +367,7 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
     }
   if (!(at.nv > 0))
     for (int k = first; k < d->ncontact; k++) attach_response(&at, d->contact + k);
-  return SS_OK;
+  return status;
 }
 
 /* soil_contacts_as for each common type apart, the type a constant, and
