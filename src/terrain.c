@@ -337,7 +337,7 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
       if (!ss_shape_cast_lowest_z(&cast, qrow, qx, &zl) &&
           !(mesh && mesh_depth(m, d, g, R, p, qx, qy, lo[2], &zl)))
         continue;
-      double floor_z = zr[i] - spr[i];
+      double spi = spr[i], floor_z = zr[i] - spi;
       double g0 = zl - floor_z;
       if (g0 > margin) continue;
       ssContact *c = ss_contact_add_head(d, &head, jadr);
@@ -350,7 +350,7 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
       c->area = area;
       c->width = width;
       c->g0 = g0;
-      c->sp = spr[i];
+      c->sp = spi;
       c->j = jr[i];
     }
   }
