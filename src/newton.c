@@ -135,6 +135,8 @@ typedef struct NGroup {
   ssModulusMemo mod;  /* its points' modulus, kept for their width */
   int axes;           /* R is an unturned bed's axes (ssContact.bed_axes):
                          r = R (p - o) a permutation */
+  ssV2 T[18];         /* y' = T y (group_T), row by row in pairs */
+  ssV2 Ttb[36];       /* T^T's entries, each in both halves */
 } NGroup;
 
 /* One evaluation's sums over a group's points, in its frame about o */
@@ -329,38 +331,58 @@ static void group_T(const NGroup *G, double T[36])
     }
 }
 
-/* out = P A P^T (6 x 6), the sums in one fixed order */
-static void congruence6(const double P[36], const double A[36], double out[36])
+/* T and T^T as congruence6 reads them: the group's frame is fixed for
+ * the solve, so T is formed once a solve, not at every evaluation (out
+ * of line: inlined into newton_solve it moves the register allocation of
+ * the F-only evaluation's loop there, two instructions more a point on
+ * the settled plate) */
+static __attribute__((noinline)) void group_frame(NGroup *G)
 {
-  double AP[36];
+  double T[36];
+  group_T(G, T);
+  for (int k = 0; k < 18; k++) G->T[k] = (ssV2){T[2 * k], T[2 * k + 1]};
   for (int a = 0; a < 6; a++)
-    for (int b = 0; b < 6; b++) {
-      double t = 0;
-      for (int k = 0; k < 6; k++) t += A[6 * a + k] * P[6 * b + k];
-      AP[6 * a + b] = t;
+    for (int k = 0; k < 6; k++) G->Ttb[6 * a + k] = (ssV2){T[6 * k + a], T[6 * k + a]};
+}
+
+/* out = P A P^T (6 x 6), from P's entries each in both halves (Pb) and
+ * P^T's rows in pairs (Pt): two entries of a row at a time (SSE2 pairs),
+ * each entry's sum (AP^T)_ab = sum_k A_ak P_bk, then out_ab = sum_k P_ak
+ * (AP^T)_kb, from 0 in the order k = 0, 1, ..., 5 as the scalar sums
+ * (a product's factors commute exactly): the same values, with half the
+ * arithmetic instructions and P's broadcasts formed once a solve */
+static void congruence6(const ssV2 Pb[36], const ssV2 Pt[18], const double A[36],
+                        double out[36])
+{
+  ssV2 AP[18];
+  for (int a = 0; a < 6; a++) {
+    ssV2 ak[6];
+    for (int k = 0; k < 6; k++) ak[k] = (ssV2){A[6 * a + k], A[6 * a + k]};
+    for (int j = 0; j < 3; j++) {
+      ssV2 t = {0, 0};
+      for (int k = 0; k < 6; k++) t += ak[k] * Pt[3 * k + j];
+      AP[3 * a + j] = t;
     }
-  for (int a = 0; a < 6; a++)
-    for (int b = 0; b < 6; b++) {
-      double t = 0;
-      for (int k = 0; k < 6; k++) t += P[6 * a + k] * AP[6 * k + b];
-      out[6 * a + b] = t;
+  }
+  for (int j = 0; j < 3; j++)
+    for (int a = 0; a < 6; a++) {
+      ssV2 t = {0, 0};
+      for (int k = 0; k < 6; k++) t += Pb[6 * a + k] * AP[3 * k + j];
+      memcpy(out + 6 * a + 2 * j, &t, sizeof t);
     }
 }
 
 static void from_group(const NGroup *G, const double Fg[6], const double Hg[36],
                        double F[6], double H[36])
 {
-  double T[36], Tt[36];
-  group_T(G, T);
   for (int a = 0; a < 6; a++) {
     double t = 0;
-    for (int k = 0; k < 6; k++) t += T[6 * k + a] * Fg[k];
+    for (int k = 0; k < 6; k++) t += G->T[3 * k + a / 2][a % 2] * Fg[k];
     F[a] = t;
   }
   if (!Hg) return;
-  for (int a = 0; a < 6; a++)
-    for (int b = 0; b < 6; b++) Tt[6 * a + b] = T[6 * b + a];
-  congruence6(Tt, Hg, H);
+  /* H = T^T Hg T: P = T^T, whose transpose is T */
+  congruence6(G->Ttb, G->T, Hg, H);
 }
 
 /* A group's body velocity y_b = (omega; v_O) from its system's
@@ -407,9 +429,14 @@ static void body_block(const ssModel *m, const ssData *d, int b, double Y[36])
  * and its G_kk = x_k^T Lam' x_k is a quadratic in r */
 static void group_lam(const NGroup *G, const double Lam[36], double Lg[36])
 {
-  double T[36];
-  group_T(G, T);
-  congruence6(T, Lam, Lg);
+  /* P = T: its entries in both halves, and T^T's rows in pairs */
+  ssV2 Tb[36], Tt[18];
+  for (int a = 0; a < 6; a++)
+    for (int k = 0; k < 6; k++) {
+      Tb[6 * a + k] = (ssV2){G->T[3 * a + k / 2][k % 2], G->T[3 * a + k / 2][k % 2]};
+      Tt[3 * k + a / 2][a % 2] = G->T[3 * a + k / 2][k % 2];
+    }
+  congruence6(Tb, Tt, Lam, Lg);
 }
 
 /* G_11 and G_22 of a point at r (group frame) as quadratics in r, from
@@ -1816,6 +1843,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
    * quadratics that give a point's, and their bound over the group */
   for (int g = 0; g < ngroup; g++) {
     double Lb[36];
+    group_frame(w->grp + g);
     for (int a = 0; a < 6; a++)
       for (int k = 0; k < 6; k++) Lb[6 * a + k] = w->Lam[(size_t)(6 * g + a) * n + 6 * g + k];
     group_lam(w->grp + g, Lb, w->grp[g].Lg);
