@@ -1059,6 +1059,44 @@ static double imp_check(const Mat *M, NPoint *P, const NGroup *G, const double V
   return fabs(ln - lam[0]) + fabs(d1) + fabs(d2);
 }
 
+/* check's measure of the points [i0, i1) of one run (group g, material
+ * M) at their group's velocity V (frame about o).  The forms, each
+ * compiled for itself as evaluate's are: without impulse-form points
+ * (with_imp = 0, most solves) their test a point goes; the material's
+ * tests (linear soil, the power's series, a shear modulus) are known
+ * where form says so, and compile away. */
+enum { CHECK_ANY, CHECK_LINEAR, CHECK_POW_SHEAR };
+static inline __attribute__((always_inline)) void
+check_run(Mat M, const ssData *d, const ssNewtonWork *w, int g, int i0, int i1,
+          const double Vg[6], Measure *q, const int with_imp, const int form)
+{
+  if (form == CHECK_LINEAR) M.linear = 1;
+  if (form == CHECK_POW_SHEAR) {
+    M.linear = 0;
+    M.pser.ok = 1;
+    if (!(M.rj > 0)) __builtin_unreachable();
+  }
+  double V[6];
+  memcpy(V, Vg, sizeof V);
+  for (int i = i0; i < i1; i++) {
+    const ssContact *c = d->contact + i;
+    /* the laws keep the points' memos where they are (pow_point): at
+     * the last evaluation's y, so that H formed there later
+     * (ss_newton_solve) is what the evaluation would have formed */
+    NPoint *P = w->pt + i;
+    double lam[3], dn;
+    if (with_imp && P->imp) {
+      dn = imp_check(&M, P, w->grp + g, V, c->lambda);
+    } else {
+      dn = point_law(&M, P, V, lam, NULL, 1) == STICKS
+               ? INFINITY
+               : fabs(lam[0] - c->lambda[0]) + fabs(lam[1] - c->lambda[1]) +
+                     fabs(lam[2] - c->lambda[2]);
+    }
+    measure_add(q, dn, fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]));
+  }
+}
+
 /* The check of a converged Newton solve, an exact residual: with the
  * velocities u the contacts' impulses give, each contact's law at its
  * velocity against the impulse it holds (an impulse-form point: imp_check).
@@ -1075,33 +1113,24 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
     to_group(G, V, w->sum[g].V);
   }
   Measure q = {0, 0, 1};
-  int gprev = -1;
+  int gprev = -1, form = CHECK_ANY;
   Mat M = {0};
   for (int u = 0; u < w->nrun; u++) {
     const int i0 = w->run[u], i1 = w->run[u + 1], g = w->group_of[i0];
     if (g != gprev) {
       gprev = g;
       M = mat_of(w->grp + g, dt);
+      form = M.linear ? CHECK_LINEAR : M.pser.ok && M.rj > 0 ? CHECK_POW_SHEAR : CHECK_ANY;
     }
-    double V[6];
-    memcpy(V, w->sum[g].V, sizeof V);
-    for (int i = i0; i < i1; i++) {
-      const ssContact *c = d->contact + i;
-      /* the laws keep the points' memos where they are (pow_point): at
-       * the last evaluation's y, so that H formed there later
-       * (ss_newton_solve) is what the evaluation would have formed */
-      NPoint *P = w->pt + i;
-      double lam[3], dn;
-      if (P->imp) {
-        dn = imp_check(&M, P, w->grp + g, V, c->lambda);
-      } else {
-        dn = point_law(&M, P, V, lam, NULL, 1) == STICKS
-                 ? INFINITY
-                 : fabs(lam[0] - c->lambda[0]) + fabs(lam[1] - c->lambda[1]) +
-                       fabs(lam[2] - c->lambda[2]);
-      }
-      measure_add(&q, dn, fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]));
-    }
+    const double *V = w->sum[g].V;
+    if (w->ns)
+      check_run(M, d, w, g, i0, i1, V, &q, 1, CHECK_ANY);
+    else if (form == CHECK_POW_SHEAR)
+      check_run(M, d, w, g, i0, i1, V, &q, 0, CHECK_POW_SHEAR);
+    else if (form == CHECK_LINEAR)
+      check_run(M, d, w, g, i0, i1, V, &q, 0, CHECK_LINEAR);
+    else
+      check_run(M, d, w, g, i0, i1, V, &q, 0, CHECK_ANY);
   }
   for (int r = 0; r < s->nrow; r++) {
     const ssContact *c = d->contact + s->first_row + r;
