@@ -170,6 +170,7 @@ struct ssNewtonWork {
   double *q, *qtry;   /* (6 ngroup) F's part from their equations' values:
                          the step solves (I - Lam H) dy = -phi - Lam q */
   double *col;        /* (nv) one gathered response column */
+  ssV2 *F2;           /* (n) residual's F, each entry in both halves */
   NPoint *pt;         /* (ncontact) the soil points' constants and caches */
   NGroup *grp;        /* (ngroup) */
   NSum *sum;          /* (ngroup) one evaluation's sums */
@@ -198,7 +199,7 @@ void ss_newton_work_free(ssNewtonWork *w)
   free(w->Lam); free(w->A); free(w->piv); free(w->y); free(w->yfree);
   free(w->phi); free(w->dy); free(w->F); free(w->ytry); free(w->Ftry);
   free(w->phitry); free(w->H); free(w->Htry); free(w->K); free(w->Ktry);
-  free(w->col); free(w->pt);
+  free(w->col); free(w->F2); free(w->pt);
   free(w->grp); free(w->sum);
   free(w->q); free(w->qtry); free(w->imp); free(w->live); free(w->mu); free(w->mutry); free(w->dmu);
   free(w->ie); free(w->ietry);
@@ -258,6 +259,7 @@ static ssNewtonWork *work(ssData *d, int n, int nc, int nv, int ng)
         !grow(&w->Htry, 6 * (size_t)n, sizeof(double)) ||
         !grow(&w->Lam, (size_t)n * n, sizeof(double)) ||
         !grow(&w->A, (size_t)n * n, sizeof(double)) ||
+        !grow(&w->F2, (size_t)n, sizeof(ssV2)) ||
         !grow(&w->piv, (size_t)n, sizeof(int)))
       return NULL;
     w->cap_n = n;
@@ -1175,14 +1177,37 @@ static double residual(const Setup *s, const ssNewtonWork *w, const double *y,
 {
   int n = s->n;
   double sum = 0, big = 0;
-  for (int a = 0; a < n; a++) {
+  /* (Lam F)_a four rows at a time, rows a, a + 1 and a + 2, a + 3 in the
+   * halves of two pairs, F_b in both halves of F2[b]: each row's sum from
+   * 0 in the order b = 0, 1, ... as one row at a time, with F read once
+   * for four rows (the rows left over one at a time) */
+  ssV2 *F2 = w->F2;
+  for (int b = 0; b < n; b++) F2[b] = (ssV2){F[b], F[b]};
+  for (int a = 0; a < n;) {
     const double *L = w->Lam + (size_t)a * n;
-    double t = 0;
-    for (int b = 0; b < n; b++) t += L[b] * F[b];
-    phi[a] = y[a] - w->yfree[a] - t;
-    double inv = L[a] > 0 ? 1 / L[a] : 1;
-    sum += phi[a] * phi[a] * inv;
-    big += t * t * inv;
+    double t[4];
+    int rows = n - a >= 4 ? 4 : 1;
+    if (rows == 4) {
+      const double *L1 = L + n, *L2 = L1 + n, *L3 = L2 + n;
+      ssV2 t01 = {0, 0}, t23 = {0, 0};
+      for (int b = 0; b < n; b++) {
+        t01 += (ssV2){L[b], L1[b]} * F2[b];
+        t23 += (ssV2){L2[b], L3[b]} * F2[b];
+      }
+      t[0] = t01[0];
+      t[1] = t01[1];
+      t[2] = t23[0];
+      t[3] = t23[1];
+    } else {
+      t[0] = 0;
+      for (int b = 0; b < n; b++) t[0] += L[b] * F[b];
+    }
+    for (int r = 0; r < rows; r++, a++, L += n) {
+      phi[a] = y[a] - w->yfree[a] - t[r];
+      double inv = L[a] > 0 ? 1 / L[a] : 1;
+      sum += phi[a] * phi[a] * inv;
+      big += t[r] * t[r] * inv;
+    }
   }
   for (int k = 0; k < w->ns; k++) {
     int i = w->imp[k];
