@@ -1786,100 +1786,83 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
   /* groups: one per link (or body) and bed (a link's contacts may come in
    * several runs); every point of a bed shares the bed's frame (the
    * bed's axes, terrain.c's frame_from_bed: the same bits for all its
-   * points of a step), so it is compared only where a run starts.  The
-   * run's group, its key and its points' largest offsets stay in locals
-   * while it goes on. */
+   * points of a step), so it is compared only where a run starts.  A run
+   * at a time: its group found, then its points while the key holds,
+   * with the group's constants, the points' largest offsets and the
+   * modulus memo in locals, stored into the group where the run ends. */
   const double dt = m->opt.timestep;
-  int gr = -1, run_link = 0, run_sys = 0, run_bed = 0, nrun = 0, axes = 0;
-  NGroup *G = NULL;
-  const ssSoilMaterial *mat = NULL;
-  double rm0 = 0, rm1 = 0, rm2 = 0, o0 = 0, o1 = 0, o2 = 0, ik = 0, coh = 0;
-  ssModulusMemo mod = {NAN, 0};
-  for (int i = 0; i < first_row; i++) {
-    const ssContact *c = d->contact + i;
+  const ssContact *contact = d->contact;
+  NPoint *pts = w->pt;
+  int *group_of = w->group_of;
+  int nrun = 0;
+  for (int i = 0; i < first_row;) {
+    const ssContact *c = contact + i;
     if (c->type != SS_CONTACT_SOIL) return 0;
-    if (!(G && c->link == run_link && c->sys == run_sys && c->hfield == run_bed)) {
-      /* a new run: the last one's offsets and modulus into its group
-       * first */
-      w->run[nrun++] = i;
-      if (G) {
-        G->rmax[0] = rm0;
-        G->rmax[1] = rm1;
-        G->rmax[2] = rm2;
-        G->mod = mod;
-      }
-      if (!(c->nv > 0 && (c->link >= 0 || (c->nv == 6 && m->sys_type[c->sys] == SS_SYS_FREE))))
-        return 0;
-      gr = 0;
-      while (gr < ngroup && !(w->grp[gr].link == c->link && w->grp[gr].sys == c->sys &&
-                             w->grp[gr].mat == &m->hfield_soilmat[c->hfield]))
-        gr++;
-      if (gr == w->cap_g && !work(d, 0, 0, 0, 2 * gr + 4)) return 0;
-      G = w->grp + gr;
-      if (gr == ngroup) {
-        ngroup++;
-        G->link = c->link;
-        G->sys = c->sys;
-        G->body = c->link >= 0 ? c->link : m->geom_body[c->geom];
-        G->bed = c->hfield;
-        G->mat = &m->hfield_soilmat[c->hfield];
-        G->pt = ss_solver_pow_table(m, d, c->hfield);
-        G->ik = G->mat->shear_displacement > 0 ? 1 / G->mat->shear_displacement : 0;
-        G->mod.b = NAN;
-        memcpy(G->R, c->frame, sizeof G->R);
-        G->axes = c->bed_axes;
-        memcpy(G->o, c->pos, sizeof G->o);
-        G->rmax[0] = G->rmax[1] = G->rmax[2] = 0;
-        if (c->link < 0) body_block(m, d, G->body, G->Yb);
-      } else if (memcmp(G->R, c->frame, sizeof G->R)) {
-        return 0;
-      }
-      run_link = c->link;
-      run_sys = c->sys;
-      run_bed = c->hfield;
-      rm0 = G->rmax[0];
-      rm1 = G->rmax[1];
-      rm2 = G->rmax[2];
-      mod = G->mod;
-      /* (and what its points read from the group: the point's stores
-       * could alias them, as the compiler sees it) */
-      mat = G->mat;
-      o0 = G->o[0];
-      o1 = G->o[1];
-      o2 = G->o[2];
-      ik = G->ik;
-      coh = mat->cohesion;
-      axes = G->axes;
+    w->run[nrun++] = i;
+    if (!(c->nv > 0 && (c->link >= 0 || (c->nv == 6 && m->sys_type[c->sys] == SS_SYS_FREE))))
+      return 0;
+    int gr = 0;
+    while (gr < ngroup && !(w->grp[gr].link == c->link && w->grp[gr].sys == c->sys &&
+                           w->grp[gr].mat == &m->hfield_soilmat[c->hfield]))
+      gr++;
+    if (gr == w->cap_g && !work(d, 0, 0, 0, 2 * gr + 4)) return 0;
+    NGroup *G = w->grp + gr;
+    if (gr == ngroup) {
+      ngroup++;
+      G->link = c->link;
+      G->sys = c->sys;
+      G->body = c->link >= 0 ? c->link : m->geom_body[c->geom];
+      G->bed = c->hfield;
+      G->mat = &m->hfield_soilmat[c->hfield];
+      G->pt = ss_solver_pow_table(m, d, c->hfield);
+      G->ik = G->mat->shear_displacement > 0 ? 1 / G->mat->shear_displacement : 0;
+      G->mod.b = NAN;
+      memcpy(G->R, c->frame, sizeof G->R);
+      G->axes = c->bed_axes;
+      memcpy(G->o, c->pos, sizeof G->o);
+      G->rmax[0] = G->rmax[1] = G->rmax[2] = 0;
+      if (c->link < 0) body_block(m, d, G->body, G->Yb);
+    } else if (memcmp(G->R, c->frame, sizeof G->R)) {
+      return 0;
     }
-    w->group_of[i] = gr;
-    /* the point's constants, its caches empty */
-    NPoint *P = w->pt + i;
-    double rel[3] = {c->pos[0] - o0, c->pos[1] - o1, c->pos[2] - o2};
-    if (axes) {
-      P->r[0] = rel[2];
-      P->r[1] = rel[0];
-      P->r[2] = rel[1];
-    } else {
-      ss_m3_mulv(P->r, G->R, rel);
-    }
-    P->g0 = c->g0;
-    P->sp = c->sp;
-    P->S = c->area * dt;
-    P->k = ss_soil_modulus_at(mat, &mod, c->width);
-    P->tf0 = P->S * coh;
-    /* x0 = j / K_j as the sweeps' law forms it (point.c, mobil_init):
-     * the same bits, and no division a point */
-    P->x0 = (c->j > 0 ? c->j : 0) * ik;
-    P->pw.s = 0;
-    P->mob = ss_exp_memo_start(P->x0);
-    P->imp = 0;
-    P->gtt = -1;
-    double a0 = fabs(P->r[0]), a1 = fabs(P->r[1]), a2 = fabs(P->r[2]);
-    rm0 = a0 > rm0 ? a0 : rm0;
-    rm1 = a1 > rm1 ? a1 : rm1;
-    rm2 = a2 > rm2 ? a2 : rm2;
-  }
-  if (G) {
+    const int run_link = c->link, run_sys = c->sys, run_bed = c->hfield, axes = G->axes;
+    double rm0 = G->rmax[0], rm1 = G->rmax[1], rm2 = G->rmax[2];
+    ssModulusMemo mod = G->mod;
+    /* (and what its points read from the group: the point's stores
+     * could alias them, as the compiler sees it) */
+    const ssSoilMaterial *mat = G->mat;
+    const double o0 = G->o[0], o1 = G->o[1], o2 = G->o[2], ik = G->ik, coh = mat->cohesion;
+    do {
+      group_of[i] = gr;
+      /* the point's constants, its caches empty */
+      NPoint *P = pts + i;
+      double rel[3] = {c->pos[0] - o0, c->pos[1] - o1, c->pos[2] - o2};
+      if (axes) {
+        P->r[0] = rel[2];
+        P->r[1] = rel[0];
+        P->r[2] = rel[1];
+      } else {
+        ss_m3_mulv(P->r, G->R, rel);
+      }
+      P->g0 = c->g0;
+      P->sp = c->sp;
+      P->S = c->area * dt;
+      P->k = ss_soil_modulus_at(mat, &mod, c->width);
+      P->tf0 = P->S * coh;
+      /* x0 = j / K_j as the sweeps' law forms it (point.c, mobil_init):
+       * the same bits, and no division a point */
+      P->x0 = (c->j > 0 ? c->j : 0) * ik;
+      P->pw.s = 0;
+      P->mob = ss_exp_memo_start(P->x0);
+      P->imp = 0;
+      P->gtt = -1;
+      double a0 = fabs(P->r[0]), a1 = fabs(P->r[1]), a2 = fabs(P->r[2]);
+      rm0 = a0 > rm0 ? a0 : rm0;
+      rm1 = a1 > rm1 ? a1 : rm1;
+      rm2 = a2 > rm2 ? a2 : rm2;
+      c = contact + ++i;
+    } while (i < first_row && c->type == SS_CONTACT_SOIL && c->link == run_link &&
+             c->sys == run_sys && c->hfield == run_bed);
     G->rmax[0] = rm0;
     G->rmax[1] = rm1;
     G->rmax[2] = rm2;
