@@ -116,6 +116,15 @@ typedef struct NImpEval {
   double e[2];        /* d phi / d v_n (through lambda_n and tf) */
 } NImpEval;
 
+/* a bed material's constants as the law uses them */
+typedef struct Mat {
+  double dt, n, Ke, D, mu, rj; /* rj = dt / K_j, 0 when K_j = 0 */
+  int linear;
+  ssPowSeries pser;            /* of s^(n-1), when not linear */
+  const double *gq;            /* its group's slip_quadratics */
+  double gmax;                 /* and bound on G_tt (slip_bound) */
+} Mat;
+
 /* A group: the soil points of one link (or free rigid body) on one bed,
  * in that bed's frame */
 typedef struct NGroup {
@@ -137,6 +146,8 @@ typedef struct NGroup {
                          r = R (p - o) a permutation */
   ssV2 T[18];         /* y' = T y (group_T), row by row in pairs */
   ssV2 Ttb[36];       /* T^T's entries, each in both halves */
+  Mat M;              /* its law's constants (mat_of), formed once a
+                         solve: the evaluations and the check copy them */
 } NGroup;
 
 /* One evaluation's sums over a group's points, in its frame about o */
@@ -489,15 +500,6 @@ static double slip_bound(const double q[12], const double R[3])
               fabs(q[9]) * R[0] * R[1] + fabs(q[10]) * R[1] + fabs(q[11]) * R[0];
   return 2 * (g1 > g2 ? g1 : g2);
 }
-
-/* a bed material's constants as the law uses them */
-typedef struct Mat {
-  double dt, n, Ke, D, mu, rj; /* rj = dt / K_j, 0 when K_j = 0 */
-  int linear;
-  ssPowSeries pser;            /* of s^(n-1), when not linear */
-  const double *gq;            /* its group's slip_quadratics */
-  double gmax;                 /* and bound on G_tt (slip_bound) */
-} Mat;
 
 static Mat mat_of(const NGroup *G, double dt)
 {
@@ -872,7 +874,6 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
             double *lam_out, double *restrict K_out, NImpEval *ie, const int with_H,
             const int with_imp, const int linear)
 {
-  const double dt = m->opt.timestep;
   /* (K_out is there with H: the laws' tests of K compile away) */
   if (with_H && !K_out) __builtin_unreachable();
   memset(F, 0, (size_t)s->n * sizeof(double));
@@ -893,7 +894,7 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
     NSum *A = w->sum + g;
     if (g != gprev) {
       gprev = g;
-      M = mat_of(w->grp + g, dt);
+      M = w->grp[g].M;
       /* (the same value, now known where this form is compiled) */
       if (linear) M.linear = 1;
     }
@@ -1107,7 +1108,6 @@ check_run(Mat M, const ssData *d, const ssNewtonWork *w, int g, int i0, int i1,
  * not finite. */
 static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonWork *w)
 {
-  const double dt = m->opt.timestep;
   for (int g = 0; g < s->ngroup; g++) {
     const NGroup *G = w->grp + g;
     double V[6];
@@ -1121,7 +1121,7 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
     const int i0 = w->run[u], i1 = w->run[u + 1], g = w->group_of[i0];
     if (g != gprev) {
       gprev = g;
-      M = mat_of(w->grp + g, dt);
+      M = w->grp[g].M;
       form = M.linear ? CHECK_LINEAR : M.pser.ok && M.rj > 0 ? CHECK_POW_SHEAR : CHECK_ANY;
     }
     const double *V = w->sum[g].V;
@@ -1430,7 +1430,7 @@ static int switch_points(const ssModel *m, const ssData *d, const Setup *s, ssNe
     if (P->imp || !(w->lam[3 * i] > 0)) continue;
     if (g != gprev) {
       gprev = g;
-      M = mat_of(w->grp + g, m->opt.timestep);
+      M = w->grp[g].M;
     }
     double lam[3], warm[3];
     int st = point_law(&M, P, w->sum[g].V, lam, NULL, 1);
@@ -1886,6 +1886,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     group_lam(w->grp + g, Lb, w->grp[g].Lg);
     slip_quadratics(w->grp[g].Lg, w->grp[g].gq);
     w->grp[g].gmax = slip_bound(w->grp[g].gq, w->grp[g].rmax);
+    w->grp[g].M = mat_of(w->grp + g, dt);
   }
   unknowns_of(m, d, &s, w, d->qvel_free, w->yfree);
   uint64_t key = unknowns_key(d, &s, w);
