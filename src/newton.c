@@ -1265,13 +1265,25 @@ static void newton_matrix(const Setup *s, ssNewtonWork *w, const double *H)
  * column is zero there (singular) */
 static int lu_pivot(double *A, int *piv, int n, int k)
 {
-  int p = k;
+  int p = k, i = k + 1;
   double best = fabs(A[k * n + k]);
-  for (int i = k + 1; i < n; i++)
-    if (fabs(A[i * n + k]) > best) {
-      best = fabs(A[i * n + k]);
+  /* two rows a pass (the same comparisons in the same order: the first
+   * largest wins), half the loop's own instructions */
+  for (; i + 1 < n; i += 2) {
+    double a0 = fabs(A[i * n + k]), a1 = fabs(A[(i + 1) * n + k]);
+    if (a0 > best) {
+      best = a0;
       p = i;
     }
+    if (a1 > best) {
+      best = a1;
+      p = i + 1;
+    }
+  }
+  if (i < n && fabs(A[i * n + k]) > best) {
+    best = fabs(A[i * n + k]);
+    p = i;
+  }
   if (!(best > 0)) return 0;
   piv[k] = p;
   if (p != k)
@@ -1559,8 +1571,12 @@ static void apply_at(const ssModel *m, ssData *d, const Setup *s, const ssNewton
                      const double *lam, const double *F)
 {
   d->warm_pending = 0; /* the answer replaces the warm start, applied or not */
-  for (int i = 0; i < s->first_row; i++)
-    memcpy(d->contact[i].lambda, lam + 3 * i, 3 * sizeof(double));
+  /* (the contacts and their count in locals: the copies' stores could
+   * alias them, as the compiler sees it, and they would be loaded again
+   * at every point) */
+  ssContact *contact = d->contact;
+  const int np = s->first_row;
+  for (int i = 0; i < np; i++) memcpy(contact[i].lambda, lam + 3 * i, 3 * sizeof(double));
   memcpy(d->qvel, d->qvel_free, (size_t)m->nv * sizeof(double));
   /* the links' and joint rows' impulses, summed on their paths, then one
    * solve a system (ss_art_force_apply) */
@@ -1613,18 +1629,27 @@ static double apply_linear(const ssModel *m, ssData *d, const Setup *s, ssNewton
 {
   /* (the scratch sums' V hold each group's dy, frame about o) */
   for (int g = 0; g < s->ngroup; g++) to_group(w->grp + g, w->dy + 6 * g, w->sum[g].V);
+  /* (the arrays in locals: the stores to lamtry could alias w's
+   * pointers, as the compiler sees it, and they would be loaded again at
+   * every point) */
+  const double *lam = w->lam, *Ks = w->K;
+  double *lamtry = w->lamtry;
+  const NPoint *pt = w->pt;
   for (int u = 0; u < w->nrun; u++) {
     const int i1 = w->run[u + 1];
     double V[6];
     memcpy(V, w->sum[w->group_of[w->run[u]]].V, sizeof V);
     for (int i = w->run[u]; i < i1; i++) {
       /* (the offsets in size_t, as in h_sums) */
-      const double *l = w->lam + 3 * (size_t)i, *K = w->K + 6 * (size_t)i;
-      double *lt = w->lamtry + 3 * (size_t)i, dv[3];
-      lt[0] = lt[1] = lt[2] = 0;
-      if (!(l[0] > 0)) continue;
-      point_velocity(w->pt[i].r, V, dv);
+      const double *l = lam + 3 * (size_t)i, *K = Ks + 6 * (size_t)i;
+      double *lt = lamtry + 3 * (size_t)i, dv[3];
+      if (!(l[0] > 0)) {
+        lt[0] = lt[1] = lt[2] = 0;
+        continue;
+      }
+      point_velocity(pt[i].r, V, dv);
       double ln = l[0] + K[0] * dv[0];
+      /* (lamtry is left part written: declined, nothing applies it) */
       if (!(ln > 0)) return INFINITY;
       lt[0] = ln;
       lt[1] = l[1] + K[1] * dv[0] + K[3] * dv[1] + K[4] * dv[2];
