@@ -1008,20 +1008,23 @@ evaluate_F(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWork
  * change is not finite (check and warm_check) */
 typedef struct Measure {
   double dmax, lmax;
-  int finite;
+  double nf;          /* the sum of the changes' dn - dn: 0 while every
+                         change is finite, NaN from the first that is not
+                         (an instruction less a contact than isfinite's
+                         test and flag) */
 } Measure;
 
 static inline void measure_add(Measure *q, double dn, double ln)
 {
   /* not fmax: a libm call here, and it would pass over a NaN */
-  q->finite &= isfinite(dn);
+  q->nf += dn - dn;
   q->dmax = dn > q->dmax ? dn : q->dmax;
   q->lmax = ln > q->lmax ? ln : q->lmax;
 }
 
 static double measure_value(const Measure *q)
 {
-  if (!q->finite) return INFINITY;
+  if (!(q->nf == 0)) return INFINITY;
   return q->lmax > 0 ? q->dmax / q->lmax : 0;
 }
 
@@ -1114,7 +1117,7 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
     group_motion(m, d, G, d->qvel + m->sys_vadr[G->sys], V);
     to_group(G, V, w->sum[g].V);
   }
-  Measure q = {0, 0, 1};
+  Measure q = {0, 0, 0};
   int gprev = -1, form = CHECK_ANY;
   Mat M = {0};
   for (int u = 0; u < w->nrun; u++) {
@@ -1153,7 +1156,7 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
  * not finite. */
 static double warm_check(const ssData *d, const Setup *s, const ssNewtonWork *w)
 {
-  Measure q = {0, 0, 1};
+  Measure q = {0, 0, 0};
   for (int i = 0; i < s->first_row; i++) {
     const double *l = d->contact[i].lambda, *law = w->lam + 3 * i;
     measure_add(&q, fabs(law[0] - l[0]) + fabs(law[1] - l[1]) + fabs(law[2] - l[2]),
