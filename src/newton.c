@@ -1795,6 +1795,62 @@ int ss_newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
   return done;
 }
 
+/* The set-up of the points of one run of group gr (G), from contact i
+ * while the run's key holds; returns where it ends.  The group's
+ * constants, the points' largest offsets and the modulus memo in locals,
+ * stored into the group at the end.  Compiled for an unturned bed's axes
+ * (the points' r a permutation) and for a turned one. */
+static inline __attribute__((always_inline)) int
+setup_run(const ssModel *m, const ssContact *contact, NPoint *pts, int *group_of, int i,
+          int first_row, int gr, NGroup *G, const int axes)
+{
+  const double dt = m->opt.timestep;
+  const ssContact *c = contact + i;
+  const int run_link = c->link, run_sys = c->sys, run_bed = c->hfield;
+  double rm0 = G->rmax[0], rm1 = G->rmax[1], rm2 = G->rmax[2];
+  ssModulusMemo mod = G->mod;
+  /* (and what its points read from the group: the point's stores
+   * could alias them, as the compiler sees it) */
+  const ssSoilMaterial *mat = G->mat;
+  const double o0 = G->o[0], o1 = G->o[1], o2 = G->o[2], ik = G->ik, coh = mat->cohesion;
+  do {
+    group_of[i] = gr;
+    /* the point's constants, its caches empty */
+    NPoint *P = pts + i;
+    double rel[3] = {c->pos[0] - o0, c->pos[1] - o1, c->pos[2] - o2};
+    if (axes) {
+      P->r[0] = rel[2];
+      P->r[1] = rel[0];
+      P->r[2] = rel[1];
+    } else {
+      ss_m3_mulv(P->r, G->R, rel);
+    }
+    P->g0 = c->g0;
+    P->sp = c->sp;
+    P->S = c->area * dt;
+    P->k = ss_soil_modulus_at(mat, &mod, c->width);
+    P->tf0 = P->S * coh;
+    /* x0 = j / K_j as the sweeps' law forms it (point.c, mobil_init):
+     * the same bits, and no division a point */
+    P->x0 = (c->j > 0 ? c->j : 0) * ik;
+    P->pw.s = 0;
+    P->mob = ss_exp_memo_start(P->x0);
+    P->imp = 0;
+    P->gtt = -1;
+    double a0 = fabs(P->r[0]), a1 = fabs(P->r[1]), a2 = fabs(P->r[2]);
+    rm0 = a0 > rm0 ? a0 : rm0;
+    rm1 = a1 > rm1 ? a1 : rm1;
+    rm2 = a2 > rm2 ? a2 : rm2;
+    c = contact + ++i;
+  } while (i < first_row && c->type == SS_CONTACT_SOIL && c->link == run_link &&
+           c->sys == run_sys && c->hfield == run_bed);
+  G->rmax[0] = rm0;
+  G->rmax[1] = rm1;
+  G->rmax[2] = rm2;
+  G->mod = mod;
+  return i;
+}
+
 static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
                         int *sticking, double *residual_out, int may_predict,
                         int *predicted)
@@ -1815,9 +1871,8 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
    * several runs); every point of a bed shares the bed's frame (the
    * bed's axes, terrain.c's frame_from_bed: the same bits for all its
    * points of a step), so it is compared only where a run starts.  A run
-   * at a time: its group found, then its points while the key holds,
-   * with the group's constants, the points' largest offsets and the
-   * modulus memo in locals, stored into the group where the run ends. */
+   * at a time: its group found, then its points while the key holds
+   * (setup_run). */
   const double dt = m->opt.timestep;
   const ssContact *contact = d->contact;
   NPoint *pts = w->pt;
@@ -1853,48 +1908,8 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     } else if (memcmp(G->R, c->frame, sizeof G->R)) {
       return 0;
     }
-    const int run_link = c->link, run_sys = c->sys, run_bed = c->hfield, axes = G->axes;
-    double rm0 = G->rmax[0], rm1 = G->rmax[1], rm2 = G->rmax[2];
-    ssModulusMemo mod = G->mod;
-    /* (and what its points read from the group: the point's stores
-     * could alias them, as the compiler sees it) */
-    const ssSoilMaterial *mat = G->mat;
-    const double o0 = G->o[0], o1 = G->o[1], o2 = G->o[2], ik = G->ik, coh = mat->cohesion;
-    do {
-      group_of[i] = gr;
-      /* the point's constants, its caches empty */
-      NPoint *P = pts + i;
-      double rel[3] = {c->pos[0] - o0, c->pos[1] - o1, c->pos[2] - o2};
-      if (axes) {
-        P->r[0] = rel[2];
-        P->r[1] = rel[0];
-        P->r[2] = rel[1];
-      } else {
-        ss_m3_mulv(P->r, G->R, rel);
-      }
-      P->g0 = c->g0;
-      P->sp = c->sp;
-      P->S = c->area * dt;
-      P->k = ss_soil_modulus_at(mat, &mod, c->width);
-      P->tf0 = P->S * coh;
-      /* x0 = j / K_j as the sweeps' law forms it (point.c, mobil_init):
-       * the same bits, and no division a point */
-      P->x0 = (c->j > 0 ? c->j : 0) * ik;
-      P->pw.s = 0;
-      P->mob = ss_exp_memo_start(P->x0);
-      P->imp = 0;
-      P->gtt = -1;
-      double a0 = fabs(P->r[0]), a1 = fabs(P->r[1]), a2 = fabs(P->r[2]);
-      rm0 = a0 > rm0 ? a0 : rm0;
-      rm1 = a1 > rm1 ? a1 : rm1;
-      rm2 = a2 > rm2 ? a2 : rm2;
-      c = contact + ++i;
-    } while (i < first_row && c->type == SS_CONTACT_SOIL && c->link == run_link &&
-             c->sys == run_sys && c->hfield == run_bed);
-    G->rmax[0] = rm0;
-    G->rmax[1] = rm1;
-    G->rmax[2] = rm2;
-    G->mod = mod;
+    i = G->axes ? setup_run(m, contact, pts, group_of, i, first_row, gr, G, 1)
+                : setup_run(m, contact, pts, group_of, i, first_row, gr, G, 0);
   }
   w->run[nrun] = first_row;
   w->nrun = nrun;
