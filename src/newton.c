@@ -1337,6 +1337,18 @@ static void lu_row_steps2(double *y, double f, double g, const double *x, const 
   if (g != 0) ss_row_add_scaled(y, -g, z, m);
 }
 
+/* a, b, c and d all nonzero, or else 0 where that is not sure: their
+ * product is 0 or NaN where one is 0 (and NaN where one is NaN), and is
+ * 0 where all are nonzero only by underflow (|p| > 0: neither).  lu_factor's pair of rows
+ * takes its two-row pass only where this holds, else the row by row
+ * updates, which skip a zero multiplier's and give each entry the same
+ * operations otherwise: one product test instead of four compares, each
+ * with its parity test. */
+static inline int all_nonzero4(double a, double b, double c, double d)
+{
+  return fabs((a * b) * (c * d)) > 0;
+}
+
 /* LU with partial pivoting of the n x n matrix A, in place; 0 if
  * singular.  Two elimination steps k, k + 1 at a time: step k's
  * multipliers, its update of column k + 1 (the next pivot's column) and
@@ -1371,7 +1383,7 @@ static int lu_factor(double *A, int *piv, int n)
       double f0 = y0[k], f1 = y1[k], g0 = y0[k + 1] * inv1, g1 = y1[k + 1] * inv1;
       y0[k + 1] = g0;
       y1[k + 1] = g1;
-      if (f0 != 0 && g0 != 0 && f1 != 0 && g1 != 0) {
+      if (all_nonzero4(f0, g0, f1, g1)) {
         lu_rows2_steps2(y0 + k + 2, -f0, -g0, y1 + k + 2, -f1, -g1, x + k + 2, z + k + 2, len);
       } else {
         lu_row_steps2(y0 + k + 2, f0, g0, x + k + 2, z + k + 2, len);
