@@ -1592,7 +1592,13 @@ static void apply_at(const ssModel *m, ssData *d, const Setup *s, const ssNewton
    * at every point) */
   ssContact *contact = d->contact;
   const int np = s->first_row;
-  for (int i = 0; i < np; i++) memcpy(contact[i].lambda, lam + 3 * i, 3 * sizeof(double));
+  int i = 0;
+  /* (two a pass: the loop's own instructions halved) */
+  for (; i + 1 < np; i += 2) {
+    memcpy(contact[i].lambda, lam + 3 * i, 3 * sizeof(double));
+    memcpy(contact[i + 1].lambda, lam + 3 * i + 3, 3 * sizeof(double));
+  }
+  if (i < np) memcpy(contact[i].lambda, lam + 3 * i, 3 * sizeof(double));
   memcpy(d->qvel, d->qvel_free, (size_t)m->nv * sizeof(double));
   /* the links' and joint rows' impulses, summed on their paths, then one
    * solve a system (ss_art_force_apply) */
