@@ -592,10 +592,13 @@ static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint 
   double T = tf * mob;
   lam[0] = ln;
   if (K) K[0] = kn;
-  /* T G_tt, where the group's bound lets it pass IMP_RATIO |v_t| (else
-   * 0: both tests below fail for it as for T G_tt) */
-  double Tg = T * M->gmax > IMP_RATIO * sigma ? T * point_gtt(M->gq, P) : 0;
-  if (!(T > 0) || !(sigma > 0) || Tg > STICK_RATIO * sigma) {
+  /* T G_tt, where the group's bound lets it pass IMP_RATIO |v_t|
+   * (bound); elsewhere both tests below fail for it as they would for
+   * T G_tt, and are not made (nearly every point: two compares and
+   * their products a point less) */
+  const int bound = T * M->gmax > IMP_RATIO * sigma;
+  double Tg = bound ? T * point_gtt(M->gq, P) : 0;
+  if (!(T > 0) || !(sigma > 0) || (bound && Tg > STICK_RATIO * sigma)) {
     /* no shear bound (LOADED), or sticking (STICKS) */
     lam[1] = lam[2] = 0;
     if (K) K[1] = K[2] = K[3] = K[4] = K[5] = 0;
@@ -614,7 +617,7 @@ static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint 
     K[4] = (a - b) * t1 * t2;
     K[5] = -a * (1 - t2 * t2) - b * t2 * t2;
   }
-  return Tg > IMP_RATIO * sigma ? NEAR : LOADED;
+  return bound && Tg > IMP_RATIO * sigma ? NEAR : LOADED;
 }
 
 /* The friction law of an impulse-form point in natural-map form at slip
