@@ -315,6 +315,9 @@ typedef struct Setup {
   int ngroup, nrow, n, first_row;
   int linear;         /* every group's soil is linear (n = 1): its laws
                          need no power (evaluate's own form) */
+  int pow_shear;      /* every group's soil nonlinear, with the power's
+                         series and a shear modulus (K_j > 0): evaluate's
+                         form where their tests compile away */
 } Setup;
 
 /* y_b (omega; v_O, world, about the origin) in a group's frame about its
@@ -871,11 +874,26 @@ static inline __attribute__((always_inline)) void h_sums(const NPoint *pt, const
  * a velocity-form point is near sticking (point_law's NEAR), plus STUCK if one
  * sticks or an impulse-form point has no answer (the evaluation is then
  * no good). */
+/* What a form of the laws' loops knows of its material (evaluate_at,
+ * check_run): nothing, linear soil, or nonlinear soil with the power's
+ * series and a shear modulus; mat_form sets what the form knows in M, so
+ * that the laws' tests of it compile away */
+enum { FORM_ANY, FORM_LINEAR, FORM_POW_SHEAR };
+static inline __attribute__((always_inline)) void mat_form(Mat *M, const int form)
+{
+  if (form == FORM_LINEAR) M->linear = 1;
+  if (form == FORM_POW_SHEAR) {
+    M->linear = 0;
+    M->pser.ok = 1;
+    if (!(M->rj > 0)) __builtin_unreachable();
+  }
+}
+
 static inline __attribute__((always_inline)) int
 evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWork *w,
             const double *y, double *mu, double *F, double *H, double *q,
             double *lam_out, double *restrict K_out, NImpEval *ie, const int with_H,
-            const int with_imp, const int linear)
+            const int with_imp, const int form)
 {
   /* (K_out is there with H: the laws' tests of K compile away) */
   if (with_H && !K_out) __builtin_unreachable();
@@ -898,8 +916,8 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
     if (g != gprev) {
       gprev = g;
       M = w->grp[g].M;
-      /* (the same value, now known where this form is compiled) */
-      if (linear) M.linear = 1;
+      /* (the same values, now known where this form is compiled) */
+      mat_form(&M, form);
     }
     int nl = 0;
     /* the group's velocity in a local (the laws' stores could alias the
@@ -992,18 +1010,23 @@ static int evaluate(const ssModel *m, const ssData *d, const Setup *s,
                     const ssNewtonWork *w, const double *y, double *mu, double *F,
                     double *H, double *q, double *lam_out, double *K, NImpEval *ie)
 {
-  if (w->ns) return evaluate_at(m, d, s, w, y, mu, F, H, q, lam_out, K, ie, 1, 1, 0);
-  return s->linear ? evaluate_at(m, d, s, w, y, mu, F, H, q, lam_out, K, ie, 1, 0, 1)
-                   : evaluate_at(m, d, s, w, y, mu, F, H, q, lam_out, K, ie, 1, 0, 0);
+  if (w->ns) return evaluate_at(m, d, s, w, y, mu, F, H, q, lam_out, K, ie, 1, 1, FORM_ANY);
+  if (s->linear)
+    return evaluate_at(m, d, s, w, y, mu, F, H, q, lam_out, K, ie, 1, 0, FORM_LINEAR);
+  if (s->pow_shear)
+    return evaluate_at(m, d, s, w, y, mu, F, H, q, lam_out, K, ie, 1, 0, FORM_POW_SHEAR);
+  return evaluate_at(m, d, s, w, y, mu, F, H, q, lam_out, K, ie, 1, 0, FORM_ANY);
 }
 
 static inline __attribute__((always_inline)) int
 evaluate_F(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWork *w,
            const double *y, double *mu, double *F, double *lam_out, NImpEval *ie)
 {
-  if (w->ns) return evaluate_at(m, d, s, w, y, mu, F, NULL, NULL, lam_out, NULL, ie, 0, 1, 0);
-  return s->linear ? evaluate_at(m, d, s, w, y, mu, F, NULL, NULL, lam_out, NULL, ie, 0, 0, 1)
-                   : evaluate_at(m, d, s, w, y, mu, F, NULL, NULL, lam_out, NULL, ie, 0, 0, 0);
+  if (w->ns)
+    return evaluate_at(m, d, s, w, y, mu, F, NULL, NULL, lam_out, NULL, ie, 0, 1, FORM_ANY);
+  return s->linear
+             ? evaluate_at(m, d, s, w, y, mu, F, NULL, NULL, lam_out, NULL, ie, 0, 0, FORM_LINEAR)
+             : evaluate_at(m, d, s, w, y, mu, F, NULL, NULL, lam_out, NULL, ie, 0, 0, FORM_ANY);
 }
 
 /* The sweeps' measure of a solve: the largest change |law - lambda|_1 a
@@ -1072,19 +1095,12 @@ static double imp_check(const Mat *M, NPoint *P, const NGroup *G, const double V
  * M) at their group's velocity V (frame about o).  The forms, each
  * compiled for itself as evaluate's are: without impulse-form points
  * (with_imp = 0, most solves) their test a point goes; the material's
- * tests (linear soil, the power's series, a shear modulus) are known
- * where form says so, and compile away. */
-enum { CHECK_ANY, CHECK_LINEAR, CHECK_POW_SHEAR };
+ * tests are known where form says so (mat_form), and compile away. */
 static inline __attribute__((always_inline)) void
 check_run(Mat M, const ssData *d, const ssNewtonWork *w, int g, int i0, int i1,
           const double Vg[6], Measure *q, const int with_imp, const int form)
 {
-  if (form == CHECK_LINEAR) M.linear = 1;
-  if (form == CHECK_POW_SHEAR) {
-    M.linear = 0;
-    M.pser.ok = 1;
-    if (!(M.rj > 0)) __builtin_unreachable();
-  }
+  mat_form(&M, form);
   double V[6];
   memcpy(V, Vg, sizeof V);
   for (int i = i0; i < i1; i++) {
@@ -1121,24 +1137,24 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
     to_group(G, V, w->sum[g].V);
   }
   Measure q = {0, 0, 0};
-  int gprev = -1, form = CHECK_ANY;
+  int gprev = -1, form = FORM_ANY;
   Mat M = {0};
   for (int u = 0; u < w->nrun; u++) {
     const int i0 = w->run[u], i1 = w->run[u + 1], g = w->group_of[i0];
     if (g != gprev) {
       gprev = g;
       M = w->grp[g].M;
-      form = M.linear ? CHECK_LINEAR : M.pser.ok && M.rj > 0 ? CHECK_POW_SHEAR : CHECK_ANY;
+      form = M.linear ? FORM_LINEAR : M.pser.ok && M.rj > 0 ? FORM_POW_SHEAR : FORM_ANY;
     }
     const double *V = w->sum[g].V;
     if (w->ns)
-      check_run(M, d, w, g, i0, i1, V, &q, 1, CHECK_ANY);
-    else if (form == CHECK_POW_SHEAR)
-      check_run(M, d, w, g, i0, i1, V, &q, 0, CHECK_POW_SHEAR);
-    else if (form == CHECK_LINEAR)
-      check_run(M, d, w, g, i0, i1, V, &q, 0, CHECK_LINEAR);
+      check_run(M, d, w, g, i0, i1, V, &q, 1, FORM_ANY);
+    else if (form == FORM_POW_SHEAR)
+      check_run(M, d, w, g, i0, i1, V, &q, 0, FORM_POW_SHEAR);
+    else if (form == FORM_LINEAR)
+      check_run(M, d, w, g, i0, i1, V, &q, 0, FORM_LINEAR);
     else
-      check_run(M, d, w, g, i0, i1, V, &q, 0, CHECK_ANY);
+      check_run(M, d, w, g, i0, i1, V, &q, 0, FORM_ANY);
   }
   for (int r = 0; r < s->nrow; r++) {
     const ssContact *c = d->contact + s->first_row + r;
@@ -1937,7 +1953,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
   w->nrun = nrun;
   int n = 6 * ngroup + nrow;
   if (!work(d, n, 0, 0, ngroup)) return 0;
-  Setup s = {ngroup, nrow, n, first_row, 1};
+  Setup s = {ngroup, nrow, n, first_row, 1, 1};
   for (int g = 0; g < ngroup; g++) s.linear &= w->grp[g].mat->sinkage_exponent == 1.0;
 
   lam_matrix(m, d, &s, w);
@@ -1952,6 +1968,8 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     slip_quadratics(w->grp[g].Lg, w->grp[g].gq);
     w->grp[g].gmax = slip_bound(w->grp[g].gq, w->grp[g].rmax);
     w->grp[g].M = mat_of(w->grp + g, dt);
+    const Mat *M = &w->grp[g].M;
+    s.pow_shear &= !M->linear && M->pser.ok && M->rj > 0;
   }
   unknowns_of(m, d, &s, w, d->qvel_free, w->yfree);
   uint64_t key = unknowns_key(d, &s, w);
