@@ -595,13 +595,17 @@ static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint 
   double T = tf * mob;
   lam[0] = ln;
   if (K) K[0] = kn;
-  /* T G_tt, where the group's bound lets it pass IMP_RATIO |v_t|
-   * (bound); elsewhere both tests below fail for it as they would for
+  /* T G_tt, where the group's bound lets it pass IMP_RATIO |v_t|, and
+   * its two tests (stick, near); elsewhere both fail as they would for
    * T G_tt, and are not made (nearly every point: two compares and
    * their products a point less) */
-  const int bound = T * M->gmax > IMP_RATIO * sigma;
-  double Tg = bound ? T * point_gtt(M->gq, P) : 0;
-  if (!(T > 0) || !(sigma > 0) || (bound && Tg > STICK_RATIO * sigma)) {
+  int stick = 0, near = 0;
+  if (T * M->gmax > IMP_RATIO * sigma) {
+    double Tg = T * point_gtt(M->gq, P);
+    stick = Tg > STICK_RATIO * sigma;
+    near = Tg > IMP_RATIO * sigma;
+  }
+  if (!(T > 0) || !(sigma > 0) || stick) {
     /* no shear bound (LOADED), or sticking (STICKS) */
     lam[1] = lam[2] = 0;
     if (K) K[1] = K[2] = K[3] = K[4] = K[5] = 0;
@@ -620,7 +624,7 @@ static inline __attribute__((always_inline)) int point_law(const Mat *M, NPoint 
     K[4] = (a - b) * t1 * t2;
     K[5] = -a * (1 - t2 * t2) - b * t2 * t2;
   }
-  return bound && Tg > IMP_RATIO * sigma ? NEAR : LOADED;
+  return near ? NEAR : LOADED;
 }
 
 /* The friction law of an impulse-form point in natural-map form at slip
