@@ -519,27 +519,31 @@ static int ltdl_factor(ssArtWork *w)
     double d = fabs(L[w->anc_adr[k]]);
     dmax = d > dmax ? d : dmax;
   }
+  /* the chains' addresses and k's pivot in locals: the row updates'
+   * stores through L would otherwise reload them for every row i */
+  const int *adr = w->anc_adr, *anc = w->anc;
   for (int k = n - 1; k >= 0; k--) {
-    double *Lk = L + w->anc_adr[k];
-    if (!(Lk[0] > 1e-14 * dmax)) return -1 - k;
+    double *Lk = L + adr[k], dk = Lk[0];
+    if (!(dk > 1e-14 * dmax)) return -1 - k;
     /* i runs up k's chain; its own chain is the rest of k's, so row i's
-     * entries are row k's from t on, both contiguous: the updates two at a
-     * time */
-    const int *ak = w->anc + w->anc_adr[k];
-    const int nk = w->anc_adr[k + 1] - w->anc_adr[k];
+     * entries are row k's from t on, both contiguous: an odd row's first
+     * entry alone, then the updates two at a time (each entry's one update
+     * the same operation wherever it falls) */
+    const int *ak = anc + adr[k];
+    const int nk = adr[k + 1] - adr[k];
     for (int t = 1; t < nk; t++) {
-      double a = Lk[t] / Lk[0], *Li = L + w->anc_adr[ak[t]];
+      double a = Lk[t] / dk, *Li = L + adr[ak[t]];
       const double *lk = Lk + t;
       ssV2 av = {a, a};
-      int u = 0, m = nk - t;
-      for (; u + 2 <= m; u += 2) {
+      int m = nk - t, u = m & 1;
+      if (u) Li[0] -= a * lk[0];
+      for (; u < m; u += 2) {
         ssV2 x, y;
         memcpy(&x, lk + u, sizeof x);
         memcpy(&y, Li + u, sizeof y);
         y -= av * x;
         memcpy(Li + u, &y, sizeof y);
       }
-      if (u < m) Li[u] -= a * lk[u];
       Lk[t] = a;
     }
   }
@@ -1139,12 +1143,15 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
     memset(Js, 0, (size_t)n * sizeof(double));
     point_rows(m, w, b1, p1, dv, 1, 1, Js, n);
     point_rows(m, w, b2, p2, dv, 1, -1, Js, n);
-    double ldot = 0;
-    for (int i = 0; i < n; i++) ldot += Js[i] * u[i];
     double tension = par[0] * (len - par[2]);
-    if (is_ancestor(m, b1, b2) || is_ancestor(m, b2, b1)) {
+    int low = is_ancestor(m, b1, b2) ? b2 : is_ancestor(m, b2, b1) ? b1 : -1;
+    if (low >= 0) {
       double c = dt * (par[1] + dt * par[0]);
-      for (int i = 0; i < n; i++) {
+      /* Js is zero off the deeper end's path (both paths are on it): its
+       * dofs i, in any order (each writes only L's row i and rhs_i) */
+      const int *path = w->anc + w->padr[low - b0];
+      for (int q = 0; q < w->npath[low - b0]; q++) {
+        int i = path[q];
         if (Js[i] == 0) continue;
         /* (the chain's pairs only, all on the tree's pattern: i and its
          * ancestors j in L's row i) */
@@ -1155,6 +1162,9 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
         w->rhs[i] -= dt * tension * Js[i];
       }
     } else {
+      /* the rate of extension (the explicit force's only use) */
+      double ldot = 0;
+      for (int i = 0; i < n; i++) ldot += Js[i] * u[i];
       double f = tension + par[1] * ldot;
       for (int i = 0; i < n; i++) w->rhs[i] -= dt * f * Js[i];
     }
