@@ -22,6 +22,10 @@ struct ssArtWork {
                             and solves' loops read their dofs from it: a
                             parent's index is then no load that waits for
                             the last one) */
+  int *arel;             /* (sum of depths) anc_adr[anc[q]] - q: where entry
+                            q's dof's own chain starts, less q (reduce's
+                            L_{path[i] path[t]}, path a chain at anc + a, is
+                            L[arel[a + i] + a + t], one load for three) */
   int *dsc, *dsc_adr;    /* (2 (sum of depths - nv)), (nv + 1): the dofs i
                             whose chains hold dof k below i, descending, at
                             dsc + 2 dsc_adr[k], each as i and the entry's
@@ -228,6 +232,7 @@ void ss_art_work_free(ssArtWork *w)
 {
   if (!w) return;
   free(w->eq); free(w->dof_body); free(w->dof_parent); free(w->anc); free(w->anc_adr);
+  free(w->arel);
   free(w->dsc); free(w->dsc_adr); free(w->live);
   free(w->S);
   free(w->vel); free(w->acc); free(w->frc); free(w->Ic);
@@ -319,7 +324,8 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
   w->anc = malloc((size_t)(nanc ? nanc : 1) * sizeof(int));
   w->anc_adr = malloc((nv + 1) * sizeof(int));
   w->L = malloc((size_t)(nanc ? nanc : 1) * sizeof(double));
-  if (!w->anc || !w->anc_adr || !w->L) {
+  w->arel = malloc((size_t)(nanc ? nanc : 1) * sizeof(int));
+  if (!w->anc || !w->anc_adr || !w->L || !w->arel) {
     ss_art_work_free(w);
     return NULL;
   }
@@ -329,6 +335,7 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
     for (int j = k; j >= 0; j = w->dof_parent[j]) w->anc[nanc++] = j;
   }
   w->anc_adr[w->nv] = nanc;
+  for (int q = 0; q < nanc; q++) w->arel[q] = w->anc_adr[w->anc[q]] - q;
   /* each link's path: the chain of its last dof (none: empty) */
   for (int lb = 0; lb < w->nb; lb++) {
     int top = last_dof(m, w, w->b0 + lb);
@@ -680,7 +687,7 @@ static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
 /* r (length nv) += s * (point Jacobian row along dir of world point p on
  * body b): sum over path dofs of dir . (v_k + w_k x p); for nd <= 3
  * directions at once (dir (nd x 3), row q at r + q ld: a pin's three rows),
- * in one walk of the path with each S_k loaded once (in a local: the rows'
+ * in one walk of the path with each S_k loaded once (in locals: the rows'
  * stores would make it a reload per row) */
 static inline void point_rows(const ssModel *m, const ssArtWork *w, int b, const double p[3],
                               const double *dir, int nd, double s, double *r, int ld)
@@ -692,10 +699,15 @@ static inline void point_rows(const ssModel *m, const ssArtWork *w, int b, const
     if (!na) continue;
     int k0 = m->body_dofadr[a] - w->v0;
     for (int k = k0; k < k0 + na; k++) {
-      double c[6];
-      memcpy(c, w->S + 6 * k, sizeof c);
-      for (int q = 0; q < nd; q++)
-        r[q * ld + k] += s * (ss_v3_dot(c + 3, dir + 3 * q) + ss_v3_dot(c, pxd + 3 * q));
+      /* six scalars (a copied array stayed on the stack: a store and a
+       * load more each); the sums as ss_v3_dot's */
+      const double *Sk = w->S + 6 * k;
+      double c0 = Sk[0], c1 = Sk[1], c2 = Sk[2], c3 = Sk[3], c4 = Sk[4], c5 = Sk[5];
+      for (int q = 0; q < nd; q++) {
+        const double *e = dir + 3 * q, *f = pxd + 3 * q;
+        r[q * ld + k] +=
+            s * ((c3 * e[0] + c4 * e[1] + c5 * e[2]) + (c0 * f[0] + c1 * f[1] + c2 * f[2]));
+      }
     }
   }
 }
@@ -1223,13 +1235,15 @@ static void reduce(ssArtWork *w, const int *path, int np, int ncol, double *X, d
                    double *W)
 {
   int nr = w->nrow;
+  const int *rel = w->arel + (path - w->anc);
   /* the tree solve's first sweep on the path: row t takes -L_{path[i]
    * path[t]} X_path[i] from each i < t in turn (path[i]'s chain is the path
-   * from i on: that entry at t - i), the sum of row updates pulled into
-   * registers (the same operations in the same order: x - h y rounds as
-   * their x + (-h) y, ss_math.h), then X/D */
+   * from i on: that entry at t - i, Lt[rel[i]]), the sum of row updates
+   * pulled into registers (the same operations in the same order: x - h y
+   * rounds as their x + (-h) y, ss_math.h), then X/D */
   for (int t = 0; t < np; t++) {
     int k = path[t];
+    const double *Lt = w->L + (path - w->anc) + t;
     double d = w->L[w->anc_adr[k]];
     if (ncol == 6) {
       ssV2 a0, a1, a2, x0, x1, x2;
@@ -1237,7 +1251,7 @@ static void reduce(ssArtWork *w, const int *path, int np, int ncol, double *X, d
       memcpy(&a1, w->S + 6 * k + 2, sizeof a1);
       memcpy(&a2, w->S + 6 * k + 4, sizeof a2);
       for (int i = 0; i < t; i++) {
-        const double *xi = X + 6 * i, h = w->L[w->anc_adr[path[i]] + t - i];
+        const double *xi = X + 6 * i, h = Lt[rel[i]];
         ssV2 hv = {h, h};
         memcpy(&x0, xi, sizeof x0);
         memcpy(&x1, xi + 2, sizeof x1);
@@ -1258,7 +1272,7 @@ static void reduce(ssArtWork *w, const int *path, int np, int ncol, double *X, d
       memcpy(XD + 6 * t + 4, &a2, sizeof a2);
     } else {
       double x = t == 0;
-      for (int i = 0; i < t; i++) x -= w->L[w->anc_adr[path[i]] + t - i] * X[i];
+      for (int i = 0; i < t; i++) x -= Lt[rel[i]] * X[i];
       X[t] = x;
       XD[t] = x / d;
     }
@@ -1458,8 +1472,11 @@ probe_pair(const ssArtWork *w, Probe a, Probe b, int ca, int cb, double *out, in
       for (int k = i, l = j; k < a.np; k++, l++)
         rows3_sum(s, a.X + 6 * k + r0, b.XD + 6 * l, 0);
       for (int k = 0; k < nr; k++) rows3_sum(s, a.W + 6 * k + r0, b.W + 6 * k, 1);
+      /* a pair at a time (one copy of a row's three would keep s in
+       * memory, zeroed there and stored after each sum) */
       for (int r = 0; r < 3; r++)
-        memcpy(out + (size_t)ldo * (r0 + r), s + 3 * r, 6 * sizeof(double));
+        for (int q = 0; q < 3; q++)
+          memcpy(out + (size_t)ldo * (r0 + r) + 2 * q, &s[3 * r + q], sizeof s[0]);
     }
     return;
   }
