@@ -63,6 +63,10 @@ struct ssArtWork {
    * and X_b / D (M'^-1 = T^T D^-1 T, T = L^-T the tree solve's first
    * sweep), and W_b = L_A^-1 K M'^-1 J_b^T (nr x 6, A = L_A L_A^T) */
   int *padr, *npath;     /* (nb) b's path, its last dof's chain: npath dofs of anc from padr */
+  int *bord;             /* (sum of depths) each chain of anc with every
+                            body's dofs ascending (the bodies from the
+                            chain's first up): a link's path at bord + padr
+                            in the order of a walk of its bodies */
   double *Xp, *XD;       /* (nb x nv x 6), rows on the path */
   double *Wp;            /* (nb x nr x 6) */
   unsigned char *Xok;    /* (nb) valid for this step */
@@ -232,7 +236,7 @@ void ss_art_work_free(ssArtWork *w)
 {
   if (!w) return;
   free(w->eq); free(w->dof_body); free(w->dof_parent); free(w->anc); free(w->anc_adr);
-  free(w->arel);
+  free(w->arel); free(w->bord);
   free(w->dsc); free(w->dsc_adr); free(w->live);
   free(w->S);
   free(w->vel); free(w->acc); free(w->frc); free(w->Ic);
@@ -325,7 +329,8 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
   w->anc_adr = malloc((nv + 1) * sizeof(int));
   w->L = malloc((size_t)(nanc ? nanc : 1) * sizeof(double));
   w->arel = malloc((size_t)(nanc ? nanc : 1) * sizeof(int));
-  if (!w->anc || !w->anc_adr || !w->L || !w->arel) {
+  w->bord = malloc((size_t)(nanc ? nanc : 1) * sizeof(int));
+  if (!w->anc || !w->anc_adr || !w->L || !w->arel || !w->bord) {
     ss_art_work_free(w);
     return NULL;
   }
@@ -336,6 +341,14 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
   }
   w->anc_adr[w->nv] = nanc;
   for (int q = 0; q < nanc; q++) w->arel[q] = w->anc_adr[w->anc[q]] - q;
+  /* a chain's runs of one body's dofs (descending in anc) reversed */
+  for (int k = 0; k < w->nv; k++)
+    for (int q = w->anc_adr[k], e; q < w->anc_adr[k + 1]; q = e) {
+      for (e = q + 1; e < w->anc_adr[k + 1] && w->dof_body[w->anc[e]] == w->dof_body[w->anc[q]];
+           e++) {
+      }
+      for (int i = q; i < e; i++) w->bord[i] = w->anc[q + e - 1 - i];
+    }
   /* each link's path: the chain of its last dof (none: empty) */
   for (int lb = 0; lb < w->nb; lb++) {
     int top = last_dof(m, w, w->b0 + lb);
@@ -400,9 +413,12 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
 /* kinematics                                                              */
 
 /* World pose of every body of system s from qpos (xpos, xquat per body,
- * indexed by body - first body). */
+ * indexed by body - first body), and where xmat is not NULL its rotation
+ * matrix (xmat, the same indexing): each body's matrix formed once, from
+ * its final quaternion, serves its children's joints as well (the bits of
+ * the matrix they would form from it) */
 static void kinematics(const ssModel *m, int s, const double *qpos,
-                       double *xpos, double *xquat)
+                       double *xpos, double *xquat, double *xmat)
 {
   int b0 = m->sys_bodyadr[s];
   for (int lb = 0; lb < m->sys_nbody[s]; lb++) {
@@ -417,11 +433,17 @@ static void kinematics(const ssModel *m, int s, const double *qpos,
         memcpy(p, m->body_jntpos + 3 * b, 3 * sizeof(double));
         memcpy(q, m->body_jntquat + 4 * b, 4 * sizeof(double));
       }
+      if (xmat) ss_quat_to_mat(xmat + 9 * lb, q);
       continue;
     }
-    const double *pp = xpos + 3 * (par - b0), *pq = xquat + 4 * (par - b0);
-    double Rp[9], off[3], jq[4];
-    ss_quat_to_mat(Rp, pq);
+    const double *pp = xpos + 3 * (par - b0), *pq = xquat + 4 * (par - b0), *Rp;
+    double Rl[9], off[3], jq[4];
+    if (xmat) {
+      Rp = xmat + 9 * (par - b0);
+    } else {
+      ss_quat_to_mat(Rl, pq);
+      Rp = Rl;
+    }
     ss_m3_mulv(off, Rp, m->body_jntpos + 3 * b);
     ss_v3_add(p, pp, off);
     ss_quat_mul(jq, pq, m->body_jntquat + 4 * b);
@@ -449,6 +471,7 @@ static void kinematics(const ssModel *m, int s, const double *qpos,
       break;
     }
     ss_quat_normalize(q);
+    if (xmat) ss_quat_to_mat(xmat + 9 * lb, q);
   }
 }
 
@@ -456,11 +479,12 @@ void ss_art_forward(const ssModel *m, ssData *d, int s)
 {
   ssArtWork *w = d->art[s];
   int b0 = w->b0;
-  kinematics(m, s, d->qpos, d->body_xpos + 3 * b0, d->body_xquat + 4 * b0);
+  kinematics(m, s, d->qpos, d->body_xpos + 3 * b0, d->body_xquat + 4 * b0,
+             d->body_xmat + 9 * b0);
   for (int lb = 0; lb < w->nb; lb++) {
     int b = b0 + lb;
-    double *R = d->body_xmat + 9 * b, *p = d->body_xpos + 3 * b, off[3];
-    ss_quat_to_mat(R, d->body_xquat + 4 * b);
+    const double *R = d->body_xmat + 9 * b, *p = d->body_xpos + 3 * b;
+    double off[3];
     ss_m3_mulv(off, R, m->body_ipos + 3 * b);
     ss_v3_add(d->body_xipos + 3 * b, p, off);
     int nd = m->body_ndof[b];
@@ -1619,12 +1643,19 @@ void ss_art_link_motion_cols(const ssModel *m, const ssData *d, int b, const dou
                              int ldu, int ncol, double *out, int ldo)
 {
   const ssArtWork *w = d->art[m->body_sys[b]];
+  const int *path = w->bord + w->padr[b - w->b0];
+  int np = w->npath[b - w->b0];
   for (int c = 0; c < ncol; c++) {
-    /* each body's dofs in turn from b's, the sums from +0 */
+    /* each body's dofs in turn from b's (its path in bord: no walk of the
+     * bodies), the sums from +0 */
     ssV2 p[3] = {{0, 0}, {0, 0}, {0, 0}};
-    for (int a = b; a >= 0; a = m->body_parent[a]) {
-      int nd = m->body_ndof[a];
-      if (nd) add_motion(p, w->S, m->body_dofadr[a] - w->v0, nd, U + c, (size_t)ldu);
+    for (int t = 0; t < np; t++) {
+      int k = path[t];
+      ssV2 uk = {U[(size_t)ldu * k + c], U[(size_t)ldu * k + c]}, sk;
+      for (int i = 0; i < 3; i++) {
+        memcpy(&sk, w->S + 6 * k + 2 * i, sizeof sk);
+        p[i] += sk * uk;
+      }
     }
     double V[6];
     memcpy(V, p, sizeof V);
@@ -1971,7 +2002,7 @@ int ss_model_add_articulated(ssModel *m, const ssUrdf *u, const ssArtDef *def,
     goto fail;
   }
   double *xq = xp + 3 * m->sys_nbody[s];
-  kinematics(m, s, m->qpos0, xp, xq);
+  kinematics(m, s, m->qpos0, xp, xq, NULL);
   int b0 = m->sys_bodyadr[s];
 #define WORLD_POINT(b, local, out)                                             \
   do {                                                                         \
