@@ -670,6 +670,14 @@ static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
       }
       w->live[k] = live;
     }
+  } else if (m == 1) {
+    /* one column (a velocity, a sum of impulses): x_j - h x_i where the
+     * rows' update adds (-h) x_i, the same bits without a negation each */
+    for (int i = n - 1; i >= 0; i--) {
+      double xi = X[i];
+      if (xi == 0) continue;
+      for (int t = w->anc_adr[i] + 1; t < w->anc_adr[i + 1]; t++) X[w->anc[t]] -= L[t] * xi;
+    }
   } else {
     for (int i = n - 1; i >= 0; i--) {
       const double *xi = X + (size_t)m * i;
@@ -811,9 +819,18 @@ static void factor_closures(ssArtWork *w)
 {
   int n = w->nv, nr = w->nrow;
   w->rank_deficient = 0;
-  /* MiKT = M'^-1 K^T, its nr columns solved together */
-  for (int i = 0; i < n; i++)
-    for (int r = 0; r < nr; r++) w->MiKT[(size_t)i * nr + r] = w->K[(size_t)r * n + i];
+  /* MiKT = M'^-1 K^T, its nr columns solved together (K^T two entries of
+   * a row at a time, one store each pair) */
+  for (int i = 0; i < n; i++) {
+    const double *ki = w->K + i;
+    double *mi = w->MiKT + (size_t)i * nr;
+    int r = 0;
+    for (; r + 2 <= nr; r += 2) {
+      ssV2 v = {ki[(size_t)r * n], ki[(size_t)(r + 1) * n]};
+      memcpy(mi + r, &v, sizeof v);
+    }
+    if (r < nr) mi[r] = ki[(size_t)r * n];
+  }
   ltdl_solve(w, w->MiKT, nr);
   /* A = K MiKT (lower triangle, row by row over K's nonzeros, in pairs
    * (ss_row_add_scaled, whose loop the compiler need not guard against
