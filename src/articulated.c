@@ -758,14 +758,17 @@ static void path_zero(const ssModel *m, const ssArtWork *w, int b, double *r, in
     for (int q = 0; q < nd; q++) r[q * ld + k] = 0;
 }
 
-/* closure rows K (nrow x nv) and residual phi at the current kinematics.
- * A row's entries on its two bodies' paths are zeroed and summed anew;
- * the rest of the row is never written and stays the zeros of K's calloc
- * (the closures and their rows are fixed), without a memset per call */
-static void closures(const ssModel *m, const ssData *d, ssArtWork *w)
+/* closure residual phi and, with rows, closure rows K (nrow x nv) at the
+ * current kinematics (phi's bits the same either way).  A row's entries on
+ * its two bodies' paths are zeroed and summed anew; the rest of the row is
+ * never written and stays the zeros of K's calloc (the closures and their
+ * rows are fixed), without a memset per call.  Without rows K is left as
+ * it was (clo_gen says where it stands): the drift loop's chord steps read
+ * phi alone */
+static void closures(const ssModel *m, const ssData *d, ssArtWork *w, int rows)
 {
   int n = w->nv, r = 0;
-  w->clo_gen = w->kin_gen;
+  if (rows) w->clo_gen = w->kin_gen;
   for (int e = 0; e < w->neq; e++) {
     int k = w->eq[e], b1 = m->eq_body[2 * k], b2 = m->eq_body[2 * k + 1];
     const double *an = m->eq_anchor + 6 * k;
@@ -778,11 +781,12 @@ static void closures(const ssModel *m, const ssData *d, ssArtWork *w)
       const double dir[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
       double *Kr = w->K + (size_t)r * n;
       for (int i = 0; i < 3; i++) w->phi[r + i] = p1[i] - p2[i];
+      r += 3;
+      if (!rows) break;
       path_zero(m, w, b1, Kr, 3, n);
       path_zero(m, w, b2, Kr, 3, n);
       point_rows(m, w, b1, p1, dir, 3, 1, Kr, n);
       point_rows(m, w, b2, p2, dir, 3, -1, Kr, n);
-      r += 3;
       break;
     }
     case SS_CLOSURE_DISTANCE: {
@@ -790,23 +794,25 @@ static void closures(const ssModel *m, const ssData *d, ssArtWork *w)
       body_point(d, b1, an, p1);
       body_point(d, b2, an + 3, p2);
       ss_v3_sub(dv, p1, p2);
-      double len = ss_v3_normalize(dv);
-      w->phi[r] = len - m->eq_data[2 * k];
-      path_zero(m, w, b1, w->K + (size_t)r * n, 1, n);
-      path_zero(m, w, b2, w->K + (size_t)r * n, 1, n);
-      point_rows(m, w, b1, p1, dv, 1, 1, w->K + (size_t)r * n, n);
-      point_rows(m, w, b2, p2, dv, 1, -1, w->K + (size_t)r * n, n);
-      r++;
+      double len = ss_v3_normalize(dv), *Kr = w->K + (size_t)r * n;
+      w->phi[r++] = len - m->eq_data[2 * k];
+      if (!rows) break;
+      path_zero(m, w, b1, Kr, 1, n);
+      path_zero(m, w, b2, Kr, 1, n);
+      point_rows(m, w, b1, p1, dv, 1, 1, Kr, n);
+      point_rows(m, w, b2, p2, dv, 1, -1, Kr, n);
       break;
     }
     case SS_CLOSURE_EQUALITY: {
       double ratio = m->eq_data[2 * k], off = m->eq_data[2 * k + 1];
-      w->phi[r] = d->qpos[m->body_qadr[b1]] - ratio * d->qpos[m->body_qadr[b2]] - off;
-      w->K[(size_t)r * n + m->body_dofadr[b1] - w->v0] = 0;
-      w->K[(size_t)r * n + m->body_dofadr[b2] - w->v0] = 0;
-      w->K[(size_t)r * n + m->body_dofadr[b1] - w->v0] += 1;
-      w->K[(size_t)r * n + m->body_dofadr[b2] - w->v0] -= ratio;
-      r++;
+      double *Kr = w->K + (size_t)r * n;
+      int k1 = m->body_dofadr[b1] - w->v0, k2 = m->body_dofadr[b2] - w->v0;
+      w->phi[r++] = d->qpos[m->body_qadr[b1]] - ratio * d->qpos[m->body_qadr[b2]] - off;
+      if (!rows) break;
+      Kr[k1] = 0;
+      Kr[k2] = 0;
+      Kr[k1] += 1;
+      Kr[k2] -= ratio;
       break;
     }
     }
@@ -1237,7 +1243,7 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
     /* K and phi stand where the poses do since closures formed them (the
      * closure projection's last pass of the step before, whose poses this
      * step kept: ss_forward_step) */
-    if (w->clo_gen != w->kin_gen) closures(m, d, w);
+    if (w->clo_gen != w->kin_gen) closures(m, d, w, 1);
     factor_closures(w);
     project(w, u);
   }
@@ -1731,7 +1737,7 @@ double ss_art_closure_error(const ssModel *m, ssData *d, int s)
   ssArtWork *w = d->art[s];
   if (!w->nrow) return 0;
   ss_art_forward(m, d, s);
-  closures(m, d, w);
+  closures(m, d, w, 0);
   double e = 0;
   for (int r = 0; r < w->nrow; r++) e = fmax(e, fabs(w->phi[r]));
   return e;
@@ -1754,14 +1760,20 @@ void ss_art_integrate(const ssModel *m, ssData *d, int s)
   if (!zz) return;
   for (int it = 0; it < 12; it++) {
     ss_art_forward(m, d, s);
-    closures(m, d, w);
+    closures(m, d, w, 0);
     err = 0;
     for (int r = 0; r < w->nrow; r++) {
       double e = fabs(w->phi[r]);
       err = e > err ? e : err; /* fmax's maximum, without its call */
     }
     if (err < 1e-13) break;
-    if (!(err <= 0.25 * prev)) factor_closures(w);
+    /* K at these poses only where A is refactored (the chord steps keep
+     * the step's K and A; ss_art_free_velocity forms K where the loop
+     * leaves it stale: the same rows) */
+    if (!(err <= 0.25 * prev)) {
+      closures(m, d, w, 1);
+      factor_closures(w);
+    }
     prev = err;
     memcpy(zz, w->phi, (size_t)w->nrow * sizeof(double));
     closure_solve(w, zz, 1);
@@ -1824,7 +1836,7 @@ static ssStatus check_closures(ssModel *m, int s, ssError *err)
   ssStatus st = SS_OK;
   if (w->nrow) {
     ss_forward(m, d);
-    closures(m, d, w);
+    closures(m, d, w, 1);
     int n = w->nv, r = 0;
     double *Q = calloc((size_t)w->nrow * (n ? n : 1), sizeof(double));
     if (!Q) st = ss_error_set(err, SS_ERR_NOMEM, m->source_path, 0, "out of memory");
