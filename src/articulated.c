@@ -39,7 +39,6 @@ struct ssArtWork {
   double *Ic;            /* (nb x 36) composite inertias, world, by columns
                             (entry ij at 6 j + i: m6v_cols); the bodies'
                             own spatial inertias until the backward pass */
-  double *M;             /* (nv x nv) the mass matrix M (the CRBA's) */
   double *L;             /* (sum of depths) M' = M + implicit terms on the
                             tree's pattern, then its LTDL factor, row k along
                             k's chain: L[anc_adr[k] + t] is L_kj, j =
@@ -240,7 +239,7 @@ void ss_art_work_free(ssArtWork *w)
   free(w->dsc); free(w->dsc_adr); free(w->live);
   free(w->S);
   free(w->vel); free(w->acc); free(w->frc); free(w->Ic);
-  free(w->M); free(w->L); free(w->rhs); free(w->x); free(w->y);
+  free(w->L); free(w->rhs); free(w->x); free(w->y);
   free(w->K); free(w->phi); free(w->MiKT); free(w->A); free(w->Z); free(w->row_on);
   free(w->Y); free(w->Lam); free(w->Yok);
   free(w->padr); free(w->npath); free(w->Xp); free(w->XD); free(w->Wp); free(w->Xok);
@@ -268,7 +267,6 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
   w->acc = calloc(nb * 6, sizeof(double));
   w->frc = calloc(nb * 6, sizeof(double));
   w->Ic = calloc(nb * 36, sizeof(double));
-  w->M = calloc(nv * nv, sizeof(double));
   w->rhs = calloc(nv, sizeof(double));
   w->x = calloc(nv, sizeof(double));
   w->y = calloc(nv > nr ? nv : nr, sizeof(double));
@@ -301,7 +299,7 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
     return NULL;
   }
   if (!w->eq || !w->dof_body || !w->dof_parent || !w->S || !w->vel || !w->acc ||
-      !w->frc || !w->Ic || !w->M || !w->rhs || !w->x || !w->y ||
+      !w->frc || !w->Ic || !w->rhs || !w->x || !w->y ||
       !w->K || !w->phi || !w->MiKT || !w->A || !w->Z || !w->row_on || !w->Y || !w->Lam ||
       !w->Yok) {
     ss_art_work_free(w);
@@ -1134,11 +1132,10 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
     }
   }
 
-  /* CRBA: M[k][j] = S_j . (Ic_b S_k) for j on the path of k, into M (for
-   * M u) and into M' on the tree's pattern (L, where the dampers and
-   * springs below add their implicit terms and ltdl_factor factors it).
-   * These are the only entries of M ever written, each step anew: the
-   * others stay the zeros of M's calloc, without a memset a step */
+  /* CRBA: M[k][j] = S_j . (Ic_b S_k) for j on the path of k, into M' on
+   * the tree's pattern (L, where M u reads them, and the dampers and
+   * springs below add their implicit terms and ltdl_factor factors it);
+   * M's other entries are zero */
   for (int lb = 0; lb < w->nb; lb++) {
     int b = b0 + lb, nd = m->body_ndof[b];
     if (!nd) continue;
@@ -1156,22 +1153,30 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
         const double *s0 = w->S + 6 * j0, *s1 = w->S + 6 * j1;
         ssV2 v = (ssV2){s0[0], s1[0]} * f[0];
         for (int i = 1; i < 6; i++) v += (ssV2){s0[i], s1[i]} * f[i];
-        w->M[k * n + j0] = w->M[j0 * n + k] = w->L[t] = v[0];
-        w->M[k * n + j1] = w->M[j1 * n + k] = w->L[t + 1] = v[1];
+        w->L[t] = v[0];
+        w->L[t + 1] = v[1];
       }
       if (t < te) {
         int j = w->anc[t];
-        double v = dot6(w->S + 6 * j, F);
-        w->M[k * n + j] = w->M[j * n + k] = v;
-        w->L[t] = v;
+        w->L[t] = dot6(w->S + 6 * j, F);
       }
     }
   }
 
-  /* rhs = M u + dt (-c + explicit forces); implicit terms go into M' */
-  double *Mu = w->x;
-  mat_vec(w->M, n, n, u, Mu);
-  for (int i = 0; i < n; i++) w->rhs[i] = Mu[i] + dt * w->rhs[i];
+  /* rhs = M u + dt (-c + explicit forces); implicit terms go into M'.
+   * Row k of M u sums over j ascending from +0, as a dense row would, but
+   * over the tree's pattern alone: k's ancestors and k (its chain in L,
+   * reversed), then its descendants i (dsc reversed; M_ki = M_ik, L's entry
+   * of row i).  The terms left out are M_kj u_j = 0 x u_j, +-0 for the
+   * finite u that a step starts from, which leave a sum from +0 as it
+   * stands (it is never -0) */
+  for (int k = 0; k < n; k++) {
+    double sum = 0;
+    for (int t = w->anc_adr[k + 1] - 1; t >= w->anc_adr[k]; t--) sum += w->L[t] * u[w->anc[t]];
+    for (int q = w->dsc_adr[k + 1] - 1; q >= w->dsc_adr[k]; q--)
+      sum += w->L[w->dsc[2 * q + 1]] * u[w->dsc[2 * q]];
+    w->rhs[k] = sum + dt * w->rhs[k];
+  }
 
   /* joint dampers and springs, implicit (into M' = L: a dof's diagonal
    * leads its chain) */
