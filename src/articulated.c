@@ -473,12 +473,25 @@ static void kinematics(const ssModel *m, int s, const double *qpos,
   }
 }
 
-void ss_art_forward(const ssModel *m, ssData *d, int s)
+/* ss_art_forward in two halves: the poses (kin_q is their qpos; kin_ok
+ * stays 0 until the second half), then the centres of mass and motion
+ * subspaces, which the closure-drift passes that read phi alone do
+ * without */
+static void forward_poses(const ssModel *m, ssData *d, int s)
 {
   ssArtWork *w = d->art[s];
   int b0 = w->b0;
   kinematics(m, s, d->qpos, d->body_xpos + 3 * b0, d->body_xquat + 4 * b0,
              d->body_xmat + 9 * b0);
+  memcpy(w->kin_q, d->qpos + m->sys_qadr[s], (size_t)m->sys_nq[s] * sizeof(double));
+  w->kin_ok = 0;
+  w->kin_gen++;
+}
+
+static void forward_rest(const ssModel *m, ssData *d, int s)
+{
+  ssArtWork *w = d->art[s];
+  int b0 = w->b0;
   for (int lb = 0; lb < w->nb; lb++) {
     int b = b0 + lb;
     const double *R = d->body_xmat + 9 * b, *p = d->body_xpos + 3 * b;
@@ -518,9 +531,13 @@ void ss_art_forward(const ssModel *m, ssData *d, int s)
       break;
     }
   }
-  memcpy(w->kin_q, d->qpos + m->sys_qadr[s], (size_t)m->sys_nq[s] * sizeof(double));
   w->kin_ok = 1;
-  w->kin_gen++;
+}
+
+void ss_art_forward(const ssModel *m, ssData *d, int s)
+{
+  forward_poses(m, d, s);
+  forward_rest(m, d, s);
 }
 
 /* (articulated.h) */
@@ -1764,7 +1781,7 @@ void ss_art_integrate(const ssModel *m, ssData *d, int s)
   double *zz = w->nrow <= 64 ? z : malloc((size_t)w->nrow * sizeof(double));
   if (!zz) return;
   for (int it = 0; it < 12; it++) {
-    ss_art_forward(m, d, s);
+    forward_poses(m, d, s);
     closures(m, d, w, 0);
     err = 0;
     for (int r = 0; r < w->nrow; r++) {
@@ -1776,6 +1793,7 @@ void ss_art_integrate(const ssModel *m, ssData *d, int s)
      * the step's K and A; ss_art_free_velocity forms K where the loop
      * leaves it stale: the same rows) */
     if (!(err <= 0.25 * prev)) {
+      forward_rest(m, d, s); /* (K reads S) */
       closures(m, d, w, 1);
       factor_closures(w);
     }
@@ -1787,6 +1805,10 @@ void ss_art_integrate(const ssModel *m, ssData *d, int s)
     for (int k = 0; k < w->nv; k++) du[k] = -du[k];
     advance(m, d, w, du, 1);
   }
+  /* the last poses' centres of mass and subspaces, where a refactoring
+   * pass has not formed them (at the poses ss_art_forward would form them
+   * at: those of kin_q) */
+  if (!w->kin_ok) forward_rest(m, d, s);
   if (err > d->closure_error) d->closure_error = err;
   if (zz != z) free(zz);
 }
