@@ -78,6 +78,9 @@ struct ssArtWork {
   double *kin_q;         /* (the system's nq) the qpos of the last
                             ss_art_forward, whose poses and S stand */
   int kin_ok;            /* 0: no ss_art_forward yet */
+  unsigned char *clo_body; /* (nb) 1: a closure's body or an ancestor of one
+                            (the poses phi reads) */
+  int kin_part;          /* 1: forward_poses posed only the clo_body bodies */
   uint64_t kin_gen;      /* ss_art_forward's runs */
   uint64_t clo_gen;      /* kin_gen where closures last formed K and phi
                             (they depend on the poses, S and qpos alone) */
@@ -244,7 +247,7 @@ void ss_art_work_free(ssArtWork *w)
   free(w->Y); free(w->Lam); free(w->Yok);
   free(w->padr); free(w->npath); free(w->Xp); free(w->XD); free(w->Wp); free(w->Xok);
   free(w->fsum); free(w->Xd); free(w->XDd); free(w->Wd);
-  free(w->dok); free(w->kin_q); free(w->kcol); free(w->nkcol);
+  free(w->dok); free(w->kin_q); free(w->clo_body); free(w->kcol); free(w->nkcol);
   free(w);
 }
 
@@ -291,10 +294,11 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
   w->Wd = calloc(nv * nr, sizeof(double));
   w->dok = calloc(nv, 1);
   w->kin_q = calloc(m->sys_nq[s] ? (size_t)m->sys_nq[s] : 1, sizeof(double));
+  w->clo_body = calloc(nb ? nb : 1, 1);
   w->kcol = calloc(nr * nv, sizeof(int));
   w->nkcol = calloc(nr, sizeof(int));
-  if (!w->kin_q || !w->kcol || !w->nkcol || !w->padr || !w->npath || !w->Xp || !w->XD ||
-      !w->Wp || !w->Xok || !w->fsum || !w->Xd || !w->XDd || !w->Wd || !w->dok) {
+  if (!w->kin_q || !w->clo_body || !w->kcol || !w->nkcol || !w->padr || !w->npath ||
+      !w->Xp || !w->XD || !w->Wp || !w->Xok || !w->fsum || !w->Xd || !w->XDd || !w->Wd || !w->dok) {
     ss_art_work_free(w);
     return NULL;
   }
@@ -306,6 +310,11 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
     return NULL;
   }
   sys_closures(m, s, w->eq, NULL);
+  /* the bodies whose poses phi reads: the closures' and their ancestors */
+  for (int e = 0; e < w->neq; e++)
+    for (int q = 0; q < 2; q++)
+      for (int a = m->eq_body[2 * w->eq[e] + q]; a >= 0; a = m->body_parent[a])
+        w->clo_body[a - w->b0] = 1;
   w->clo_gen = UINT64_MAX;
   /* LTDL parent of each dof: the previous dof of its joint, else the last
    * dof of the nearest ancestor that has one */
@@ -414,12 +423,14 @@ ssArtWork *ss_art_work_new(const ssModel *m, int s)
  * indexed by body - first body), and where xmat is not NULL its rotation
  * matrix (xmat, the same indexing): each body's matrix formed once, from
  * its final quaternion, serves its children's joints as well (the bits of
- * the matrix they would form from it) */
-static void kinematics(const ssModel *m, int s, const double *qpos,
-                       double *xpos, double *xquat, double *xmat)
+ * the matrix they would form from it).  Where only is not NULL, only the
+ * bodies lb with only[lb] == want (their parents posed before) */
+static void kinematics(const ssModel *m, int s, const double *qpos, double *xpos,
+                       double *xquat, double *xmat, const unsigned char *only, int want)
 {
   int b0 = m->sys_bodyadr[s];
   for (int lb = 0; lb < m->sys_nbody[s]; lb++) {
+    if (only && only[lb] != want) continue;
     int b = b0 + lb, par = m->body_parent[b], type = m->body_jnttype[b];
     double *p = xpos + 3 * lb, *q = xquat + 4 * lb;
     const double *qa = m->body_qadr[b] >= 0 ? qpos + m->body_qadr[b] : NULL;
@@ -476,15 +487,17 @@ static void kinematics(const ssModel *m, int s, const double *qpos,
 /* ss_art_forward in two halves: the poses (kin_q is their qpos; kin_ok
  * stays 0 until the second half), then the centres of mass and motion
  * subspaces, which the closure-drift passes that read phi alone do
- * without */
-static void forward_poses(const ssModel *m, ssData *d, int s)
+ * without.  With part, only the bodies phi reads are posed (clo_body): the
+ * others follow in forward_rest, which must then come before qpos moves */
+static void forward_poses(const ssModel *m, ssData *d, int s, int part)
 {
   ssArtWork *w = d->art[s];
   int b0 = w->b0;
   kinematics(m, s, d->qpos, d->body_xpos + 3 * b0, d->body_xquat + 4 * b0,
-             d->body_xmat + 9 * b0);
+             d->body_xmat + 9 * b0, part ? w->clo_body : NULL, 1);
   memcpy(w->kin_q, d->qpos + m->sys_qadr[s], (size_t)m->sys_nq[s] * sizeof(double));
   w->kin_ok = 0;
+  w->kin_part = part;
   w->kin_gen++;
 }
 
@@ -492,6 +505,10 @@ static void forward_rest(const ssModel *m, ssData *d, int s)
 {
   ssArtWork *w = d->art[s];
   int b0 = w->b0;
+  if (w->kin_part)
+    kinematics(m, s, d->qpos, d->body_xpos + 3 * b0, d->body_xquat + 4 * b0,
+               d->body_xmat + 9 * b0, w->clo_body, 0);
+  w->kin_part = 0;
   for (int lb = 0; lb < w->nb; lb++) {
     int b = b0 + lb;
     const double *R = d->body_xmat + 9 * b, *p = d->body_xpos + 3 * b;
@@ -536,7 +553,7 @@ static void forward_rest(const ssModel *m, ssData *d, int s)
 
 void ss_art_forward(const ssModel *m, ssData *d, int s)
 {
-  forward_poses(m, d, s);
+  forward_poses(m, d, s, 0);
   forward_rest(m, d, s);
 }
 
@@ -1781,7 +1798,9 @@ void ss_art_integrate(const ssModel *m, ssData *d, int s)
   double *zz = w->nrow <= 64 ? z : malloc((size_t)w->nrow * sizeof(double));
   if (!zz) return;
   for (int it = 0; it < 12; it++) {
-    forward_poses(m, d, s);
+    /* the bodies phi reads, the others where the loop stops here (the
+     * last pass poses all: the loop then moves qpos once more) */
+    forward_poses(m, d, s, it < 11);
     closures(m, d, w, 0);
     err = 0;
     for (int r = 0; r < w->nrow; r++) {
@@ -2058,7 +2077,7 @@ int ss_model_add_articulated(ssModel *m, const ssUrdf *u, const ssArtDef *def,
     goto fail;
   }
   double *xq = xp + 3 * m->sys_nbody[s];
-  kinematics(m, s, m->qpos0, xp, xq, NULL);
+  kinematics(m, s, m->qpos0, xp, xq, NULL, NULL, 0);
   int b0 = m->sys_bodyadr[s];
 #define WORLD_POINT(b, local, out)                                             \
   do {                                                                         \
