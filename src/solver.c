@@ -294,9 +294,10 @@ static void row_key(const ssData *d, const ssContact *c, int *geom, int *vertex)
 /* The cache entry of key (geom, vertex), or NULL.  Contacts come in runs
  * of ascending keys (one collider's points in vertex order, the colliders
  * in order), so the search walks on from the previous hit (*cursor) while
- * the keys ascend, a few entries at most, and falls back to bisection
- * when they do not (a new bed, the joint rows, a gap of more than 8
- * entries no longer loaded).  (Inlined where it is used: the call
+ * the keys ascend, a few entries at most, answers NULL at once for a key
+ * between the previous hit and the entry after it (the cache is sorted),
+ * and falls back to bisection otherwise (a new bed, the joint rows, a gap
+ * of more than 8 entries no longer loaded).  (Inlined where it is used: the call
  * added a tenth to a settled plate point's warm start.) */
 static inline __attribute__((always_inline)) const ssWarmEntry *
 find_warm(const ssWarmEntry *warm, int n, int geom, int vertex, int *cursor)
@@ -312,6 +313,11 @@ find_warm(const ssWarmEntry *warm, int n, int geom, int vertex, int *cursor)
       }
       if (ek > key) return NULL; /* passed it: not cached */
     }
+  } else if (p > 0 && entry_key(warm + p - 1) < key) {
+    /* between the previous hit (the cursor's last entry) and the entry
+     * after it, or past the last: not cached, without the bisection (a
+     * point new to the patch) */
+    return NULL;
   }
   /* the first entry not below the key */
   int a = 0, b = n;
