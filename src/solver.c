@@ -807,7 +807,10 @@ static void visit(const ssModel *m, ssData *d, ssContact *c, Group *g,
 static inline __attribute__((always_inline)) void
 contact_end(ssContact *c, const double v[3], double dt)
 {
-  memcpy(c->v, v, sizeof c->v);
+  /* (one store each: a memcpy went through a copy on the stack) */
+  c->v[0] = v[0];
+  c->v[1] = v[1];
+  c->v[2] = v[2];
   c->loaded = c->type == SS_CONTACT_SOIL && c->lambda[0] > 0 && -(c->g0 + dt * v[0]) > 0;
   if (c->type == SS_CONTACT_SOIL && !c->loaded)
     c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
@@ -828,6 +831,26 @@ static ssContact *body_run_end(const ssModel *m, const ssData *d, ssContact *c,
   for (; c < end && c->type == SS_CONTACT_SOIL && c->geom == geom; c++) {
     double v[3];
     body_point_velocity(c, com, u, v);
+    contact_end(c, v, dt);
+  }
+  return c;
+}
+
+/* The same for the run of contacts from c on (before end) that lie on
+ * c's link: the link's spatial velocity formed once for the run, in
+ * locals (as body_run_end's), and each point's velocity kept from
+ * registers instead of through a stack copy. */
+static ssContact *link_run_end(const ssModel *m, const ssData *d, ssContact *c,
+                               const ssContact *end)
+{
+  const double dt = m->opt.timestep;
+  const int link = c->link;
+  double S[6];
+  ss_art_link_velocity(m, d, link, S);
+  const double V[6] = {S[0], S[1], S[2], S[3], S[4], S[5]};
+  for (; c < end && c->link == link; c++) {
+    double v[3];
+    link_point_velocity(c, V, v);
     contact_end(c, v, dt);
   }
   return c;
@@ -962,8 +985,6 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   st->converged = st->residual <= tol;
 
   /* end-of-step contact velocities for the soil update */
-  int link = -1;
-  double V[6];
   /* (no contacts: the array may not exist yet, and no arithmetic on its
    * NULL) */
   const ssContact *end = d->ncontact ? d->contact + d->ncontact : d->contact;
@@ -971,9 +992,8 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
     double v[3] = {0, 0, 0};
     if (c->link >= 0) {
       /* one spatial velocity per link run */
-      if (c->link != link) ss_art_link_velocity(m, d, c->link, V);
-      link = c->link;
-      link_point_velocity(c, V, v);
+      c = link_run_end(m, d, c, end);
+      continue;
     } else if (c->nv) {
       if (c->type == SS_CONTACT_SOIL) {
         /* a rigid body's soil points, as one run */
