@@ -356,10 +356,11 @@ typedef struct WarmApply {
 } WarmApply;
 
 /* soil point c's warm impulse from its cache entry e (with the creeping
- * colliders' rates or without) into lam; dt the time step */
+ * colliders' rates or without) into lam; dt the time step, mats the beds'
+ * soils (m->hfield_soilmat) */
 static inline __attribute__((always_inline)) void
-warm_soil_impulse(const ssModel *m, double dt, const ssContact *c, const ssWarmEntry *e,
-                  int creep_rates, double lam[3])
+warm_soil_impulse(const ssSoilMaterial *mats, double dt, const ssContact *c,
+                  const ssWarmEntry *e, int creep_rates, double lam[3])
 {
   double scale = c->area * dt, t[3];
   static const double none[3] = {0, 0, 0};
@@ -369,7 +370,7 @@ warm_soil_impulse(const ssModel *m, double dt, const ssContact *c, const ssWarmE
   double lt0 = t[1] * scale, lt1 = t[2] * scale;
   /* the bound at zero slip as the laws form it (point.c, newton.c):
    * A dt c + mu lambda_n, the strength tau_f(p_n) times A dt */
-  const ssSoilMaterial *mat = &m->hfield_soilmat[c->hfield];
+  const ssSoilMaterial *mat = &mats[c->hfield];
   double lim = scale * mat->cohesion + mat->friction_coefficient * ln;
   double mag = sqrt(lt0 * lt0 + lt1 * lt1);
   if (mag > lim) {
@@ -394,7 +395,7 @@ warm_impulse(const ssModel *m, const ssContact *c, const ssWarmEntry *e, int cre
   } else if (c->type == SS_CONTACT_LIMIT) {
     lam[0] = e->traction[0] > 0 ? e->traction[0] * dt : 0;
   } else {
-    warm_soil_impulse(m, dt, c, e, creep_rates, lam);
+    warm_soil_impulse(m->hfield_soilmat, dt, c, e, creep_rates, lam);
   }
 }
 
@@ -468,7 +469,12 @@ static void warm_close(const ssModel *m, ssData *d, WarmApply *a)
  * solve starts from); returns 1 where the warm start leaves e's rate out */
 static inline int warm_keep(ssContact *c, const ssWarmEntry *e, int converged, int creep_rates)
 {
-  memcpy(c->warm_t, e->traction, sizeof c->warm_t);
+  /* (element by element: a memcpy's stores may alias anything, as the
+   * compiler sees it, and the callers' loops read their invariants again
+   * after one) */
+  c->warm_t[0] = e->traction[0];
+  c->warm_t[1] = e->traction[1];
+  c->warm_t[2] = e->traction[2];
   c->warm_trend = converged;
   return e->creep && !creep_rates;
 }
@@ -489,42 +495,70 @@ warm_match(const ssData *d, ssContact *c, const ssWarmEntry *warm, int nwarm, in
   return e;
 }
 
+/* warm_body_run's point c of collider geom: its cache entry matched
+ * (*cur, as find_warm's cursor), kept (warm_keep, counted in *nleft) and
+ * its impulse into c->lambda and lam; 0 where it has no entry (its
+ * impulse 0) */
+static inline __attribute__((always_inline)) int
+warm_body_point(const ssSoilMaterial *mats, double dt, ssContact *c, const ssWarmEntry *warm,
+                int nwarm, int geom, int converged, int creep_rates, int *cur, int *nleft,
+                double lam[3])
+{
+  const ssWarmEntry *e = find_warm(warm, nwarm, geom, c->vertex, cur);
+  if (!e) {
+    c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
+    return 0;
+  }
+  *nleft += warm_keep(c, e, converged, creep_rates);
+  warm_soil_impulse(mats, dt, c, e, creep_rates, lam);
+  c->lambda[0] = lam[0];
+  c->lambda[1] = lam[1];
+  c->lambda[2] = lam[2];
+  return 1;
+}
+
 /* The warm start (not deferred) of the soil points from contact i on that
  * lie on collider geom of a rigid body, up to the first contact that does
  * not; returns its index.  Each point as warm_start and warm_one take it,
  * their sums into a->br in the same order, but with the collider, the
  * type tests and the body's centre of mass known for the run, and the
  * run's sums in locals (the contacts' stores could alias them, as the
- * compiler sees it). */
+ * compiler sees it).  The points up to the first with an entry, where
+ * the body's run opens (a call), and those after it are two loops: the
+ * second calls nothing, so the contacts, the soils and the loop's bounds
+ * stay in registers instead of being read again after each point. */
 static int warm_body_run(const ssModel *m, ssData *d, int i, int nwarm, int converged,
                          int creep_rates, int *cursor, int *left, WarmApply *a)
 {
   const ssWarmEntry *warm = d->warm;
-  const int ncontact = d->ncontact, geom = d->contact[i].geom, b = m->geom_body[geom];
+  ssContact *const contact = d->contact;
+  const ssSoilMaterial *const mats = m->hfield_soilmat;
+  const int ncontact = d->ncontact, geom = contact[i].geom, b = m->geom_body[geom];
   const double dt = m->opt.timestep;
   const double com[3] = {d->body_xipos[3 * b], d->body_xipos[3 * b + 1],
                          d->body_xipos[3 * b + 2]};
-  double F[6];
+  double F[6], lam[3];
   int open = 0, cur = *cursor, nleft = 0;
   for (; i < ncontact; i++) {
-    ssContact *c = d->contact + i;
+    ssContact *c = contact + i;
     if (c->type != SS_CONTACT_SOIL || c->geom != geom) break;
-    const ssWarmEntry *e = find_warm(warm, nwarm, geom, c->vertex, &cur);
-    if (!e) {
-      c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
+    if (!warm_body_point(mats, dt, c, warm, nwarm, geom, converged, creep_rates, &cur, &nleft,
+                         lam))
       continue;
-    }
-    nleft += warm_keep(c, e, converged, creep_rates);
-    double lam[3];
-    warm_soil_impulse(m, dt, c, e, creep_rates, lam);
-    memcpy(c->lambda, lam, sizeof lam);
-    if (!open) {
-      /* the run's first impulse: the body's run opens (or goes on) */
-      body_run_open(m, d, a, b);
-      memcpy(F, a->br.F, sizeof F);
-      open = 1;
-    }
+    /* the run's first impulse: the body's run opens (or goes on) */
+    body_run_open(m, d, a, b);
+    memcpy(F, a->br.F, sizeof F);
     body_run_add(c, com, lam, F);
+    open = 1;
+    i++;
+    break;
+  }
+  for (; open && i < ncontact; i++) {
+    ssContact *c = contact + i;
+    if (c->type != SS_CONTACT_SOIL || c->geom != geom) break;
+    if (warm_body_point(mats, dt, c, warm, nwarm, geom, converged, creep_rates, &cur, &nleft,
+                        lam))
+      body_run_add(c, com, lam, F);
   }
   if (open) memcpy(a->br.F, F, sizeof F);
   *cursor = cur;
