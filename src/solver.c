@@ -566,6 +566,31 @@ static int warm_body_run(const ssModel *m, ssData *d, int i, int nwarm, int conv
   return i;
 }
 
+/* The deferred warm start's matching (warm_start): each contact's cache
+ * entry (c->warm_entry, -1: none) from the nwarm of warm, its impulse
+ * zeroed and a soil point's entry kept (warm_match); returns how many
+ * matched entries' rates were left out.  A function of its own, not
+ * inlined: inside warm_start the loop shared its registers with the other
+ * path's, and read converged, creep_rates and its count from the stack
+ * at each point. */
+static __attribute__((noinline)) int
+warm_match_all(const ssData *d, const ssWarmEntry *warm, int nwarm, int converged,
+               int creep_rates)
+{
+  ssContact *const contact = d->contact;
+  const int ncontact = d->ncontact;
+  int left = 0, cursor = 0;
+  for (int i = 0; i < ncontact; i++) {
+    ssContact *c = contact + i;
+    const ssWarmEntry *e =
+      warm_match(d, c, warm, nwarm, &cursor, converged, creep_rates, &left);
+    /* (a hit leaves the cursor just after its entry: its index without
+     * a division by the entry's size) */
+    c->warm_entry = e ? cursor - 1 : -1;
+  }
+  return left;
+}
+
 /* Initial impulses from last step's tractions extrapolated by their rate
  * (ssWarmEntry), scaled by the current area and time step and projected
  * into the current bounds; joint rows start from last step's impulse
@@ -591,12 +616,7 @@ static int warm_start(const ssModel *m, ssData *d, int converged, int creep_rate
   const ssWarmEntry *warm = d->warm;
   const int nwarm = m->opt.terrain_warm_start ? d->nwarm : 0, ncontact = d->ncontact;
   if (defer) {
-    for (int i = 0; i < ncontact; i++) {
-      ssContact *c = d->contact + i;
-      const ssWarmEntry *e =
-        warm_match(d, c, warm, nwarm, &cursor, converged, creep_rates, &left);
-      c->warm_entry = e ? (int)(e - warm) : -1;
-    }
+    left = warm_match_all(d, warm, nwarm, converged, creep_rates);
   } else {
     for (int i = 0; i < ncontact;) {
       ssContact *c = d->contact + i;
