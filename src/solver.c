@@ -728,12 +728,14 @@ store_entries(const ssModel *m, const ssData *d, ssWarmEntry *next, const double
       vertex = c->vertex;
       /* (the soil points come first, as the Newton phase needs) */
       const double *l = law ? law + 3 * i : c->lambda;
+      /* (the 1-norms start from their first terms: 0 + |x| is |x|,
+       * whatever x, and they are only compared) */
       double ch = 0, size = 0;
       for (int k = 0; k < 3; k++) {
         e->traction[k] = l[k] * inv;
         e->rate[k] = c->warm_trend && converged ? e->traction[k] - c->warm_t[k] : 0;
-        ch += fabs(e->rate[k]);
-        size += fabs(e->traction[k]);
+        ch = k ? ch + fabs(e->rate[k]) : fabs(e->rate[k]);
+        size = k ? size + fabs(e->traction[k]) : fabs(e->traction[k]);
       }
       /* a change within the solver's tolerance is not a trend: the
        * tractions are known to about that (a settled body's drift) */
