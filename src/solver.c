@@ -1083,7 +1083,15 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
         c = body_run_end(m, d, c, end);
         continue;
       }
-      contact_velocity(m, d, c, v);
+      if (c->type == SS_CONTACT_PD || c->type == SS_CONTACT_LIMIT)
+        /* a joint row's one row, as its visits take it (row_velocity),
+         * instead of J u's three sums over every velocity: its other
+         * rows are zero, and the sums gave the same up to the sign of a
+         * zero (or which NaN, where u is not finite); no reader takes a
+         * row's v (the soil update and the cache read soil points') */
+        v[0] = row_velocity(d, c);
+      else
+        contact_velocity(m, d, c, v);
     }
     contact_end(c, v, dt);
     c++;
