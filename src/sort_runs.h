@@ -84,7 +84,15 @@
         int e2 = e1 >= n ? n : r < known ? run_end[r++] : name##_run(v, e1, n); \
         const T *a = v + i, *ea = v + e1, *b = ea, *eb = v + e2;               \
         T *o = t + i;                                                          \
-        while (a < ea && b < eb) *o++ = less(b, a) ? *b++ : *a++;              \
+        /* (in stretches from one side: the other's head stays put)       */ \
+        while (a < ea && b < eb) {                                             \
+          if (less(b, a))                                                      \
+            do *o++ = *b++;                                                    \
+            while (b < eb && less(b, a));                                      \
+          else                                                                 \
+            do *o++ = *a++;                                                    \
+            while (a < ea && !less(b, a));                                     \
+        }                                                                      \
         memcpy(o, a, (size_t)(ea - a) * sizeof *v);                            \
         memcpy(o + (ea - a), b, (size_t)(eb - b) * sizeof *v);                 \
         /* (run_end[runs] is read already: runs < r)                       */ \
