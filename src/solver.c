@@ -293,27 +293,29 @@ static void row_key(const ssData *d, const ssContact *c, int *geom, int *vertex)
 
 /* The cache entry of key (geom, vertex), or NULL.  Contacts come in runs
  * of ascending keys (one collider's points in vertex order, the colliders
- * in order), so the search walks on from the previous hit (*cursor) while
- * the keys ascend, a few entries at most, answers NULL at once for a key
- * between the previous hit and the entry after it (the cache is sorted),
- * and falls back to bisection otherwise (a new bed, the joint rows, a gap
- * of more than 8 entries no longer loaded).  (Inlined where it is used: the call
- * added a tenth to a settled plate point's warm start.) */
+ * in order), so the search walks on from the previous hit while the keys
+ * ascend, a few entries at most, answers NULL at once for a key between
+ * the previous hit and the entry after it (the cache is sorted), and
+ * falls back to bisection otherwise (a new bed, the joint rows, a gap of
+ * more than 8 entries no longer loaded).  *cursor: the entry after the
+ * previous hit (warm at the start), a pointer (an index took a product
+ * by the entry's size at each look-up).  (Inlined where it is used: the
+ * call added a tenth to a settled plate point's warm start.) */
 static inline __attribute__((always_inline)) const ssWarmEntry *
-find_warm(const ssWarmEntry *warm, int n, int geom, int vertex, int *cursor)
+find_warm(const ssWarmEntry *warm, int n, int geom, int vertex, const ssWarmEntry **cursor)
 {
-  int p = *cursor;
+  const ssWarmEntry *p = *cursor, *end = warm + n;
   const uint64_t key = warm_key(geom, vertex);
-  if (p < n && entry_key(warm + p) <= key) {
-    for (int k = 0; k < 8 && p < n; k++, p++) {
-      uint64_t ek = entry_key(warm + p);
+  if (p < end && entry_key(p) <= key) {
+    for (int k = 0; k < 8 && p < end; k++, p++) {
+      uint64_t ek = entry_key(p);
       if (ek == key) {
         *cursor = p + 1;
-        return warm + p;
+        return p;
       }
       if (ek > key) return NULL; /* passed it: not cached */
     }
-  } else if (p > 0 && entry_key(warm + p - 1) < key) {
+  } else if (p > warm && entry_key(p - 1) < key) {
     /* between the previous hit (the cursor's last entry) and the entry
      * after it, or past the last: not cached, without the bisection (a
      * point new to the patch) */
@@ -327,7 +329,7 @@ find_warm(const ssWarmEntry *warm, int n, int geom, int vertex, int *cursor)
     else b = mid;
   }
   if (a == n || entry_key(warm + a) != key) return NULL;
-  *cursor = a + 1;
+  *cursor = warm + a + 1;
   return warm + a;
 }
 
@@ -483,8 +485,8 @@ static inline int warm_keep(ssContact *c, const ssWarmEntry *e, int converged, i
  * impulse zeroed and a soil point's entry kept (warm_keep, counted in
  * *left) */
 static inline __attribute__((always_inline)) const ssWarmEntry *
-warm_match(const ssData *d, ssContact *c, const ssWarmEntry *warm, int nwarm, int *cursor,
-           int converged, int creep_rates, int *left)
+warm_match(const ssData *d, ssContact *c, const ssWarmEntry *warm, int nwarm,
+           const ssWarmEntry **cursor, int converged, int creep_rates, int *left)
 {
   c->lambda[0] = c->lambda[1] = c->lambda[2] = 0;
   if (!nwarm || c->type == SS_CONTACT_RIGID) return NULL;
@@ -501,7 +503,8 @@ warm_match(const ssData *d, ssContact *c, const ssWarmEntry *warm, int nwarm, in
  * impulse 0) */
 static inline __attribute__((always_inline)) int
 warm_body_point(const ssSoilMaterial *mats, double dt, ssContact *c, const ssWarmEntry *warm,
-                int nwarm, int geom, int converged, int creep_rates, int *cur, int *nleft,
+                int nwarm, int geom, int converged, int creep_rates, const ssWarmEntry **cur,
+                int *nleft,
                 double lam[3])
 {
   const ssWarmEntry *e = find_warm(warm, nwarm, geom, c->vertex, cur);
@@ -528,7 +531,7 @@ warm_body_point(const ssSoilMaterial *mats, double dt, ssContact *c, const ssWar
  * second calls nothing, so the contacts, the soils and the loop's bounds
  * stay in registers instead of being read again after each point. */
 static int warm_body_run(const ssModel *m, ssData *d, int i, int nwarm, int converged,
-                         int creep_rates, int *cursor, int *left, WarmApply *a)
+                         int creep_rates, const ssWarmEntry **cursor, int *left, WarmApply *a)
 {
   const ssWarmEntry *warm = d->warm;
   ssContact *const contact = d->contact;
@@ -538,7 +541,8 @@ static int warm_body_run(const ssModel *m, ssData *d, int i, int nwarm, int conv
   const double com[3] = {d->body_xipos[3 * b], d->body_xipos[3 * b + 1],
                          d->body_xipos[3 * b + 2]};
   double F[6], lam[3];
-  int open = 0, cur = *cursor, nleft = 0;
+  const ssWarmEntry *cur = *cursor;
+  int open = 0, nleft = 0;
   for (; i < ncontact; i++) {
     ssContact *c = contact + i;
     if (c->type != SS_CONTACT_SOIL || c->geom != geom) break;
@@ -569,26 +573,34 @@ static int warm_body_run(const ssModel *m, ssData *d, int i, int nwarm, int conv
 /* The deferred warm start's matching (warm_start): each contact's cache
  * entry (c->warm_entry, -1: none) from the nwarm of warm, its impulse
  * zeroed and a soil point's entry kept (warm_match); returns how many
- * matched entries' rates were left out.  A function of its own, not
- * inlined: inside warm_start the loop shared its registers with the other
- * path's, and read converged, creep_rates and its count from the stack
- * at each point. */
-static __attribute__((noinline)) int
-warm_match_all(const ssData *d, const ssWarmEntry *warm, int nwarm, int converged,
-               int creep_rates)
+ * matched entries' rates were left out.  Inlined into one copy for each
+ * value of creep_rates (warm_match_all). */
+static inline __attribute__((always_inline)) int
+match_all(const ssData *d, const ssWarmEntry *warm, int nwarm, int converged,
+          const int creep_rates)
 {
   ssContact *const contact = d->contact;
   const int ncontact = d->ncontact;
-  int left = 0, cursor = 0;
+  const ssWarmEntry *cursor = warm;
+  int left = 0;
   for (int i = 0; i < ncontact; i++) {
     ssContact *c = contact + i;
     const ssWarmEntry *e =
       warm_match(d, c, warm, nwarm, &cursor, converged, creep_rates, &left);
-    /* (a hit leaves the cursor just after its entry: its index without
-     * a division by the entry's size) */
-    c->warm_entry = e ? cursor - 1 : -1;
+    c->warm_entry = e ? (int)(e - warm) : -1;
   }
   return left;
+}
+
+/* match_all, a function of its own, not inlined: inside warm_start the
+ * loop shared its registers with the other path's, and read converged,
+ * creep_rates and its count from the stack at each point */
+static __attribute__((noinline)) int
+warm_match_all(const ssData *d, const ssWarmEntry *warm, int nwarm, int converged,
+               int creep_rates)
+{
+  return creep_rates ? match_all(d, warm, nwarm, converged, 1)
+                     : match_all(d, warm, nwarm, converged, 0);
 }
 
 /* Initial impulses from last step's tractions extrapolated by their rate
@@ -608,13 +620,14 @@ warm_match_all(const ssData *d, const ssWarmEntry *warm, int nwarm, int converge
  * from the warm start after all, and the solve before any sweep. */
 static int warm_start(const ssModel *m, ssData *d, int converged, int creep_rates)
 {
-  int left = 0, cursor = 0, defer = !d->solver_warm_eager && ss_newton_may_predict(m, d);
+  int left = 0, defer = !d->solver_warm_eager && ss_newton_may_predict(m, d);
   WarmApply a = {{NULL, NULL, NULL, {0}, {0}}, {-1, {0}}};
   d->warm_creep_rates = creep_rates;
   /* (the loop's invariants in locals: the contacts' stores could alias
    * them, as the compiler sees it) */
   const ssWarmEntry *warm = d->warm;
   const int nwarm = m->opt.terrain_warm_start ? d->nwarm : 0, ncontact = d->ncontact;
+  const ssWarmEntry *cursor = warm;
   if (defer) {
     left = warm_match_all(d, warm, nwarm, converged, creep_rates);
   } else {
