@@ -755,10 +755,16 @@ store_entries(const ssModel *m, const ssData *d, ssWarmEntry *next, const double
       if (ch <= tol * size) {
         e->rate[0] = e->rate[1] = e->rate[2] = 0;
       } else {
-        double *g = patch + 3 * geom, v2 = c->v[1] * c->v[1] + c->v[2] * c->v[2];
-        if (v2 > g[0]) g[0] = v2;
-        g[1] += c->lambda[0];
-        g[2] += fabs(c->lambda[1]) + fabs(c->lambda[2]);
+        /* (a patch whose fastest slip reached CREEP_SLIP does not creep,
+         * whatever its later points and sums: those are left out, and
+         * its sums, scratch, are not read) */
+        double *g = patch + 3 * geom;
+        if (g[0] < CREEP_SLIP * CREEP_SLIP) {
+          double v2 = c->v[1] * c->v[1] + c->v[2] * c->v[2];
+          if (v2 > g[0]) g[0] = v2;
+          g[1] += c->lambda[0];
+          g[2] += fabs(c->lambda[1]) + fabs(c->lambda[2]);
+        }
       }
     } else {
       row_key(d, c, &geom, &vertex);
