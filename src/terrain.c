@@ -334,6 +334,9 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
       double zl;
       cast.type = type;
       if (oblique) cast.par[0] = cast.par[1] = cast.par[2] = 0;
+      /* an oblique cylinder's lines are not along its axis either
+       * (soil_contacts: a != 0), so the cast's test of a folds away */
+      if (type == SS_GEOM_CYLINDER && oblique && cast.a == 0) __builtin_unreachable();
       if (!ss_shape_cast_lowest_z(&cast, qrow, qx, &zl) &&
           !(mesh && mesh_depth(m, d, g, R, p, qx, qy, lo[2], &zl)))
         continue;
@@ -385,7 +388,9 @@ static ssStatus soil_contacts(const ssModel *m, ssData *d, int h, int g, int sys
   const double *dl = s.R + 6;
   switch (m->geom_type[g]) {
   case SS_GEOM_CYLINDER:
-    if (dl[2] != 0) return soil_contacts_as(m, d, h, g, sys, R, p, err, &s, SS_GEOM_CYLINDER, 1);
+    /* (the second test is the cast's a, ss_shape_cast_init, formed alike) */
+    if (dl[2] != 0 && dl[0] * dl[0] + dl[1] * dl[1] != 0)
+      return soil_contacts_as(m, d, h, g, sys, R, p, err, &s, SS_GEOM_CYLINDER, 1);
     break;
   case SS_GEOM_BOX:
     if (dl[0] != 0 && dl[1] != 0 && dl[2] != 0)
