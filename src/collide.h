@@ -150,7 +150,10 @@ static inline int ss_cast_sphere(const double c[3], double r, double x, double y
 {
   double dx = x - c[0], dy = y - c[1];
   double h = r * r - (dx * dx + dy * dy);
-  if (h < 0) return 0;
+  /* isless: the quiet compare that sqrt's errno check (the call to libm on
+   * a negative) makes too, so the compiler sees it already made and drops
+   * it; the same outcome as h < 0, NaN included */
+  if (isless(h, 0)) return 0;
   *z = c[2] - sqrt(h);
   return 1;
 }
@@ -187,7 +190,8 @@ static inline int ss_shape_cast_lowest_z(const ssShapeCast *c, const ssCastRow *
     hit = !(cc > 0);
   } else {
     double disc = b * b - c->a * cc;
-    if (disc < 0) {
+    /* (isless: as in ss_cast_sphere, sqrt's errno check folds into it) */
+    if (isless(disc, 0)) {
       hit = 0;
     } else {
       double q = -(b + copysign(sqrt(disc), b));
