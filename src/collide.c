@@ -1082,6 +1082,7 @@ void ss_shape_cast_init(ssShapeCast *c, const ssShape *s)
     double h = s->type == SS_GEOM_BOX ? 0.5 * s->size[k] : 0.5 * s->size[1];
     c->h[k] = h;
     c->e[k] = copysign(h, c->d[k]);
+    c->ne[k] = -c->e[k];
   }
   /* the lateral surface: a t^2 + 2 b t + c = 0 with a fixed */
   c->a = c->d[0] * c->d[0] + c->d[1] * c->d[1];

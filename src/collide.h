@@ -112,6 +112,7 @@ typedef struct ssShapeCast {
   double d[3], id[3];  /* its direction there, and 1/d (0 where d = 0) */
   int par[3];          /* d = 0: parallel to that axis' slab */
   double h[3], e[3];   /* slab half-widths, and signed as d */
+  double ne[3];        /* -e, formed once (a negation is exact) */
   double r, rr, a, ia; /* radius, r^2, d_x^2 + d_y^2 and its reciprocal */
   double end[2][3];    /* a capsule's sphere centres */
 } ssShapeCast;
@@ -134,11 +135,11 @@ static inline void ss_shape_cast_row(const ssShapeCast *c, double y, ssCastRow *
  * once (0 where d = 0: the line is parallel to it, inside or not) and
  * e = h signed as d, so that the entry and exit need no comparison:
  * [(-e - o) id, (e - o) id]. */
-static inline int ss_cast_slab(double o, double h, double e, double id, int par,
+static inline int ss_cast_slab(double o, double h, double e, double ne, double id, int par,
                                double *tin, double *tout)
 {
   if (par) return fabs(o) <= h;
-  double t0 = (-e - o) * id, t1 = (e - o) * id;
+  double t0 = (ne - o) * id, t1 = (e - o) * id;
   *tin = t0 > *tin ? t0 : *tin;
   *tout = t1 < *tout ? t1 : *tout;
   return 1;
@@ -174,9 +175,9 @@ static inline int ss_shape_cast_lowest_z(const ssShapeCast *c, const ssCastRow *
 
   if (c->type == SS_GEOM_BOX) {
     /* slab method */
-    if (!ss_cast_slab(o0, c->h[0], c->e[0], c->id[0], c->par[0], &tin, &tout) ||
-        !ss_cast_slab(o1, c->h[1], c->e[1], c->id[1], c->par[1], &tin, &tout) ||
-        !ss_cast_slab(o2, c->h[2], c->e[2], c->id[2], c->par[2], &tin, &tout) || !(tin <= tout))
+    if (!ss_cast_slab(o0, c->h[0], c->e[0], c->ne[0], c->id[0], c->par[0], &tin, &tout) ||
+        !ss_cast_slab(o1, c->h[1], c->e[1], c->ne[1], c->id[1], c->par[1], &tin, &tout) ||
+        !ss_cast_slab(o2, c->h[2], c->e[2], c->ne[2], c->id[2], c->par[2], &tin, &tout) || !(tin <= tout))
       return 0;
     *z = c->pos[2] + tin;
     return 1;
@@ -204,7 +205,7 @@ static inline int ss_shape_cast_lowest_z(const ssShapeCast *c, const ssCastRow *
       }
     }
   }
-  hit = hit && ss_cast_slab(o2, c->h[2], c->e[2], c->id[2], c->par[2], &tin, &tout) && tin <= tout;
+  hit = hit && ss_cast_slab(o2, c->h[2], c->e[2], c->ne[2], c->id[2], c->par[2], &tin, &tout) && tin <= tout;
   double best = hit ? c->pos[2] + tin : INFINITY;
   if (c->type == SS_GEOM_CAPSULE) {
     /* union with the end spheres: the first entry of any piece */
