@@ -259,6 +259,8 @@ typedef struct ssPowTable {
   double e2[SS_POWT_EMAX - SS_POWT_EMIN + 1]; /* 2^(e a) */
   double mc[SS_POWT_N];   /* c_k^a */
   double ic[SS_POWT_N];   /* 1 / c_k */
+  double c[SS_POWT_N];    /* c_k itself, so that a look-up does not form it
+                           * again (a conversion and two operations) */
 } ssPowTable;
 
 static inline void ss_pow_table_init(ssPowTable *t, double a)
@@ -271,6 +273,7 @@ static inline void ss_pow_table_init(ssPowTable *t, double a)
     double c = 1 + (k + 0.5) / SS_POWT_N;
     t->mc[k] = pow(c, a);
     t->ic[k] = 1 / c;
+    t->c[k] = c;
   }
 }
 
@@ -285,7 +288,7 @@ static inline double ss_pow_tab(const ssPowTable *t, double s)
   uint64_t mb = (b & 0x000FFFFFFFFFFFFFull) | 0x3FF0000000000000ull;
   double m;
   memcpy(&m, &mb, sizeof m);
-  double u = (m - (1 + (k + 0.5) / SS_POWT_N)) * t->ic[k], v = t->mc[k];
+  double u = (m - t->c[k]) * t->ic[k], v = t->mc[k];
   return t->e2[e - SS_POWT_EMIN] * (v + v * ss_pow1p_m1(&t->ser, u));
 }
 
