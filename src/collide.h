@@ -131,15 +131,15 @@ static inline void ss_shape_cast_row(const ssShapeCast *c, double y, ssCastRow *
   for (int k = 0; k < 3; k++) r->oyw[k] = c->oy[k] * wy;
 }
 
-/* The slab |o + t d| <= h along one axis, with d's reciprocal id formed
- * once (0 where d = 0: the line is parallel to it, inside or not) and
- * e = h signed as d, so that the entry and exit need no comparison:
+/* The slab |o + t d| <= h along axis k of cast c, with d's reciprocal id
+ * formed once (0 where d = 0: the line is parallel to it, inside or not)
+ * and e = h signed as d, so that the entry and exit need no comparison:
  * [(-e - o) id, (e - o) id]. */
-static inline int ss_cast_slab(double o, double h, double e, double ne, double id, int par,
-                               double *tin, double *tout)
+static inline int ss_cast_slab(const ssShapeCast *c, int k, double o, double *tin,
+                               double *tout)
 {
-  if (par) return fabs(o) <= h;
-  double t0 = (ne - o) * id, t1 = (e - o) * id;
+  if (c->par[k]) return fabs(o) <= c->h[k];
+  double t0 = (c->ne[k] - o) * c->id[k], t1 = (c->e[k] - o) * c->id[k];
   *tin = t0 > *tin ? t0 : *tin;
   *tout = t1 < *tout ? t1 : *tout;
   return 1;
@@ -175,9 +175,8 @@ static inline int ss_shape_cast_lowest_z(const ssShapeCast *c, const ssCastRow *
 
   if (c->type == SS_GEOM_BOX) {
     /* slab method */
-    if (!ss_cast_slab(o0, c->h[0], c->e[0], c->ne[0], c->id[0], c->par[0], &tin, &tout) ||
-        !ss_cast_slab(o1, c->h[1], c->e[1], c->ne[1], c->id[1], c->par[1], &tin, &tout) ||
-        !ss_cast_slab(o2, c->h[2], c->e[2], c->ne[2], c->id[2], c->par[2], &tin, &tout) || !(tin <= tout))
+    if (!ss_cast_slab(c, 0, o0, &tin, &tout) || !ss_cast_slab(c, 1, o1, &tin, &tout) ||
+        !ss_cast_slab(c, 2, o2, &tin, &tout) || !(tin <= tout))
       return 0;
     *z = c->pos[2] + tin;
     return 1;
@@ -205,7 +204,7 @@ static inline int ss_shape_cast_lowest_z(const ssShapeCast *c, const ssCastRow *
       }
     }
   }
-  hit = hit && ss_cast_slab(o2, c->h[2], c->e[2], c->ne[2], c->id[2], c->par[2], &tin, &tout) && tin <= tout;
+  hit = hit && ss_cast_slab(c, 2, o2, &tin, &tout) && tin <= tout;
   double best = hit ? c->pos[2] + tin : INFINITY;
   if (c->type == SS_GEOM_CAPSULE) {
     /* union with the end spheres: the first entry of any piece */
