@@ -871,13 +871,6 @@ static inline __attribute__((always_inline)) void h_sums(const NPoint *pt, const
   A->ww[8] += ww[8][0] + ww[8][1];
 }
 
-/* F(y, mu) and H(y) = dF/dy over all contacts, the soil points' impulses
- * in lam (3 each; the rows' are their entries of F), the impulse-form
- * points' equations in ie.  H: a 6 x 6 block per group, then one value
- * per row; with_H = 0: F alone (H not touched).  Returns NEAR_STICK if
- * a velocity-form point is near sticking (point_law's NEAR), plus STUCK if one
- * sticks or an impulse-form point has no answer (the evaluation is then
- * no good). */
 /* What a form of the laws' loops knows of its material (evaluate_at,
  * check_run): nothing, linear soil, or nonlinear soil with the power's
  * series and a shear modulus; mat_form sets what the form knows in M, so
@@ -893,6 +886,13 @@ static inline __attribute__((always_inline)) void mat_form(Mat *M, const int for
   }
 }
 
+/* F(y, mu) and H(y) = dF/dy over all contacts, the soil points' impulses
+ * in lam (3 each; the rows' are their entries of F), the impulse-form
+ * points' equations in ie.  H: a 6 x 6 block per group, then one value
+ * per row; with_H = 0: F alone (H not touched).  Returns NEAR_STICK if
+ * a velocity-form point is near sticking (point_law's NEAR), plus STUCK if one
+ * sticks or an impulse-form point has no answer (the evaluation is then
+ * no good). */
 static inline __attribute__((always_inline)) int
 evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWork *w,
             const double *y, double *mu, double *F, double *H, double *q,
