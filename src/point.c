@@ -47,11 +47,13 @@
  *    stop-slip impulse exceeds the bound at the guessed slip speed, itself
  *    >= the bound at zero slip) is solved by Newton on both equations at
  *    once in (lambda_n, sigma), F1 = f with the shear impulse -T w inside
- *    v_n and F2 = q - 1, with their full 2x2 Jacobian.  From a warm start
- *    this is one step and the checking evaluation.  It returns only when
- *    both residual tests pass at the same point and the point cannot stick
- *    there; any iterate leaving lambda_n > 0, 0 < sigma <= |c_t| hands the
- *    point to the safeguarded loop.  Cold, the start is the n = 1 piece (or
+ *    v_n and F2 = q - 1, with their full 2x2 Jacobian (its rows scaled
+ *    so that no division lies between one iterate and the next; the
+ *    residual tests multiplied through by M's determinant).  From a warm
+ *    start this is one step and the checking evaluation.  It returns only
+ *    when both residual tests pass at the same point and the point cannot
+ *    stick there; any iterate leaving lambda_n > 0, 0 < sigma <= |c_t|
+ *    hands the point to the safeguarded loop.  Cold, the start is the n = 1 piece (or
  *    a Newton step from 0) with the shear held, and sigma from the
  *    isotropic slip equation sigma + T gamma = |c_t|.
  *  - Safeguarded loop: the scalar solves above, alternated.  Each shear
@@ -116,6 +118,33 @@ static inline double law_pressure_as(Law *L, double vn, double *dP, double *d2P,
   }
   *dP = dpdv;
   *d2P = L->dt * L->dt * curv;
+  return p;
+}
+
+/* n = 1: the pressure times det > 0 at v_n det = vnd (law_pressure with
+ * both sides scaled; the same pieces), and dP/dv_n */
+static inline double law_pressure_lin_scaled(const Law *L, double vnd, double det, double *dP)
+{
+  double dd = -(L->g0 * det + L->dt * vnd);
+  if (!(dd > 0)) {
+    *dP = 0;
+    return 0;
+  }
+  double pe = L->Ke * dd, py = L->k * (L->sp * det + dd);
+  double p, slope;
+  if (pe <= py) {
+    p = pe;
+    slope = L->Ke;
+  } else {
+    p = py;
+    slope = L->k;
+  }
+  double dpdv = -L->dt * slope;
+  if (vnd < 0) {
+    p -= L->D * vnd;
+    dpdv -= L->D;
+  }
+  *dP = dpdv;
   return p;
 }
 
@@ -277,6 +306,8 @@ static void tblock_init(TBlock *B, const double G[9])
   B->e[0] = G[3];
   B->e[1] = G[6];
   B->inert = !(fabs(G[4]) + fabs(G[8]) > 0);
+  double off = 0.5 * (G[5] + G[7]);
+  B->pd = G[4] > 0 && G[4] * G[8] - off * off > 0;
 }
 
 /* the stick test |G_tt^-1 c| <= T, as |adj c| <= T |det| */
@@ -499,9 +530,14 @@ coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu, const dou
              const double G[9], double tol, double x, double sigma, double ct0, double ct1,
              double tf, int sure, double lam[3], int *iters, const int linear)
 {
-  /* slip_eval and slip_slope written out on scalars (the same
-   * expressions, so the same iterates): this loop is most of a warm
-   * coupled visit, and the Slip record would live in memory */
+  /* slip_eval's quantities written out on scalars (this loop is most of
+   * a warm coupled visit, and the Slip record would live in memory), and
+   * no division on the chain from one iterate to the next: the residual
+   * tests are made multiplied through by det > 0 (||w| - 1| <= tol as
+   * |ra - det| <= tol det, ra = |adj(M) c_t|; for n = 1 the normal
+   * residual too, from v_n det), and the Newton step from the Jacobian
+   * with its rows scaled (below).  1/det is formed beside them, for the
+   * impulse alone. */
   const double S = L->S, *Gt = B->G, e0 = B->e[0], e1 = B->e[1];
   for (int it = 0; it < 6; it++) {
     double e = 0, m = 0;
@@ -523,42 +559,58 @@ coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu, const dou
     if (!(det > 0)) return 0;
     double wa0 = M3 * ct0 - M1 * ct1, wa1 = M0 * ct1 - M2 * ct0;
     double ra = sqrt(wa0 * wa0 + wa1 * wa1), id = 1 / det;
-    double wn = ra * id, w0 = wa0 * id, w1 = wa1 * id;
+    double w0 = wa0 * id, w1 = wa1 * id;
     double lt0 = -T * w0, lt1 = -T * w1;
-    double dP, d2P, vn = v0[0] + G[0] * x + G[1] * lt0 + G[2] * lt1;
-    double F1 = x - S * law_pressure_as(L, vn, &dP, &d2P, linear);
-    if (fabs(F1) <= tol * x && fabs(wn - 1) <= tol) {
-      /* a slip solution excludes sticking for SPD G; checked all the same,
-       * with m(sigma) >= m0 deciding most cases without m0 */
+    double dP, d2P, F1d;
+    if (linear) {
+      /* v_n det and the residual times det, without the division */
+      double vnd = (v0[0] + G[0] * x) * det - T * (G[1] * wa0 + G[2] * wa1);
+      F1d = x * det - S * law_pressure_lin_scaled(L, vnd, det, &dP);
+    } else {
+      double vn = v0[0] + G[0] * x + G[1] * lt0 + G[2] * lt1;
+      F1d = (x - S * law_pressure_as(L, vn, &dP, &d2P, linear)) * det;
+    }
+    if (fabs(F1d) <= tol * x * det && fabs(ra - det) <= tol * det) {
+      /* a slip solution excludes sticking where G_tt is positive
+       * definite: c_t = M w = sigma w + T G_tt w with |w| = 1 gives
+       * |G_tt^-1 c_t| >= w . G_tt^-1 c_t = sigma w . G_tt^-1 w + T > T.
+       * Otherwise tested, with m(sigma) >= m0 deciding most cases
+       * without m0 */
       double ct[2] = {ct0, ct1};
-      if (stick_fits(B, ct, T) && stick_fits(B, ct, tf * mobil_m0(J))) return 0;
+      if (!B->pd && stick_fits(B, ct, T) && stick_fits(B, ct, tf * mobil_m0(J))) return 0;
       lam[0] = x;
       lam[1] = lt0;
       lam[2] = lt1;
       return 1;
     }
-    /* q = 1/|w| and its slope (slip_slope): M w' = -(w + T' G w) */
-    double q = det / ra, F2 = q - 1;
-    double Mi0 = M3 * id, Mi1 = -M1 * id, Mi2 = -M2 * id, Mi3 = M0 * id;
-    double Gw0 = Gt[0] * w0 + Gt[1] * w1, Gw1 = Gt[2] * w0 + Gt[3] * w1;
-    double a0 = w0 + dT * Gw0, a1 = w1 + dT * Gw1;
-    double dw0 = -(Mi0 * a0 + Mi1 * a1), dw1 = -(Mi2 * a0 + Mi3 * a1);
-    double dq = -(w0 * dw0 + w1 * dw1) * q * q * q;
-    /* d lambda_t/d lambda_n and d lambda_t/d sigma (M w = c_t, see
-     * solve_tangent), then the 2x2 Newton step */
+    /* The 2x2 Newton step, with the first row (F1 and its slopes) scaled
+     * by det^2 and the second (F2 = det/ra - 1) by ra^3: the same step in
+     * exact arithmetic, where each entry is a polynomial in M, wa and
+     * c_t.  With w = wa/det, M w' = -(w + T' G w) (slip_slope) gives
+     * w' = -adj(M) aa / det^2, aa = wa + T' G wa; the derivative of w in
+     * lambda_n (solve_tangent), d(c_t)/d lambda_n = G_tn = e, gives
+     * adj(M) rr / det^2, rr = det e - T_n G wa.  So F2's slopes times ra^3
+     * are wa . adj(M) aa and -wa . adj(M) rr; F1's take the slopes of the
+     * shear impulse -T w times det^2: -ltx in lambda_n, lts in sigma.
+     * Both factors are positive, so the determinant's sign test stands. */
+    double Gwa0 = Gt[0] * wa0 + Gt[1] * wa1, Gwa1 = Gt[2] * wa0 + Gt[3] * wa1;
+    double aa0 = wa0 + dT * Gwa0, aa1 = wa1 + dT * Gwa1;
+    double ba0 = M3 * aa0 - M1 * aa1, ba1 = M0 * aa1 - M2 * aa0;
     double Tx = mu * m;
-    double r0 = e0 - Tx * Gw0, r1 = e1 - Tx * Gw1;
-    double wx0 = Mi0 * r0 + Mi1 * r1, wx1 = Mi2 * r0 + Mi3 * r1;
-    double ltx0 = -Tx * w0 - T * wx0, ltx1 = -Tx * w1 - T * wx1;
-    double lts0 = -dT * w0 - T * dw0, lts1 = -dT * w1 - T * dw1;
-    double J11 = 1 - S * dP * (G[0] + G[1] * ltx0 + G[2] * ltx1);
-    double J12 = -S * dP * (G[1] * lts0 + G[2] * lts1);
-    double J21 = -(w0 * wx0 + w1 * wx1) * q * q * q;
-    double J22 = dq;
+    double rr0 = det * e0 - Tx * Gwa0, rr1 = det * e1 - Tx * Gwa1;
+    double bx0 = M3 * rr0 - M1 * rr1, bx1 = M0 * rr1 - M2 * rr0;
+    double det2 = det * det, Txd = Tx * det, dTd = dT * det, SdP = S * dP;
+    double ltx0 = Txd * wa0 + T * bx0, ltx1 = Txd * wa1 + T * bx1;
+    double lts0 = T * ba0 - dTd * wa0, lts1 = T * ba1 - dTd * wa1;
+    double J11 = det2 - SdP * (G[0] * det2 - (G[1] * ltx0 + G[2] * ltx1));
+    double J12 = -SdP * (G[1] * lts0 + G[2] * lts1);
+    double J21 = -(wa0 * bx0 + wa1 * bx1);
+    double J22 = wa0 * ba0 + wa1 * ba1;
+    double F1s = F1d * det, F2s = (det - ra) * (ra * ra);
     double jdet = J11 * J22 - J12 * J21;
     if (!(jdet > 0)) return 0;
-    x -= (J22 * F1 - J12 * F2) / jdet;
-    sigma -= (J11 * F2 - J21 * F1) / jdet;
+    x -= (J22 * F1s - J12 * F2s) / jdet;
+    sigma -= (J11 * F2s - J21 * F1s) / jdet;
     if (!(x > 0)) return 0;
     /* the next evaluation's c_t and tf, at the new x */
     ct0 = v0[1] + e0 * x;

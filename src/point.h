@@ -65,6 +65,8 @@ typedef struct ssTBlock {
   double det;
   double e[2];   /* G_tn = d c_t / d lambda_n */
   int inert;     /* G_tt = 0: no response (static body) */
+  int pd;        /* x . G_tt x > 0 for x != 0 (its symmetric part positive
+                    definite): a slip solution cannot also stick */
 } ssTBlock;
 
 /* The point's solve state kept on the contact (the contact is rebuilt
