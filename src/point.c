@@ -567,7 +567,9 @@ coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu, const dou
       double vnd = (v0[0] + G[0] * x) * det - T * (G[1] * wa0 + G[2] * wa1);
       F1d = x * det - S * law_pressure_lin_scaled(L, vnd, det, &dP);
     } else {
-      double vn = v0[0] + G[0] * x + G[1] * lt0 + G[2] * lt1;
+      /* v_n with 1/det applied last: the shear's share G_nt . wa is
+       * formed while the division runs */
+      double vn = (v0[0] + G[0] * x) - T * (G[1] * wa0 + G[2] * wa1) * id;
       F1d = (x - S * law_pressure_as(L, vn, &dP, &d2P, linear)) * det;
     }
     if (fabs(F1d) <= tol * x * det && fabs(ra - det) <= tol * det) {
