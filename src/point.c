@@ -575,9 +575,10 @@ coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu, const dou
     if (fabs(F1d) <= tol * x * det && fabs(ra - det) <= tol * det) {
       /* a slip solution excludes sticking where G_tt is positive
        * definite: c_t = M w = sigma w + T G_tt w with |w| = 1 gives
-       * |G_tt^-1 c_t| >= w . G_tt^-1 c_t = sigma w . G_tt^-1 w + T > T.
-       * Otherwise tested, with m(sigma) >= m0 deciding most cases
-       * without m0 */
+       * |G_tt^-1 c_t| >= w . G_tt^-1 c_t = sigma w . G_tt^-1 w + T > T
+       * (with |w| = 1 to the tolerance, to within tol T: a stick answer
+       * there would be the same impulse to that tolerance).  Otherwise
+       * tested, with m(sigma) >= m0 deciding most cases without m0 */
       double ct[2] = {ct0, ct1};
       if (!B->pd && stick_fits(B, ct, T) && stick_fits(B, ct, tf * mobil_m0(J))) return 0;
       lam[0] = x;
