@@ -53,9 +53,9 @@
  *    start this is one step and the checking evaluation.  It returns only
  *    when both residual tests pass at the same point and the point cannot
  *    stick there; any iterate leaving lambda_n > 0, 0 < sigma <= |c_t|
- *    hands the point to the safeguarded loop.  Cold, the start is the n = 1 piece (or
- *    a Newton step from 0) with the shear held, and sigma from the
- *    isotropic slip equation sigma + T gamma = |c_t|.
+ *    hands the point to the safeguarded loop.  Cold, the start is the
+ *    n = 1 piece (or a Newton step from 0) with the shear held, and sigma
+ *    from the isotropic slip equation sigma + T gamma = |c_t|.
  *  - Safeguarded loop: the scalar solves above, alternated.  Each shear
  *    solve also returns d lambda_t / d lambda_n (implicit derivative of its
  *    equations; -G_tt^-1 G_tn when sticking), and the next normal solve
@@ -89,16 +89,20 @@ static inline double pow_near(Law *L, double s)
 
 /* Normal pressure at end-of-step normal velocity vn (DESIGN 3.1) and its
  * first two derivatives in vn (P' <= 0; P'' from the envelope only);
- * linear: L->linear, a constant where the caller is specialised for it. */
-static inline double law_pressure_as(Law *L, double vn, double *dP, double *d2P,
+ * linear: L->linear, a constant where the caller is specialised for it.
+ * sc > 0 scales both sides, for n = 1 only, whose pieces are affine: the
+ * pressure times sc at the velocity vn / sc (sc = det in coupled_slip,
+ * so that no division comes first); every other call passes 1, a
+ * constant, and x * 1 folds away. */
+static inline double law_pressure_as(Law *L, double vn, double sc, double *dP, double *d2P,
                                      const int linear)
 {
-  double delta = -(L->g0 + L->dt * vn);
+  double delta = -(L->g0 * sc + L->dt * vn);
   if (!(delta > 0)) {
     *dP = *d2P = 0;
     return 0;
   }
-  double s = L->sp + delta;
+  double s = L->sp * sc + delta;
   /* one power for the envelope and its slope: s^n = s s^(n-1) */
   double sn1 = linear ? 1.0 : pow_near(L, s);
   double pe = L->Ke * delta, py = L->k * s * sn1;
@@ -121,36 +125,9 @@ static inline double law_pressure_as(Law *L, double vn, double *dP, double *d2P,
   return p;
 }
 
-/* n = 1: the pressure times det > 0 at v_n det = vnd (law_pressure with
- * both sides scaled; the same pieces), and dP/dv_n */
-static inline double law_pressure_lin_scaled(const Law *L, double vnd, double det, double *dP)
-{
-  double dd = -(L->g0 * det + L->dt * vnd);
-  if (!(dd > 0)) {
-    *dP = 0;
-    return 0;
-  }
-  double pe = L->Ke * dd, py = L->k * (L->sp * det + dd);
-  double p, slope;
-  if (pe <= py) {
-    p = pe;
-    slope = L->Ke;
-  } else {
-    p = py;
-    slope = L->k;
-  }
-  double dpdv = -L->dt * slope;
-  if (vnd < 0) {
-    p -= L->D * vnd;
-    dpdv -= L->D;
-  }
-  *dP = dpdv;
-  return p;
-}
-
 static inline double law_pressure(Law *L, double vn, double *dP, double *d2P)
 {
-  return law_pressure_as(L, vn, dP, d2P, L->linear);
+  return law_pressure_as(L, vn, 1, dP, d2P, L->linear);
 }
 
 /* n = 1: the root of x = A dt P(a + g x) from the four affine pieces of P
@@ -565,12 +542,12 @@ coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu, const dou
     if (linear) {
       /* v_n det and the residual times det, without the division */
       double vnd = (v0[0] + G[0] * x) * det - T * (G[1] * wa0 + G[2] * wa1);
-      F1d = x * det - S * law_pressure_lin_scaled(L, vnd, det, &dP);
+      F1d = x * det - S * law_pressure_as(L, vnd, det, &dP, &d2P, linear);
     } else {
       /* v_n with 1/det applied last: the shear's share G_nt . wa is
        * formed while the division runs */
       double vn = (v0[0] + G[0] * x) - T * (G[1] * wa0 + G[2] * wa1) * id;
-      F1d = (x - S * law_pressure_as(L, vn, &dP, &d2P, linear)) * det;
+      F1d = (x - S * law_pressure_as(L, vn, 1, &dP, &d2P, linear)) * det;
     }
     if (fabs(F1d) <= tol * x * det && fabs(ra - det) <= tol * det) {
       /* a slip solution excludes sticking where G_tt is positive
