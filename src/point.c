@@ -298,7 +298,7 @@ static inline int stick_fits(const TBlock *B, const double ct[2], double T)
 /* Janosi mobilisation m = 1 - exp(-x), x = (j + dt sigma)/K, and e = 1 - m,
  * so that the bound is T = tf m, T' = tf e r, T'' = -tf e r^2 (r = dt/K).
  * m is carried directly (no 1 - exp cancellation at small x) and moved from
- * the last point by expm1(-d) = sum (-d)^k/k!: m' = m - e expm1(-d).
+ * the last point by 1 - exp(-d) = d Q(d) (ss_exp_neg_q): m' = m + e d Q.
  * r = 0: constant bound (K = 0, or a rigid Coulomb contact). */
 typedef ssMobil Mobil;
 
@@ -327,6 +327,38 @@ static inline double mobil_at(Mobil *J, double sigma, double *e)
   J->last = ss_exp_memo_move(J->last, J->x0 + J->r * sigma);
   *e = J->last.e;
   return J->last.m;
+}
+
+/* The bound T = tf m(sigma), with m and e as mobil_at gives them (the
+ * memo moved to sigma).  T is formed from the last point's m and e as
+ * tf m + (tf e d) Q(d), and d as (x0 - x_last) + r sigma: both sums'
+ * other terms are ready before sigma, so T waits on sigma for eight
+ * operations where tf times mobil_at's m waits for twelve (one
+ * evaluation of the coupled Newton takes two of these). */
+static inline double mobil_bound(Mobil *J, double tf, double sigma, double *m, double *e)
+{
+  if (!(J->r > 0)) {
+    *m = 1;
+    *e = 0;
+    return tf;
+  }
+  ssExpMemo c = J->last;
+  double rs = J->r * sigma, x = J->x0 + rs, d = (J->x0 - c.x) + rs, T;
+  if (c.x >= 0 && fabs(d) <= SS_EXP_SERIES_MAX) {
+    double q = ss_exp_neg_q(d), p = d * q;
+    T = tf * c.m + (tf * c.e * d) * q;
+    c.m += c.e * p;
+    c.e -= c.e * p;
+  } else {
+    c.m = -expm1(-x);
+    c.e = 1 - c.m;
+    T = tf * c.m;
+  }
+  c.x = x;
+  J->last = c;
+  *m = c.m;
+  *e = c.e;
+  return T;
 }
 
 /* One evaluation of the slip equation at speed sigma: w = M^-1 c_t,
@@ -510,32 +542,35 @@ coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu, const dou
   /* slip_eval's quantities written out on scalars (this loop is most of
    * a warm coupled visit, and the Slip record would live in memory), and
    * no division on the chain from one iterate to the next: the residual
-   * tests are made multiplied through by det > 0 (||w| - 1| <= tol as
-   * |ra - det| <= tol det, ra = |adj(M) c_t|; for n = 1 the normal
+   * tests are made multiplied through by det > 0 (for n = 1 the normal
    * residual too, from v_n det), and the Newton step from the Jacobian
    * with its rows scaled (below).  1/det is formed beside them, for the
-   * impulse alone. */
+   * impulse alone.  ||w| - 1| <= tol is tested squared, as
+   * (1 - tol)^2 det^2 <= ra^2 <= (1 + tol)^2 det^2 with ra = |adj(M) c_t|
+   * (the same test: both sides are positive), so that the check waits
+   * on no square root; ra itself is taken only for a step. */
   const double S = L->S, *Gt = B->G, e0 = B->e[0], e1 = B->e[1];
+  const double lo2 = (1 - tol) * (1 - tol), hi2 = (1 + tol) * (1 + tol);
   for (int it = 0; it < 6; it++) {
-    double e = 0, m = 0;
+    double e = 0, m = 0, T = 0;
     int out = !(sigma > 0) || sigma * sigma > ct0 * ct0 + ct1 * ct1;
-    if (!out || !sure) m = mobil_at(J, sigma, &e);
+    if (!out || !sure) T = mobil_bound(J, tf, sigma, &m, &e);
     if (!sure) {
       /* the start's cheap stick test (ss_point_soil), on this first
        * evaluation's bound (not an iteration of its own): within it, the
        * point may stick */
       double ct[2] = {ct0, ct1};
-      if (stick_fits(B, ct, tf * m)) return 0;
+      if (stick_fits(B, ct, T)) return 0;
       sure = 1;
     }
     (*iters)++;
     if (out) return 0;
-    double T = tf * m, dT = tf * e * J->r;
+    double dT = tf * e * J->r;
     double M0 = sigma + T * Gt[0], M1 = T * Gt[1], M2 = T * Gt[2], M3 = sigma + T * Gt[3];
     double det = M0 * M3 - M1 * M2;
     if (!(det > 0)) return 0;
     double wa0 = M3 * ct0 - M1 * ct1, wa1 = M0 * ct1 - M2 * ct0;
-    double ra = sqrt(wa0 * wa0 + wa1 * wa1), id = 1 / det;
+    double ra2 = wa0 * wa0 + wa1 * wa1, id = 1 / det, dd = det * det;
     double w0 = wa0 * id, w1 = wa1 * id;
     double lt0 = -T * w0, lt1 = -T * w1;
     double dP, d2P, F1d;
@@ -549,7 +584,7 @@ coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu, const dou
       double vn = (v0[0] + G[0] * x) - T * (G[1] * wa0 + G[2] * wa1) * id;
       F1d = (x - S * law_pressure_as(L, vn, 1, &dP, &d2P, linear)) * det;
     }
-    if (fabs(F1d) <= tol * x * det && fabs(ra - det) <= tol * det) {
+    if (fabs(F1d) <= tol * x * det && ra2 >= lo2 * dd && ra2 <= hi2 * dd) {
       /* a slip solution excludes sticking where G_tt is positive
        * definite: c_t = M w = sigma w + T G_tt w with |w| = 1 gives
        * |G_tt^-1 c_t| >= w . G_tt^-1 c_t = sigma w . G_tt^-1 w + T > T
@@ -579,14 +614,14 @@ coupled_slip(Law *L, const TBlock *B, Mobil *J, double tf0, double mu, const dou
     double Tx = mu * m;
     double rr0 = det * e0 - Tx * Gwa0, rr1 = det * e1 - Tx * Gwa1;
     double bx0 = M3 * rr0 - M1 * rr1, bx1 = M0 * rr1 - M2 * rr0;
-    double det2 = det * det, Txd = Tx * det, dTd = dT * det, SdP = S * dP;
+    double Txd = Tx * det, dTd = dT * det, SdP = S * dP;
     double ltx0 = Txd * wa0 + T * bx0, ltx1 = Txd * wa1 + T * bx1;
     double lts0 = T * ba0 - dTd * wa0, lts1 = T * ba1 - dTd * wa1;
-    double J11 = det2 - SdP * (G[0] * det2 - (G[1] * ltx0 + G[2] * ltx1));
+    double J11 = dd - SdP * (G[0] * dd - (G[1] * ltx0 + G[2] * ltx1));
     double J12 = -SdP * (G[1] * lts0 + G[2] * lts1);
     double J21 = -(wa0 * bx0 + wa1 * bx1);
     double J22 = wa0 * ba0 + wa1 * ba1;
-    double F1s = F1d * det, F2s = (det - ra) * (ra * ra);
+    double ra = sqrt(ra2), F1s = F1d * det, F2s = (det - ra) * ra2;
     double jdet = J11 * J22 - J12 * J21;
     if (!(jdet > 0)) return 0;
     x -= (J22 * F1s - J12 * F2s) / jdet;

@@ -6,6 +6,7 @@
 #include "terrain.h"
 #include "tap.h"
 
+#include <float.h>
 #include <stdlib.h>
 
 #include <string.h>
@@ -240,9 +241,57 @@ static void test_pow_table(void)
      "plastic update with the tabled power: the public one's to rounding (%.3g)", worst);
 }
 
+/* The Janosi memo (ss_math.h: ss_exp_memo_move): m = 1 - exp(-x) moved by
+ * the series from a point that libm gave (or from x = 0, as a point's
+ * first x starts) is within 4 ulp of the exact value, relative, however
+ * small m is (the reason m is carried, not 1 - e) -- of the larger of
+ * the two points' m: a move down to a much smaller x keeps the last
+ * point's rounding, m' = m - e (1 - exp(-d)) cancelling; e within 4 ulp
+ * of 1, absolute (all that its uses need).  Every move the series
+ * reaches, both ways, from small to large x. */
+static void test_exp_memo(void)
+{
+  const double x0s[] = {0, 1e-14, 3e-6, 1e-3, 0.3, 1, 4.5, 30};
+  double worst_m = 0, worst_e = 0, at_x = 0, at_d = 0;
+  int series = 0, moves = 0;
+  srand(11);
+  for (size_t i = 0; i < sizeof x0s / sizeof *x0s; i++)
+    for (int k = 0; k < 4000; k++) {
+      double x0 = x0s[i], d = SS_EXP_SERIES_MAX * ldexp(rand() / (RAND_MAX + 1.0), -(k % 40));
+      if (k % 2) d = -d;
+      if (x0 + d < 0) continue;
+      ssExpMemo c = ss_exp_memo_start(x0);
+      if (x0 > 0) {
+        c.x = x0;
+        c.m = -expm1(-x0);
+        c.e = exp(-x0);
+      }
+      double x = x0 + d;
+      series += fabs(x - x0) <= SS_EXP_SERIES_MAX;
+      moves++;
+      double m0 = c.m;
+      c = ss_exp_memo_move(c, x);
+      long double mr = -expm1l(-(long double)x);
+      double big = fmax(m0, (double)mr), u = nextafter(big, INFINITY) - big;
+      double em = (double)fabsl((long double)c.m - mr) / u;
+      double ee = (double)fabsl((long double)c.e - expl(-(long double)x)) / DBL_EPSILON;
+      if (em > worst_m) {
+        worst_m = em;
+        at_x = x0;
+        at_d = d;
+      }
+      if (ee > worst_e) worst_e = ee;
+    }
+  ok(moves > 20000 && series == moves && worst_m <= 4,
+     "Janosi memo moved by the series: m within 4 ulp (worst %.2f, x0 = %g, d = %g)", worst_m,
+     at_x, at_d);
+  ok(worst_e <= 4, "Janosi memo moved by the series: e within 4 ulp of 1 (worst %.2f)", worst_e);
+}
+
 int main(void)
 {
   test_pow_table();
+  test_exp_memo();
   test_envelope();
   test_elastic();
   test_viscous_shear();
