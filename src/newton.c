@@ -886,6 +886,12 @@ static inline __attribute__((always_inline)) void mat_form(Mat *M, const int for
   }
 }
 
+/* the form that knows most of material M */
+static inline int form_of(const Mat *M)
+{
+  return M->linear ? FORM_LINEAR : M->pser.ok && M->rj > 0 ? FORM_POW_SHEAR : FORM_ANY;
+}
+
 /* F(y, mu) and H(y) = dF/dy over all contacts, the soil points' impulses
  * in lam (3 each; the rows' are their entries of F), the impulse-form
  * points' equations in ie.  H: a 6 x 6 block per group, then one value
@@ -1148,7 +1154,7 @@ static double check(const ssModel *m, ssData *d, const Setup *s, const ssNewtonW
     if (g != gprev) {
       gprev = g;
       M = w->grp[g].M;
-      form = M.linear ? FORM_LINEAR : M.pser.ok && M.rj > 0 ? FORM_POW_SHEAR : FORM_ANY;
+      form = form_of(&M);
     }
     const double *V = w->sum[g].V;
     if (w->ns)
@@ -1973,7 +1979,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     w->grp[g].gmax = slip_bound(w->grp[g].gq, w->grp[g].rmax);
     w->grp[g].M = mat_of(w->grp + g, dt);
     const Mat *M = &w->grp[g].M;
-    s.pow_shear &= !M->linear && M->pser.ok && M->rj > 0;
+    s.pow_shear &= form_of(M) == FORM_POW_SHEAR;
   }
   unknowns_of(m, d, &s, w, d->qvel_free, w->yfree);
   uint64_t key = unknowns_key(d, &s, w);
