@@ -343,18 +343,8 @@ static inline double mobil_bound(Mobil *J, double tf, double sigma, double *m, d
     return tf;
   }
   ssExpMemo c = J->last;
-  double rs = J->r * sigma, x = J->x0 + rs, d = (J->x0 - c.x) + rs, T;
-  if (c.x >= 0 && fabs(d) <= SS_EXP_SERIES_MAX) {
-    double q = ss_exp_neg_q(d), p = d * q;
-    T = tf * c.m + (tf * c.e * d) * q;
-    c.m += c.e * p;
-    c.e -= c.e * p;
-  } else {
-    c.m = -expm1(-x);
-    c.e = 1 - c.m;
-    T = tf * c.m;
-  }
-  c.x = x;
+  double rs = J->r * sigma, x = J->x0 + rs;
+  double T = ss_exp_memo_step(&c, x, (J->x0 - c.x) + rs, tf);
   J->last = c;
   *m = c.m;
   *e = c.e;

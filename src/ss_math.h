@@ -356,22 +356,33 @@ static inline ssExpMemo ss_exp_memo_start(double x0)
   return c;
 }
 
-/* c moved to x: by the series when x is within SS_EXP_SERIES_MAX of c.x,
- * else from libm */
+/* *c moved to x, with d = x - c->x as the caller formed it: by the series
+ * when d is within SS_EXP_SERIES_MAX, else from libm.  Returns s m at x,
+ * by the series as s m + (s e d) Q(d) from the last point's m and e, so
+ * that it waits on d for the series and two operations (a caller that
+ * scales m, and forms d from values ready before x, waits less) */
+static inline double ss_exp_memo_step(ssExpMemo *c, double x, double d, double s)
+{
+  double sm;
+  if (c->x >= 0 && fabs(d) <= SS_EXP_SERIES_MAX) {
+    double q = ss_exp_neg_q(d), p = d * q; /* 1 - exp(-d) */
+    sm = s * c->m + (s * c->e * d) * q;
+    c->m += c->e * p;
+    c->e -= c->e * p;
+  } else {
+    c->m = -expm1(-x);
+    c->e = 1 - c->m;
+    sm = s * c->m;
+  }
+  c->x = x;
+  return sm;
+}
+
+/* c moved to x (ss_exp_memo_step); unchanged where x is its own */
 static inline ssExpMemo ss_exp_memo_move(ssExpMemo c, double x)
 {
   double d = x - c.x;
-  if (d != 0) {
-    if (c.x >= 0 && fabs(d) <= SS_EXP_SERIES_MAX) {
-      double p = d * ss_exp_neg_q(d); /* 1 - exp(-d) */
-      c.m += c.e * p;
-      c.e -= c.e * p;
-    } else {
-      c.m = -expm1(-x);
-      c.e = 1 - c.m;
-    }
-    c.x = x;
-  }
+  if (d != 0) ss_exp_memo_step(&c, x, d, 1);
   return c;
 }
 
