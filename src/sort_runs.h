@@ -36,6 +36,14 @@
 /* the run ends a pass keeps for the next (a stack array) */
 #define SS_SORT_RUNS_MAX 32
 
+/* name() is a convenience that a user of name_from alone leaves unused;
+ * clang warns of an unused static inline function defined in a .c file */
+#if defined(__GNUC__)
+#define SS_SORT_RUNS_MAYBE_UNUSED __attribute__((unused))
+#else
+#define SS_SORT_RUNS_MAYBE_UNUSED
+#endif
+
 #define SS_SORT_RUNS(name, T, less)                                            \
   static int name##_run(T *v, int i, int n)                                    \
   {                                                                            \
@@ -106,7 +114,7 @@
       if (runs <= 1) return v;                                                 \
     }                                                                          \
   }                                                                            \
-  static inline T *name(T *v, T *t, int n)                                     \
+  static inline SS_SORT_RUNS_MAYBE_UNUSED T *name(T *v, T *t, int n)           \
   {                                                                            \
     return name##_from(v, t, n, 0);                                            \
   }
