@@ -1974,6 +1974,20 @@ int ss_model_add_articulated(ssModel *m, const ssUrdf *u, const ssArtDef *def,
                  def->name, def->nqvel, nv);
     return -1;
   }
+  if (def->qpos && !ss_all_within(def->qpos, nq, DBL_MAX)) {
+    ss_error_set(err, SS_ERR_VALUE, f, line,
+                 "articulated_system '%s': %s values must be finite", def->name,
+                 def->qpos_name ? def->qpos_name : "qpos");
+    return -1;
+  }
+  for (int k = 0; def->qvel && k < nv; k++)
+    if (!ss_all_within(def->qvel + k, 1, SS_SPEED_MAX)) {
+      ss_error_set(err, SS_ERR_VALUE, f, line,
+                   "articulated_system '%s': qvel value %d of %d is %g; each "
+                   "must be at most 1e5 in magnitude (m/s, rad/s), the largest "
+                   "speed a step accepts", def->name, k + 1, nv, def->qvel[k]);
+      return -1;
+    }
   int mat = ss_model_material(m, def->material);
   if (mat < 0) {
     ss_error_set(err, SS_ERR_NOMEM, f, line, "out of memory");

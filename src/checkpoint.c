@@ -62,9 +62,11 @@
  * have room), so a refused file leaves the data as it was.  The contacts of
  * the last step are not saved: the next step rebuilds them. */
 #include "soilsim.h"
+#include "dynamics.h"
 #include "mesh.h"
 #include "scene.h"
 #include "solver.h"
+#include "ss_math.h"
 
 #include <limits.h>
 #include <math.h>
@@ -407,6 +409,10 @@ ssStatus ss_checkpoint_save_buffer(const ssModel *m, const ssData *d,
   *len = 0;
   ssStatus st = check_pair(m, d, "cannot write a checkpoint", NULL, err);
   if (st) return st;
+  /* what a restore would refuse, or the next step (SS_SPEED_MAX) */
+  char why[300];
+  if (!ss_dyn_check_state(m, d, why, sizeof why))
+    return ss_error_set(err, SS_ERR_VALUE, NULL, 0, "cannot write a checkpoint: %s", why);
 
   Writer w = {NULL, 0, 0, 0};
   Fingerprint f;
@@ -1045,6 +1051,11 @@ static ssStatus parse_state(const ssModel *m, const Parsed *f, const char *path,
     s->active[k] = *r_take(&r, 1);
     if (s->active[k] > 1) return corrupt(err, path, "bad section 'SYSA'");
   }
+  /* no step leaves a speed above SS_SPEED_MAX, and none is saved */
+  for (size_t k = 0; k < ns; k++)
+    if (s->active[k] &&
+        !ss_all_within(s->qvel + m->sys_vadr[k], m->sys_nv[k], SS_SPEED_MAX))
+      return corrupt(err, path, "a velocity above 1e5 (m/s or rad/s)");
   /* bed orientations are unit quaternions (ss_hfield_set_pose) */
   for (size_t h = 0; h < nh; h++) {
     const double *q = s->hquat + 4 * h;

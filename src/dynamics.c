@@ -11,6 +11,8 @@
 #include "mesh.h"
 #include "ss_math.h"
 
+#include <float.h>
+#include <stdio.h>
 #include <string.h>
 
 static int sys_dynamic(const ssModel *m, const ssData *d, int s)
@@ -218,18 +220,39 @@ void ss_dyn_integrate(const ssModel *m, ssData *d)
   }
 }
 
-int ss_dyn_check_finite(const ssModel *m, const ssData *d)
+int ss_dyn_check_finite(const ssModel *m, const ssData *d, int *velocity)
 {
-  /* 1e5 m/s (or rad/s): a hundred times a rifle bullet, far beyond any
-   * vehicle, foot or plate on soil; a sign the step blew up */
+  /* SS_SPEED_MAX: far beyond any vehicle, foot or plate on soil; after a
+   * step, a sign that it blew up */
   for (int s = 0; s < m->nsys; s++) {
     if (!d->sys_active[s]) continue;
+    *velocity = 0;
     for (int k = 0; k < m->sys_nq[s]; k++)
       if (!isfinite(d->qpos[m->sys_qadr[s] + k])) return s;
-    for (int k = 0; k < m->sys_nv[s]; k++) {
-      double v = d->qvel[m->sys_vadr[s] + k];
-      if (!isfinite(v) || fabs(v) > 1e5) return s;
-    }
+    *velocity = 1;
+    if (!ss_all_within(d->qvel + m->sys_vadr[s], m->sys_nv[s], SS_SPEED_MAX)) return s;
   }
   return -1;
+}
+
+int ss_dyn_check_state(const ssModel *m, const ssData *d, char *msg, size_t cap)
+{
+  int vel, s = ss_dyn_check_finite(m, d, &vel);
+  if (s >= 0) {
+    snprintf(msg, cap, "the %s of '%s' is %s", vel ? "velocity" : "position",
+             m->sys_name[s], vel ? "non-finite or above 1e5 (m/s or rad/s)" : "non-finite");
+    return 0;
+  }
+  /* a bed's quaternion unit as ss_hfield_set_pose leaves it (to the
+   * checkpoint reader's 1e-6) */
+  for (int h = 0; h < m->nhfield; h++) {
+    const double *q = d->hfield_quat + 4 * h;
+    if (!ss_all_within(d->hfield_pos + 3 * h, 3, DBL_MAX) ||
+        !(fabs(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] - 1) <= 1e-6)) {
+      snprintf(msg, cap, "the pose of height map '%s' is non-finite or not a unit "
+               "quaternion (move beds with ss_hfield_set_pose)", m->hfield_name[h]);
+      return 0;
+    }
+  }
+  return 1;
 }

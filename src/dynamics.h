@@ -45,8 +45,15 @@ double ss_dyn_geom_approach(const ssModel *m, const ssData *d, int g,
                             double radius, const double n[3]);
 /* Positions from velocities (semi-implicit Euler); quaternions exact. */
 void ss_dyn_integrate(const ssModel *m, ssData *d);
-/* First system whose coordinates are non-finite or whose velocities are
- * non-finite or above 1e5 (m/s or rad/s), or -1. */
-int ss_dyn_check_finite(const ssModel *m, const ssData *d);
+/* First active system whose coordinates are non-finite (*velocity = 0) or
+ * whose velocities are non-finite or above SS_SPEED_MAX in magnitude (m/s
+ * or rad/s; *velocity = 1), or -1. */
+int ss_dyn_check_finite(const ssModel *m, const ssData *d, int *velocity);
+/* The state a step starts from and an export or checkpoint writes: that
+ * of ss_dyn_check_finite, and every bed's pose finite with a unit
+ * quaternion (to 1e-6, as a checkpoint must hold it).  1 when it holds;
+ * else 0 with what is wrong in msg ("the velocity of 'ball' is non-finite
+ * or above 1e5 (m/s or rad/s)"). */
+int ss_dyn_check_state(const ssModel *m, const ssData *d, char *msg, size_t cap);
 
 #endif

@@ -610,6 +610,16 @@ int ss_model_add_body(ssModel *m, const ssBodyDef *def, ssError *err)
                  "body '%s': state values must be finite", def->name);
     return -1;
   }
+  if (!ss_all_within(def->lin_vel, 3, SS_SPEED_MAX) ||
+      !ss_all_within(def->ang_vel, 3, SS_SPEED_MAX)) {
+    ss_error_set(err, SS_ERR_VALUE, f, def->line,
+                 "body '%s': lin_vel %g %g %g, ang_vel %g %g %g; each "
+                 "component must be at most 1e5 in magnitude (m/s, rad/s), the "
+                 "largest speed a step accepts", def->name, def->lin_vel[0],
+                 def->lin_vel[1], def->lin_vel[2], def->ang_vel[0],
+                 def->ang_vel[1], def->ang_vel[2]);
+    return -1;
+  }
   double qn = sqrt(def->quat[0] * def->quat[0] + def->quat[1] * def->quat[1] +
                    def->quat[2] * def->quat[2] + def->quat[3] * def->quat[3]);
   if (qn < 1e-9) {

@@ -9,6 +9,7 @@
  * through one buffer straight to the file (no per-number library calls
  * besides the formatting), and the file is replaced atomically. */
 #include "scene.h"
+#include "dynamics.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -413,6 +414,11 @@ static ssStatus check_exportable(const ssModel *m, const ssData *d,
   if (d->in_step)
     return ss_error_set(err, SS_ERR_STATE, path, 0,
                         "cannot export in the middle of a step");
+  /* what the reader would refuse is not written (the limits a step keeps:
+   * see SS_SPEED_MAX) */
+  char why[300];
+  if (!ss_dyn_check_state(m, d, why, sizeof why))
+    return ss_error_set(err, SS_ERR_VALUE, path, 0, "cannot export: %s", why);
   for (int s = 0; s < m->nsys; s++) {
     if (!d->sys_active[s]) continue;
     if (m->sys_type[s] == SS_SYS_ARTICULATED) continue;

@@ -24,6 +24,15 @@ extern "C" {
 
 #define SS_VERSION "0.1.0"
 
+/* The largest speed a state may hold: every velocity coordinate (m/s, or
+ * rad/s for angles) must be finite and at most this in magnitude, a
+ * hundred times a rifle bullet and far beyond any vehicle, foot or plate
+ * on soil.  Bodies and articulated systems given a faster state are
+ * refused when they are added (ss_model_add_body,
+ * ss_model_add_articulated); a step that starts or ends beyond it fails
+ * (ss_step), and such a state is neither exported nor checkpointed. */
+#define SS_SPEED_MAX 1e5
+
 /* ---------------------------------------------------------------------- */
 /* errors                                                                  */
 
@@ -432,8 +441,10 @@ typedef struct ssData {
   long step;              /* completed steps */
   int in_step;            /* 1 while ss_step runs: state setters refuse */
 
-  double *qpos;           /* (nq) free body: COM position (3), quat (4) */
-  double *qvel;           /* (nv) free body: lin vel (3), ang vel (3), world */
+  double *qpos;           /* (nq) free body: COM position (3), quat (4,
+                             unit, w x y z); finite, or a step refuses it */
+  double *qvel;           /* (nv) free body: lin vel (3), ang vel (3), world;
+                             each within SS_SPEED_MAX, or a step refuses it */
   unsigned char *sys_active; /* (nsys) 0 once removed from the world */
   double *pd_target;      /* (npd x 2) position and velocity targets */
 
@@ -451,7 +462,10 @@ typedef struct ssData {
   double closure_error;   /* largest loop-closure violation after the last
                              step (m for points, rad or m for joints) */
 
-  /* height map poses (settable between steps) */
+  /* height map poses: move a bed between steps with ss_hfield_set_pose,
+   * which checks the pose, makes the quaternion unit and drops the warm
+   * start (a step refuses a pose written here directly that is not
+   * finite or whose quaternion is not unit) */
   double *hfield_pos;     /* (nhfield x 3) */
   double *hfield_quat;    /* (nhfield x 4) */
 
@@ -524,9 +538,12 @@ void ss_data_reset(const ssModel *m, ssData *d);
 void ss_forward(const ssModel *m, ssData *d);
 
 /* One time step.  SS_ERR_NUMERIC (naming the step and body) if a velocity
- * became non-finite or absurd (above 1e5 m/s or rad/s) or a position
- * non-finite.  A step that fails for any reason leaves d exactly as it was
- * (positions, velocities, soil, warm-start cache, statistics). */
+ * became non-finite or absurd (above SS_SPEED_MAX m/s or rad/s) or a
+ * position non-finite.  SS_ERR_VALUE, before anything is stepped, if the
+ * state it starts from is already so, or a bed's pose is non-finite or
+ * its quaternion not unit (as written into d between steps).  A step that fails for any
+ * reason leaves d exactly as it was (positions, velocities, soil,
+ * warm-start cache, statistics). */
 ssStatus ss_step(const ssModel *m, ssData *d, ssError *err);
 
 /* Remove a system from the world (from the next step on). */

@@ -16,6 +16,14 @@
 static inline double ss_max(double a, double b) { return a > b ? a : b; }
 static inline double ss_min(double a, double b) { return a < b ? a : b; }
 
+/* 1 when each of v[0..n) is finite and at most vmax in magnitude */
+static inline int ss_all_within(const double *v, int n, double vmax)
+{
+  for (int i = 0; i < n; i++)
+    if (!(fabs(v[i]) <= vmax)) return 0;
+  return 1;
+}
+
 /* y[0..m) += a x[0..m) for rows that do not overlap, two lanes at a time
  * (GCC's vector extension: SSE2 on x86-64, plain pairs elsewhere), the
  * same products and sums, element by element, as the scalar loop (no

@@ -20,6 +20,15 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
 {
   if (d->in_step)
     return ss_error_set(err, SS_ERR_STATE, NULL, 0, "ss_step called re-entrantly");
+  /* the state a step starts from: a caller may have written it between
+   * steps (or a checkpoint restored it), and none of it is used before
+   * it has passed the test that every step's result passes */
+  char why[300];
+  if (!ss_dyn_check_state(m, d, why, sizeof why))
+    return ss_error_set(err, SS_ERR_VALUE, NULL, 0,
+                        "step %ld (t = %.6g s): %s before the step (set between "
+                        "steps or restored); nothing was stepped", d->step + 1,
+                        d->time + m->opt.timestep, why);
   /* keep the coordinates and velocities so a failed step leaves d where it
    * was; the soil state and the warm-start cache are written only once
    * every check has passed */
@@ -55,7 +64,7 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
   if ((st = ss_solver_solve(m, d, err))) goto fail;
   t1 = now(); t[3] = t1 - t0; t0 = t1;
 
-  int bad = ss_dyn_check_finite(m, d);
+  int vel, bad = ss_dyn_check_finite(m, d, &vel);
   if (bad >= 0) {
     st = ss_error_set(err, SS_ERR_NUMERIC, NULL, 0,
                       "step %ld (t = %.6g s): the velocity of '%s' became "
@@ -71,12 +80,13 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
   ss_forward_step(m, d);
   t1 = now(); t[5] = t1 - t0; t0 = t1;
 
-  bad = ss_dyn_check_finite(m, d);
+  bad = ss_dyn_check_finite(m, d, &vel);
   if (bad >= 0) {
     st = ss_error_set(err, SS_ERR_NUMERIC, NULL, 0,
-                      "step %ld (t = %.6g s): the position of '%s' became "
-                      "non-finite", d->step + 1, d->time + m->opt.timestep,
-                      m->sys_name[bad]);
+                      "step %ld (t = %.6g s): the %s of '%s' became "
+                      "non-finite%s", d->step + 1, d->time + m->opt.timestep,
+                      vel ? "velocity" : "position", m->sys_name[bad],
+                      vel ? " or absurd" : "");
     goto fail;
   }
 

@@ -571,6 +571,7 @@ static void damage_tests(const char *what, const ssModel *m, const ssData *src,
     {"negative step count", "CLCK", 16 + 8, 8, UINT64_C(0xFFFFFFFFFFFFFFFF)},
     {"time +inf", "CLCK", 16, 8, UINT64_C(0x7ff0000000000000)},
     {"qpos NaN", "QPOS", 16, 8, UINT64_C(0x7ff8000000000001)},
+    {"qvel 2e5 (above SS_SPEED_MAX)", "QVEL", 16, 8, UINT64_C(0x41086a0000000000)},
     {"negative plastic sinkage", "PLAS", 16, 8, UINT64_C(0xbff0000000000000)},
     {"system flag 2", "SYSA", 16, 1, 2},
     {"bed quaternion of norm 2", "HQUA", 16, 8, UINT64_C(0x4000000000000000)},
@@ -982,10 +983,13 @@ static void test_export(void)
   }
 }
 
-/* A step that fails (here: a body thrown upward at 2e5 m/s, past the
- * absurd-velocity bound, while it presses on the soil with a warm cache)
- * leaves everything as it was: the same checkpoint bytes before and after,
- * soil state and warm-start cache included. */
+/* A step that fails leaves everything as it was: the same checkpoint
+ * bytes before and after, soil state and warm-start cache included.  Two
+ * ways: the step itself blows up (gravity turned to 2e8 m/s^2 upward
+ * throws the body off the soil at 2e5 m/s, past SS_SPEED_MAX, after the
+ * warm start and the solve have run on its settled contacts), and a
+ * state set beyond SS_SPEED_MAX between steps, refused before anything
+ * is stepped. */
 static void failed_step(const char *scene, int settle)
 {
   ssModel *m;
@@ -996,16 +1000,68 @@ static void failed_step(const char *scene, int settle)
   }
   ok(run(m, d, settle) && d->nwarm > 0 && d->nsoil_loaded > 0,
      "failed step on %s: %d steps settle on the soil with a warm cache", scene, settle);
-  for (int k = 0; k < m->nv; k++) d->qvel[k] = k < 3 ? 2e5 * (k == 2) : 0;
   size_t la = 0, lb = 0;
-  unsigned char *a = snapshot(m, d, &la);
+  unsigned char *a = snapshot(m, d, &la), *b;
   ssError e;
+  double g[3];
+  memcpy(g, m->opt.gravity, sizeof g);
+  m->opt.gravity[0] = m->opt.gravity[1] = 0;
+  m->opt.gravity[2] = 2e8;
   ssStatus st = ss_step(m, d, &e);
-  ok(st == SS_ERR_NUMERIC && strstr(e.message, "step"),
-     "failed step on %s: the step fails with a numeric error (%s)", scene, e.message);
-  unsigned char *b = snapshot(m, d, &lb);
+  memcpy(m->opt.gravity, g, sizeof g);
+  ok(st == SS_ERR_NUMERIC && strstr(e.message, "step 201 (") &&
+         strstr(e.message, "became non-finite or absurd"),
+     "failed step on %s: the step blows up with a numeric error (%s)", scene, e.message);
+  b = snapshot(m, d, &lb);
   ok(a && b && la == lb && !memcmp(a, b, la),
      "failed step on %s: state, soil and warm cache unchanged", scene);
+  free(b);
+  /* and the next step runs as if the failed one had not been tried */
+  ok(ss_step(m, d, &e) == SS_OK, "failed step on %s: the next step runs", scene);
+
+  ssModel *m2 = NULL;
+  ssData *d2 = NULL;
+  ok(load_scene(scene, &m2, &d2) && run(m2, d2, settle + 1),
+     "failed step on %s: the same steps run again without the failure", scene);
+  free(a);
+  a = d2 ? snapshot(m2, d2, &la) : NULL;
+  b = snapshot(m, d, &lb);
+  ok(a && b && la == lb && !memcmp(a, b, la),
+     "failed step on %s: after it, the same bytes as a run that never failed", scene);
+  free(a);
+  free(b);
+  ss_data_free(d2);
+  ss_model_free(m2);
+
+  /* (no checkpoint can hold this state: compared by hand) */
+  for (int k = 0; k < m->nv; k++) d->qvel[k] = k < 3 ? 2e5 * (k == 2) : 0;
+  size_t nb = (size_t)(m->nq + m->nv) * sizeof(double);
+  long step0 = d->step;
+  a = malloc(nb);
+  b = malloc(nb);
+  memcpy(a, d->qpos, (size_t)m->nq * sizeof(double));
+  memcpy(a + (size_t)m->nq * sizeof(double), d->qvel, (size_t)m->nv * sizeof(double));
+  st = ss_step(m, d, &e);
+  ok(st == SS_ERR_VALUE && strstr(e.message, "velocity") &&
+         strstr(e.message, "above 1e5 (m/s or rad/s) before the step"),
+     "failed step on %s: a speed set past the limit is refused (%s)", scene, e.message);
+  memcpy(b, d->qpos, (size_t)m->nq * sizeof(double));
+  memcpy(b + (size_t)m->nq * sizeof(double), d->qvel, (size_t)m->nv * sizeof(double));
+  ok(!memcmp(a, b, nb) && d->step == step0, "failed step on %s: nothing stepped", scene);
+  memset(d->qvel, 0, (size_t)m->nv * sizeof(double));
+  double q0 = d->qpos[0];
+  d->qpos[0] = NAN;
+  st = ss_step(m, d, &e);
+  ok(st == SS_ERR_VALUE && strstr(e.message, "position") && strstr(e.message, "non-finite"),
+     "failed step on %s: a non-finite position is refused (%s)", scene, e.message);
+  d->qpos[0] = q0;
+  d->hfield_pos[2] = NAN;
+  st = ss_step(m, d, &e);
+  ok(st == SS_ERR_VALUE && strstr(e.message, "pose of height map") &&
+         strstr(e.message, "ss_hfield_set_pose"),
+     "failed step on %s: a bed pose written as NaN is refused (%s)", scene, e.message);
+  d->hfield_pos[2] = m->hfield_pos0[2];
+  ok(ss_step(m, d, &e) == SS_OK, "failed step on %s: with the state mended, it steps", scene);
   free(a);
   free(b);
   ss_data_free(d);

@@ -313,7 +313,12 @@ static void test_round_trip(void)
     q[0] = 0.9 + s * 0.01; q[1] = -0.1 / 3; q[2] = 0.2 / 7; q[3] = 1e-3 * s;
     ss_quat_normalize(q);
   }
-  for (int i = 0; i < m->nv; i++) d->qvel[i] = -odd(i + 3);
+  /* velocities as odd, within the largest speed a state may hold (the
+   * huge ones become the double just below it) */
+  for (int i = 0; i < m->nv; i++) {
+    double v = -odd(i + 3);
+    d->qvel[i] = fabs(v) <= SS_SPEED_MAX ? v : copysign(nextafter(SS_SPEED_MAX, 0), v);
+  }
   d->qvel[0] = -0.0;
   int n = m->hfield_nx[0] * m->hfield_ny[0];
   double sk[6], pl[6], sh[6];
@@ -385,6 +390,28 @@ static void test_round_trip(void)
   ssData *d4 = NULL;
   load_str(scene_snake, &m4, &d4, &e);
   ok(m4 && ss_scene_export(m4, d4, bad, &e) == SS_ERR_IO, "export to a missing folder: SS_ERR_IO");
+
+  /* a state the reader (and a step) would refuse is not written: a speed
+   * past SS_SPEED_MAX, a non-finite position or bed pose; the file that
+   * was there stays as it was, and no checkpoint is made of it either */
+  if (m4 && ok(ss_scene_export(m4, d4, a, &e) == SS_OK && ss_scene_export(m4, d4, b, &e) == SS_OK,
+                "a good state exported twice")) {
+    static const char *const what[] = {"velocity", "position", "pose of height map"};
+    for (int k = 0; k < 3; k++) {
+      double *x = k == 0 ? &d4->qvel[1] : k == 1 ? &d4->qpos[2] : &d4->hfield_pos[0];
+      double keep = *x;
+      *x = k == 0 ? 2 * SS_SPEED_MAX : NAN;
+      unsigned char *buf = NULL;
+      size_t len = 0;
+      ssStatus se = ss_scene_export(m4, d4, a, &e);
+      int said = se == SS_ERR_VALUE && strstr(e.message, "cannot export: the ") &&
+                 strstr(e.message, what[k]);
+      ssStatus sc = ss_checkpoint_save_buffer(m4, d4, &buf, &len, &e);
+      ok(said && sc == SS_ERR_VALUE && !buf && strstr(e.message, what[k]) && same_file(a, b),
+         "a state with a bad %s is neither exported nor checkpointed (%s)", what[k], e.message);
+      *x = keep;
+    }
+  }
   ss_data_free(d4); ss_model_free(m4);
 }
 
