@@ -491,6 +491,11 @@ static int parse_args(int argc, char **argv, Options *o)
     return usage_error("--camera-* and --color need --render DIR");
   if (size_given && !o->render_dir && !o->rut_map)
     return usage_error("--size needs --render or --rut-map");
+  if (o->rut_map && size_given &&
+      (o->width < SS_RUT_MAP_MIN_SIDE || o->height < SS_RUT_MAP_MIN_SIDE))
+    return usage_error("--size %dx%d is too small for --rut-map: each side "
+                       "must be at least %d pixels", o->width, o->height,
+                       SS_RUT_MAP_MIN_SIDE);
   for (int i = 0; i < o->nremoval; i++)
     if (o->removal[i].step > o->steps)
       return usage_error("--remove %s: step %ld is after the last step "

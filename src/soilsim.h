@@ -628,7 +628,9 @@ ssStatus ss_render_frame(ssRenderer *r, const ssModel *m, const ssData *d,
                          const char *png_path, ssError *err);
 /* Top-down rut map of the first soil bed (or hfield >= 0): sinkage or
  * plastic sinkage as colour, colour bar labelled in millimetres, metre
- * scale.  Does not need a GL context. */
+ * scale.  Each side SS_RUT_MAP_MIN_SIDE to 16384 pixels (the colour bar,
+ * labels and scale need the room).  Does not need a GL context. */
+#define SS_RUT_MAP_MIN_SIDE 64
 ssStatus ss_render_rut_map(const ssModel *m, const ssData *d, int hfield,
                            int plastic, int width, int height,
                            const char *png_path, ssError *err);

@@ -59,6 +59,10 @@ for v in 0x10 640 x480 640x 640x480x2 -640x480 20000x100 axb; do
   run "$PLATE" --size "$v" --rut-map "$tmp/r.png"
   check "--size '$v' is rejected (exit 2)" 'usage_error && err_has "--size"'
 done
+# a rut map needs room for its colour bar and scale: refused before any step
+run "$PLATE" --steps 5 --size 63x100 --rut-map "$tmp/small.png"
+check "--size 63x100 with --rut-map: exit 2 before the run (at least 64 pixels)" \
+  'usage_error && err_has "at least 64 pixels" && no_file "$tmp/small.png"'
 for v in plate @5 plate@ plate@x plate@-1 plate@1.5; do
   run "$PLATE" --remove "$v"
   check "--remove '$v' is rejected (exit 2)" 'usage_error && err_has "--remove"'
