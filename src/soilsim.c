@@ -919,7 +919,10 @@ static int run(const Options *o)
     }
   }
   if (o->csv_path) {
-    if (ss_atomic_open(&csv, o->csv_path, &err) != SS_OK) goto fail;
+    /* the same test and message as the other outputs' (check_output) */
+    if (check_output(o->csv_path, "--csv", &err) != SS_OK ||
+        ss_atomic_open(&csv, o->csv_path, &err) != SS_OK)
+      goto fail;
     csv_open = 1;
     csv_header((FILE *)csv.fp, m);
   }

@@ -120,8 +120,11 @@ run "$PLATE" --steps 2000000000 --export /nonexistent/dir/x.xml
 check "unwritable --export path: exit 1 before stepping, names the path" \
   'rc_is 1 && err_has "/nonexistent/dir/x.xml" && no_file /nonexistent/dir/x.xml'
 run "$PLATE" --steps 2000000000 --csv /nonexistent/dir/x.csv
-check "unwritable --csv path: exit 1 before stepping" \
-  'rc_is 1 && err_has "/nonexistent/dir/x.csv"'
+check "unwritable --csv path: exit 1 before stepping, naming the option" \
+  'rc_is 1 && err_has "/nonexistent/dir/x.csv" && err_has "error: --csv: cannot write"'
+run "$PLATE" --steps 2000000000 --csv "$tmp"
+check "--csv naming a directory: exit 1 before stepping" \
+  'rc_is 1 && err_has "--csv: cannot write: is a directory"'
 run "$PLATE" --steps 2000000000 --export "$tmp"
 check "--export naming a directory: exit 1 before stepping" \
   'rc_is 1 && err_has "directory"'
