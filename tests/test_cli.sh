@@ -59,6 +59,9 @@ for v in 0x10 640 x480 640x 640x480x2 -640x480 20000x100 axb; do
   run "$PLATE" --size "$v" --rut-map "$tmp/r.png"
   check "--size '$v' is rejected (exit 2)" 'usage_error && err_has "--size"'
 done
+run "$PLATE" --steps 5 --render "$tmp/cam0" --camera-pos 0,0,1 --camera-look-at 0,0,1
+check "--camera-pos equal to --camera-look-at: exit 2 (a camera needs a direction)" \
+  'usage_error && err_has "distinct points" && no_file "$tmp/cam0"'
 # a rut map needs room for its colour bar and scale: refused before any step
 run "$PLATE" --steps 5 --size 63x100 --rut-map "$tmp/small.png"
 check "--size 63x100 with --rut-map: exit 2 before the run (at least 64 pixels)" \
