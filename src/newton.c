@@ -138,6 +138,9 @@ typedef struct NGroup {
   double gmax;        /* a bound on its points' G_tt (slip_bound) */
   const ssSoilMaterial *mat;
   double R[9];        /* contact frame rows n, t1, t2 (world) */
+  double oref[3];     /* o less the point the body's spatial quantities
+                         are about (group_motion): a free body's centre of
+                         mass, a link's world origin */
   double o[3];        /* origin of the points' r (world) */
   const ssPowTable *pt; /* its bed's table of s^(n-1), or NULL */
   double ik;          /* 1 / K_j of its material, 0 for K_j = 0 */
@@ -320,23 +323,25 @@ typedef struct Setup {
                          form where their tests compile away */
 } Setup;
 
-/* y_b (omega; v_O, world, about the origin) in a group's frame about its
- * origin: omega' = R omega, v' = R (v_O + omega x o) */
+/* y_b (omega; v_P, world, about the body's point P: group_motion) in a
+ * group's frame about its origin: omega' = R omega, v' = R (v_P + omega x
+ * (o - P)) */
 static void to_group(const NGroup *G, const double V[6], double Vg[6])
 {
   double vo[3];
-  ss_v3_cross(vo, V, G->o);
+  ss_v3_cross(vo, V, G->oref);
   ss_v3_add(vo, vo, V + 3);
   ss_m3_mulv(Vg, G->R, V);
   ss_m3_mulv(Vg + 3, G->R, vo);
 }
 
-/* The group's impulse and its derivative back to world, about the origin:
- * with y' = T y, T = [[R, 0], [-R [o]x, R]], F = T^T F' and H = T^T H' T.
- * group_T forms T. */
+/* The group's impulse and its derivative back to world, about the body's
+ * point P: with y' = T y, T = [[R, 0], [-R [o - P]x, R]], F = T^T F' and
+ * H = T^T H' T.  group_T forms T. */
 static void group_T(const NGroup *G, double T[36])
 {
-  double ox[9] = {0, -G->o[2], G->o[1], G->o[2], 0, -G->o[0], -G->o[1], G->o[0], 0}, Rox[9];
+  const double *o = G->oref;
+  double ox[9] = {0, -o[2], o[1], o[2], 0, -o[0], -o[1], o[0], 0}, Rox[9];
   ss_m3_mul(Rox, G->R, ox);
   memset(T, 0, 36 * sizeof(double));
   for (int a = 0; a < 3; a++)
@@ -401,41 +406,38 @@ static void from_group(const NGroup *G, const double Fg[6], const double Hg[36],
   congruence6(G->Ttb, G->T, Hg, H);
 }
 
-/* A group's body velocity y_b = (omega; v_O) from its system's
- * velocities u (qvel's block of the system): a link's J_b u, or for a
- * free body (qvel = (v_c; omega) at its centre of mass c)
- * (omega; v_c + c x omega). */
+/* A group's body velocity y_b = (omega; v_P) from its system's
+ * velocities u (qvel's block of the system), about the body's point P: a
+ * link's J_b u about the world origin (articulated.h), a free body's
+ * (qvel = (v_c; omega) at its centre of mass c) about c itself, so that
+ * no product of c's size (the distance from the origin) enters its
+ * spatial quantities to cancel in the group's frame: a settled plate 1 km
+ * from the origin took three times the Newton iterations of one at the
+ * origin while they were about the origin (README, "Keep a world near
+ * the origin"). */
 static void group_motion(const ssModel *m, const ssData *d, const NGroup *G,
                          const double *u, double V[6])
 {
+  (void)d;
   if (G->link >= 0) {
     ss_art_link_motion(m, d, G->link, u, V);
     return;
   }
-  double cw[3];
-  ss_v3_cross(cw, d->body_xipos + 3 * G->body, u + 3);
   ss_v3_copy(V, u + 3);
-  ss_v3_add(V + 3, u, cw);
+  ss_v3_copy(V + 3, u);
 }
 
 /* A free body's response Y (6 x 6, Y[6 i + k]: velocity i per unit of
- * F_k) to a spatial impulse F = (torque about O; force): dv_c = f / m,
- * domega = I^-1 (tau_O - c x f) */
+ * F_k) to a spatial impulse F = (torque about its centre of mass c;
+ * force), group_motion's point: dv_c = f / m, domega = I^-1 tau_c */
 static void body_block(const ssModel *m, const ssData *d, int b, double Y[36])
 {
-  const double *c = d->body_xipos + 3 * b, *Ii = d->body_iinv + 9 * b;
+  const double *Ii = d->body_iinv + 9 * b;
   double im = 1 / m->body_mass[b];
   memset(Y, 0, 36 * sizeof(double));
   for (int k = 0; k < 3; k++) {
-    double e[3] = {0, 0, 0}, ce[3], w[3];
-    e[k] = 1;
-    ss_v3_cross(ce, c, e);
-    ss_m3_mulv(w, Ii, ce);
     Y[6 * k + 3 + k] = im;
-    for (int i = 0; i < 3; i++) {
-      Y[6 * (3 + i) + k] = Ii[3 * i + k];
-      Y[6 * (3 + i) + 3 + k] = -w[i];
-    }
+    for (int i = 0; i < 3; i++) Y[6 * (3 + i) + k] = Ii[3 * i + k];
   }
 }
 
@@ -1951,6 +1953,10 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
       memcpy(G->R, c->frame, sizeof G->R);
       G->axes = c->bed_axes;
       memcpy(G->o, c->pos, sizeof G->o);
+      if (c->link < 0)
+        ss_v3_sub(G->oref, G->o, d->body_xipos + 3 * G->body);
+      else
+        memcpy(G->oref, G->o, sizeof G->oref);
       G->rmax[0] = G->rmax[1] = G->rmax[2] = 0;
       if (c->link < 0) body_block(m, d, G->body, G->Yb);
     } else if (memcmp(G->R, c->frame, sizeof G->R)) {
