@@ -11,6 +11,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* the grid of a system's spatial origin (ssArtWork.org), in metres: a
+ * power of two, so that the rounded origin and a position's offset from it
+ * are exact */
+#define ART_ORIGIN_GRID 64.0
+
 struct ssArtWork {
   int sys, nv, nb, b0, v0;
   int nrow;              /* closure rows (pin 3, distance 1, equality 1) */
@@ -81,6 +86,10 @@ struct ssArtWork {
   unsigned char *clo_body; /* (nb) 1: a closure's body or an ancestor of one
                             (the poses phi reads) */
   int kin_part;          /* 1: forward_poses posed only the clo_body bodies */
+  double org[3];         /* the point the spatial vectors are about
+                            (ss_art_origin): the root's position rounded to
+                            a multiple of ART_ORIGIN_GRID, set by
+                            forward_rest */
   uint64_t kin_gen;      /* ss_art_forward's runs */
   uint64_t clo_gen;      /* kin_gen where closures last formed K and phi
                             (they depend on the poses, S and qpos alone) */
@@ -509,12 +518,22 @@ static void forward_rest(const ssModel *m, ssData *d, int s)
     kinematics(m, s, d->qpos, d->body_xpos + 3 * b0, d->body_xquat + 4 * b0,
                d->body_xmat + 9 * b0, w->clo_body, 0);
   w->kin_part = 0;
+  /* the origin of the spatial vectors: near the system, so that no
+   * product of its distance from the world origin enters them (the
+   * motion subspaces' p x a, the inertias' c x c) to cancel in what is
+   * formed from them; on a coarse grid, so that it stays where it is
+   * from step to step (the Newton phase's records hold velocities about
+   * it) and is exactly 0 for a system near the world origin (+0.0: no
+   * signed zero) */
+  for (int k = 0; k < 3; k++)
+    w->org[k] = ART_ORIGIN_GRID * nearbyint(d->body_xpos[3 * b0 + k] / ART_ORIGIN_GRID) + 0.0;
   for (int lb = 0; lb < w->nb; lb++) {
     int b = b0 + lb;
-    const double *R = d->body_xmat + 9 * b, *p = d->body_xpos + 3 * b;
-    double off[3];
+    const double *R = d->body_xmat + 9 * b;
+    double off[3], p[3];
+    ss_v3_sub(p, d->body_xpos + 3 * b, w->org);
     ss_m3_mulv(off, R, m->body_ipos + 3 * b);
-    ss_v3_add(d->body_xipos + 3 * b, p, off);
+    ss_v3_add(d->body_xipos + 3 * b, d->body_xpos + 3 * b, off);
     int nd = m->body_ndof[b];
     if (!nd) continue;
     double *S = w->S + 6 * (m->body_dofadr[b] - w->v0);
@@ -753,10 +772,11 @@ static inline void ltdl_solve(const ssArtWork *w, double *X, int m)
  * directions at once (dir (nd x 3), row q at r + q ld: a pin's three rows),
  * in one walk of the path with each S_k loaded once (in locals: the rows'
  * stores would make it a reload per row) */
-static inline void point_rows(const ssModel *m, const ssArtWork *w, int b, const double p[3],
+static inline void point_rows(const ssModel *m, const ssArtWork *w, int b, const double pw[3],
                               const double *dir, int nd, double s, double *r, int ld)
 {
-  double pxd[9];
+  double pxd[9], p[3];
+  ss_v3_sub(p, pw, w->org);
   for (int q = 0; q < nd; q++) ss_v3_cross(pxd + 3 * q, p, dir + 3 * q);
   for (int a = b; a >= 0; a = m->body_parent[a]) {
     int na = m->body_ndof[a];
@@ -1126,7 +1146,9 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
     }
     double Iw[9];
     rotate_inertia(Iw, d->body_xmat + 9 * b, m->body_inertia + 9 * b);
-    spatial_inertia(w->Ic + 36 * lb, m->body_mass[b], d->body_xipos + 3 * b, Iw);
+    double cr[3];
+    ss_v3_sub(cr, d->body_xipos + 3 * b, w->org);
+    spatial_inertia(w->Ic + 36 * lb, m->body_mass[b], cr, Iw);
     /* f = I a + v x* I v, I a formed in f */
     double Iv[6], vf[6], *f = w->frc + 6 * lb;
     m6v_cols(Iv, w->Ic + 36 * lb, v);
@@ -1139,7 +1161,7 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
       if (d->time < m->xforce_time[2 * k] || d->time >= m->xforce_time[2 * k + 1]) continue;
       const double *F = m->xforce_force + 3 * k, *Tq = m->xforce_torque + 3 * k;
       double cxf[3];
-      ss_v3_cross(cxf, d->body_xipos + 3 * b, F);
+      ss_v3_cross(cxf, cr, F);
       for (int i = 0; i < 3; i++) {
         f[i] -= Tq[i] + cxf[i];
         f[3 + i] -= F[i];
@@ -1646,6 +1668,8 @@ void ss_art_force_apply(const ssModel *m, ssData *d, int sys, double *u)
   memset(x, 0, (size_t)n * sizeof(double));
 }
 
+const double *ss_art_origin(const ssData *d, int sys) { return d->art[sys]->org; }
+
 void ss_art_contact_rows(const double p[3], const double frame[9], double X[18])
 {
   /* contact-frame velocity of the point from a spatial velocity */
@@ -1726,10 +1750,11 @@ void ss_art_link_motion_cols(const ssModel *m, const ssData *d, int b, const dou
 }
 
 void ss_art_point_velocity(const ssModel *m, const ssData *d, int b,
-                           const double p[3], double v[3])
+                           const double pw[3], double v[3])
 {
-  double sv[6], wp[3];
+  double sv[6], wp[3], p[3];
   ss_art_link_velocity(m, d, b, sv);
+  ss_v3_sub(p, pw, d->art[m->body_sys[b]]->org);
   ss_v3_cross(wp, sv, p);
   ss_v3_add(v, sv + 3, wp);
 }

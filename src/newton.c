@@ -140,7 +140,7 @@ typedef struct NGroup {
   double R[9];        /* contact frame rows n, t1, t2 (world) */
   double oref[3];     /* o less the point the body's spatial quantities
                          are about (group_motion): a free body's centre of
-                         mass, a link's world origin */
+                         mass, a link's system's origin (ss_art_origin) */
   double o[3];        /* origin of the points' r (world) */
   const ssPowTable *pt; /* its bed's table of s^(n-1), or NULL */
   double ik;          /* 1 / K_j of its material, 0 for K_j = 0 */
@@ -408,7 +408,7 @@ static void from_group(const NGroup *G, const double Fg[6], const double Hg[36],
 
 /* A group's body velocity y_b = (omega; v_P) from its system's
  * velocities u (qvel's block of the system), about the body's point P: a
- * link's J_b u about the world origin (articulated.h), a free body's
+ * link's J_b u about its system's origin (articulated.h), a free body's
  * (qvel = (v_c; omega) at its centre of mass c) about c itself, so that
  * no product of c's size (the distance from the origin) enters its
  * spatial quantities to cancel in the group's frame: a settled plate 1 km
@@ -1756,7 +1756,9 @@ static uint64_t key_add(uint64_t h, long v)
 }
 
 /* which unknowns: the groups' links (or bodies) and beds, the rows' dofs
- * and kinds, in order */
+ * and kinds, in order; and a link's system's origin where it is not the
+ * world's (its velocities are about it: a record made about another one
+ * is no start) */
 static uint64_t unknowns_key(const ssData *d, const Setup *s, const ssNewtonWork *w)
 {
   uint64_t h = 0xcbf29ce484222325ull;
@@ -1766,6 +1768,14 @@ static uint64_t unknowns_key(const ssData *d, const Setup *s, const ssNewtonWork
     h = key_add(h, w->grp[g].link);
     h = key_add(h, w->grp[g].body);
     h = key_add(h, w->grp[g].bed);
+    if (w->grp[g].link < 0) continue;
+    const double *o = ss_art_origin(d, w->grp[g].sys);
+    if (o[0] == 0 && o[1] == 0 && o[2] == 0) continue;
+    for (int k = 0; k < 3; k++) {
+      long bits;
+      memcpy(&bits, o + k, sizeof bits);
+      h = key_add(h, bits);
+    }
   }
   for (int r = 0; r < s->nrow; r++) {
     const ssContact *c = d->contact + s->first_row + r;
@@ -1953,10 +1963,8 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
       memcpy(G->R, c->frame, sizeof G->R);
       G->axes = c->bed_axes;
       memcpy(G->o, c->pos, sizeof G->o);
-      if (c->link < 0)
-        ss_v3_sub(G->oref, G->o, d->body_xipos + 3 * G->body);
-      else
-        memcpy(G->oref, G->o, sizeof G->oref);
+      ss_v3_sub(G->oref, G->o,
+                c->link < 0 ? d->body_xipos + 3 * G->body : ss_art_origin(d, c->sys));
       G->rmax[0] = G->rmax[1] = G->rmax[2] = 0;
       if (c->link < 0) body_block(m, d, G->body, G->Yb);
     } else if (memcmp(G->R, c->frame, sizeof G->R)) {

@@ -93,19 +93,27 @@ static void rows_impulse(const double *X, const double dl[3], double w[6])
 }
 
 /* The same from the contact's point and frame, where X is not formed (it
- * is only for the sweeps): X^T dl = (p x f; f), f = frame^T dl */
-static inline void link_impulse(const ssContact *c, const double dl[3], double w[6])
+ * is only for the sweeps): X^T dl = (p x f; f), f = frame^T dl, p the
+ * point from o, its system's origin (ss_art_origin), about which the
+ * link's spatial vectors are (the callers load o once for a run of
+ * contacts on one link) */
+static inline void link_impulse(const double o[3], const ssContact *c, const double dl[3],
+                                double w[6])
 {
+  double p[3];
+  ss_v3_sub(p, c->pos, o);
   ss_contact_frame_tmulv(c, w + 3, dl);
-  ss_v3_cross(w, c->pos, w + 3);
+  ss_v3_cross(w, p, w + 3);
 }
 
 /* and its contact-frame velocity X V = frame (v_o + omega x p) from the
  * link's spatial velocity V = (omega; v_o) */
-static inline void link_point_velocity(const ssContact *c, const double V[6], double v[3])
+static inline void link_point_velocity(const double o[3], const ssContact *c, const double V[6],
+                                       double v[3])
 {
-  double w[3];
-  ss_v3_cross(w, V, c->pos);
+  double w[3], p[3];
+  ss_v3_sub(p, c->pos, o);
+  ss_v3_cross(w, V, p);
   ss_v3_add(w, w, V + 3);
   ss_contact_frame_mulv(c, v, w);
 }
@@ -140,7 +148,7 @@ contact_velocity(const ssModel *m, const ssData *d, const ssContact *c, double v
   if (c->link >= 0) {
     double V[6];
     ss_art_link_velocity(m, d, c->link, V);
-    link_point_velocity(c, V, v);
+    link_point_velocity(ss_art_origin(d, c->sys), c, V, v);
     return;
   }
   const double *u = d->qvel + c->vadr;
@@ -194,7 +202,7 @@ static void apply_impulse(const ssModel *m, ssData *d, ssContact *c,
     const double *Y, *Lam;
     double w[6];
     ss_art_link_block(m, d, c->link, &Y, &Lam);
-    link_impulse(c, dl, w);
+    link_impulse(ss_art_origin(d, c->sys), c, dl, w);
     link_apply(d, c, Y, w);
     return;
   }
@@ -218,6 +226,7 @@ typedef struct Group {
   const double *Y, *Lam;  /* the link's block */
   double V[6];            /* J_b u with F applied */
   double F[6];
+  double o[3];            /* the link's system's origin (ss_art_origin) */
 } Group;
 
 /* a lone contact keeps the full update: opening a group (J_b u) and
@@ -449,9 +458,10 @@ warm_one(const ssModel *m, ssData *d, ssContact *c, const ssWarmEntry *e, int cr
       g->first = c;
       ss_art_link_block(m, d, c->link, &g->Y, &g->Lam);
       memset(g->F, 0, sizeof g->F);
+      ss_v3_copy(g->o, ss_art_origin(d, c->sys));
     }
     double w[6];
-    link_impulse(c, c->lambda, w);
+    link_impulse(g->o, c, c->lambda, w);
     for (int k = 0; k < 6; k++) g->F[k] += w[k];
   } else {
     group_close(d, g);
@@ -621,7 +631,7 @@ warm_match_all(const ssData *d, const ssWarmEntry *warm, int nwarm, int converge
 static int warm_start(const ssModel *m, ssData *d, int converged, int creep_rates)
 {
   int left = 0, defer = !d->solver_warm_eager && ss_newton_may_predict(m, d);
-  WarmApply a = {{NULL, NULL, NULL, {0}, {0}}, {-1, {0}}};
+  WarmApply a = {{NULL, NULL, NULL, {0}, {0}, {0}}, {-1, {0}}};
   d->warm_creep_rates = creep_rates;
   /* (the loop's invariants in locals: the contacts' stores could alias
    * them, as the compiler sees it) */
@@ -661,7 +671,7 @@ void ss_solver_warm_apply(const ssModel *m, ssData *d)
 {
   if (!d->warm_pending) return;
   d->warm_pending = 0;
-  WarmApply a = {{NULL, NULL, NULL, {0}, {0}}, {-1, {0}}};
+  WarmApply a = {{NULL, NULL, NULL, {0}, {0}, {0}}, {-1, {0}}};
   for (int i = 0; i < d->ncontact; i++) {
     ssContact *c = d->contact + i;
     if (c->warm_entry >= 0) warm_one(m, d, c, d->warm + c->warm_entry, d->warm_creep_rates, &a);
@@ -950,9 +960,10 @@ static ssContact *link_run_end(const ssModel *m, const ssData *d, ssContact *c,
   double S[6];
   ss_art_link_velocity(m, d, link, S);
   const double V[6] = {S[0], S[1], S[2], S[3], S[4], S[5]};
+  const double *org = ss_art_origin(d, c->sys), o[3] = {org[0], org[1], org[2]};
   for (; c < end && c->link == link; c++) {
     double v[3];
-    link_point_velocity(c, V, v);
+    link_point_velocity(o, c, V, v);
     contact_end(c, v, dt);
   }
   return c;
@@ -1028,7 +1039,9 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
     ssContact *c = d->contact + i;
     double *J = d->jac + c->jadr;
     if (c->link >= 0) {
-      ss_art_contact_rows(c->pos, c->frame, J);
+      double p[3];
+      ss_v3_sub(p, c->pos, ss_art_origin(d, c->sys));
+      ss_art_contact_rows(p, c->frame, J);
       ss_art_contact_response(m, d, c->link, J, J + 18, c->G);
     } else if (c->nv > 0 && (c->type == SS_CONTACT_SOIL || c->type == SS_CONTACT_RIGID)) {
       int b = m->geom_body[c->geom];
@@ -1038,7 +1051,7 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
     if (c->type == SS_CONTACT_SOIL)
       ss_point_setup(&m->hfield_soilmat[c->hfield], ss_solver_pow_table(m, d, c->hfield), dt, c);
   }
-  Group g = {NULL, NULL, NULL, {0}, {0}};
+  Group g = {NULL, NULL, NULL, {0}, {0}, {0}};
   for (int sweep = 0; sweep < sweeps; sweep++) {
     double dmax = 0, lmax = 0;
     int since = 0, pending = 1;
