@@ -413,12 +413,11 @@ static void from_group(const NGroup *G, const double Fg[6], const double Hg[36],
  * no product of c's size (the distance from the origin) enters its
  * spatial quantities to cancel in the group's frame: a settled plate 1 km
  * from the origin took three times the Newton iterations of one at the
- * origin while they were about the origin (README, "Keep a world near
- * the origin"). */
+ * origin while they were about the origin (README, "Far from the
+ * origin"). */
 static void group_motion(const ssModel *m, const ssData *d, const NGroup *G,
                          const double *u, double V[6])
 {
-  (void)d;
   if (G->link >= 0) {
     ss_art_link_motion(m, d, G->link, u, V);
     return;
