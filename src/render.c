@@ -542,10 +542,13 @@ static ssStatus bed_build(bedCache *b, const ssModel *m, int h, ssError *err)
   for (int k = 0; k < mx; k++) b->ix[k] = k * step < nx - 1 ? k * step : nx - 1;
   for (int k = 0; k < my; k++) b->iy[k] = k * step < ny - 1 ? k * step : ny - 1;
 
-  /* local x, y of every drawn vertex (the same formula as DESIGN 2.1) */
+  /* local x, y of every drawn vertex (the formula of DESIGN 2.1) from the
+   * bed's centre, which draw_bed puts into the pose in double: single
+   * precision then holds the vertices to the bed's size, not to the
+   * centre's distance from the origin (a bed centred 100 km out drew
+   * over the bodies on it) */
   double xs = m->hfield_size[2 * h], ys = m->hfield_size[2 * h + 1];
-  double x0 = m->hfield_center[2 * h] - 0.5 * xs;
-  double y0 = m->hfield_center[2 * h + 1] - 0.5 * ys;
+  double x0 = -0.5 * xs, y0 = -0.5 * ys;
   for (int l = 0; l < my; l++)
     for (int k = 0; k < mx; k++) {
       size_t v = (size_t)l * (size_t)mx + (size_t)k;
@@ -1163,13 +1166,16 @@ static void draw_bed(ssRenderer *r, const ssModel *m, const ssData *d, int h,
   bedCache *b = &r->bed[h];
   double R[9], p[3], B[16], MVP[16], MV[16], G[16];
   bed_pose(m, d, h, R, p);
+  /* the vertices are from the bed's centre (bed_build) */
+  double cl[3] = {m->hfield_center[2 * h], m->hfield_center[2 * h + 1], 0}, cw[3];
+  ss_m3_mulv(cw, R, cl);
+  ss_v3_add(p, p, cw);
   m4_pose(B, R, p);
   m4_mul(MVP, VP, B);
   m4_mul(MV, V, B);
 
   double xs = m->hfield_size[2 * h], ys = m->hfield_size[2 * h + 1];
-  double x0 = m->hfield_center[2 * h] - 0.5 * xs;
-  double y0 = m->hfield_center[2 * h + 1] - 0.5 * ys;
+  double x0 = -0.5 * xs, y0 = -0.5 * ys;
   double sdrop = m->hfield_soil[h] ? smax_all : 0;
   int mode = r->opt.color_mode;
 
@@ -1267,12 +1273,17 @@ static unsigned char unit_to_byte(double v)
   return (unsigned char)floor(v * 255 + 0.5);
 }
 
+/* geom g's triangles into b, their vertices from org (the eye: GL's
+ * single precision then holds them to the scene's own size, not to its
+ * distance from the world origin, where a buggy 100 km out showed its
+ * wheels ragged) */
 static int batch_geom(const ssRenderer *r, const ssModel *m, const ssData *d,
-                      int g, geomBatch *b)
+                      int g, const double org[3], geomBatch *b)
 {
   const double *s = m->geom_size + 3 * g;
   const double *R = d->geom_xmat + 9 * g;
-  const double *p = d->geom_xpos + 3 * g;
+  double p[3];
+  ss_v3_sub(p, d->geom_xpos + 3 * g, org);
   const double *c = m->geom_rgba + 4 * g;
   unsigned char rgba[4] = {unit_to_byte(c[0]), unit_to_byte(c[1]),
                            unit_to_byte(c[2]), unit_to_byte(c[3] > 0 ? c[3] : 1)};
@@ -1463,16 +1474,18 @@ static void gl_frame_state(const ssRenderer *r, const double P[16],
 }
 
 /* Rigid ground planes as one large square each, pushed back in depth so
- * that a bed at the same height wins. */
-static void draw_planes(const ssModel *m, const double ctr[3], double half)
+ * that a bed at the same height wins; from org, as the bodies' vertices */
+static void draw_planes(const ssModel *m, const double ctr_w[3], const double org[3],
+                        double half)
 {
+  const double ctr[3] = {ctr_w[0] - org[0], ctr_w[1] - org[1]};
   if (m->nplane <= 0) return;
   glMatrixMode(GL_MODELVIEW);
   glEnable(GL_POLYGON_OFFSET_FILL);
   glPolygonOffset(2.0f, 4.0f);
   glColor4ub(SS_PLANE_R, SS_PLANE_G, SS_PLANE_B, 255);
   for (int k = 0; k < m->nplane; k++) {
-    double z = m->plane_height[k];
+    double z = m->plane_height[k] - org[2];
     glBegin(GL_TRIANGLES);
     glNormal3d(0, 0, 1);
     glVertex3d(ctr[0] - half, ctr[1] - half, z);
@@ -1558,13 +1571,23 @@ ssStatus ss_render_pixels(ssRenderer *r, const ssModel *m, const ssData *d,
                   c.up[0], c.up[1], c.up[2], -ss_v3_dot(c.up, c.eye),
                   -c.fwd[0], -c.fwd[1], -c.fwd[2], ss_v3_dot(c.fwd, c.eye),
                   0, 0, 0, 1};
+  /* the view of what is drawn from the eye (the bodies and ground
+   * planes: batch_geom): V less its translation */
+  double Ve[16];
+  memcpy(Ve, V, sizeof Ve);
+  Ve[3] = Ve[7] = Ve[11] = 0;
   double VP[16], G[16];
   m4_mul(VP, P, V);
   memcpy(r->mvp, VP, sizeof VP);
   r->have_mvp = 1;
 
   gl_frame_state(r, P, V);
-  draw_planes(m, ctr, plane_half);
+  glMatrixMode(GL_MODELVIEW);
+  m4_to_gl(G, Ve);
+  glLoadMatrixd(G);
+  draw_planes(m, ctr, c.eye, plane_half);
+  m4_to_gl(G, V);
+  glLoadMatrixd(G);
 
   /* beds */
   for (int h = 0; h < m->nhfield; h++)
@@ -1576,11 +1599,11 @@ ssStatus ss_render_pixels(ssRenderer *r, const ssModel *m, const ssData *d,
   for (int g = 0; g < m->ngeom; g++) {
     if (!geom_drawn(r, m, d, g)) continue;
     double a = m->geom_rgba[4 * g + 3];
-    if (!batch_geom(r, m, d, g, a > 0 && a < 1 ? r->glass : r->solid))
+    if (!batch_geom(r, m, d, g, c.eye, a > 0 && a < 1 ? r->glass : r->solid))
       return ss_error_set(err, SS_ERR_NOMEM, "", 0, "out of memory for bodies");
   }
   glMatrixMode(GL_MODELVIEW);
-  m4_to_gl(G, V);
+  m4_to_gl(G, Ve);
   glLoadMatrixd(G);
   glEnableClientState(GL_VERTEX_ARRAY);
   glEnableClientState(GL_NORMAL_ARRAY);

@@ -86,7 +86,8 @@ static int in_rut(double x, double y)
          y <= RUT_Y1 + 1e-9;
 }
 
-static int make_world(world *w, int with_box, double plastic_fraction)
+/* the world moved by X along x: the bed's centre and the box */
+static int make_world_at(world *w, int with_box, double plastic_fraction, double X)
 {
   ssError err;
   memset(w, 0, sizeof *w);
@@ -97,6 +98,7 @@ static int make_world(world *w, int with_box, double plastic_fraction)
   hd.name = "soil";
   hd.nx = hd.ny = BED_N;
   hd.x_size = hd.y_size = 2.0;
+  hd.center_x = X;
   hd.height = z;
   hd.soil = 1;
   w->bed = ss_model_add_hfield(w->m, &hd, &err);
@@ -114,6 +116,7 @@ static int make_world(world *w, int with_box, double plastic_fraction)
     bd.size[1] = 0.3;
     bd.size[2] = 0.1;
     bd.mass = 5;
+    bd.pos[0] = X;
     bd.pos[2] = 0.05;
     bd.rgba[0] = 0.2;
     bd.rgba[1] = 0.4;
@@ -144,6 +147,11 @@ static int make_world(world *w, int with_box, double plastic_fraction)
     return 0;
   }
   return 1;
+}
+
+static int make_world(world *w, int with_box, double plastic_fraction)
+{
+  return make_world_at(w, with_box, plastic_fraction, 0);
 }
 
 static void free_world(world *w)
@@ -425,6 +433,49 @@ static void test_frame(void)
 }
 
 /* Following a body keeps the camera's offset from it. */
+/* The same world and camera moved 100 km along x give the same picture:
+ * the bodies' and ground planes' vertices are sent to GL from the eye and
+ * a bed's from its centre (render.c), so single precision holds them to
+ * the scene's size.  From the world origin (before), the box drew ragged
+ * and the bed over it in stripes.  A few pixels may part at edges where
+ * a triangle's rasterised boundary falls on a pixel centre (at most
+ * 0.5 % asked). */
+static void test_far_from_origin(void)
+{
+  const int W = 240, H = 180;
+  const double X = 1e5;
+  unsigned char *img[2] = {malloc((size_t)W * H * 4), malloc((size_t)W * H * 4)};
+  int good = img[0] && img[1];
+  for (int k = 0; k < 2 && good; k++) {
+    world w;
+    good = make_world_at(&w, 1, 0.5, k ? X : 0);
+    ssRenderOptions o = ss_render_options_default();
+    o.width = W;
+    o.height = H;
+    o.camera_given = 1;
+    double eye[3] = {-1.2, -1.6, 0.9}, at[3] = {0.1, 0.1, 0};
+    for (int i = 0; i < 3; i++) {
+      o.camera_pos[i] = eye[i] + (k && i == 0 ? X : 0);
+      o.camera_look_at[i] = at[i] + (k && i == 0 ? X : 0);
+    }
+    o.sinkage_max = RUT_DEPTH;
+    ssError err;
+    ssRenderer *r = good ? ss_render_new(w.m, &o, &err) : NULL;
+    good = r && ss_render_pixels(r, w.m, w.d, img[k], &err) == SS_OK;
+    if (!good) diag("render: %s", err.message);
+    ss_render_free(r);
+    free_world(&w);
+  }
+  int differ = 0;
+  for (int i = 0; good && i < W * H; i++)
+    differ += memcmp(img[0] + 4 * i, img[1] + 4 * i, 4) != 0;
+  ok(good && differ <= W * H / 200,
+     "a scene 100 km from the origin renders as at the origin (%d of %d pixels differ, "
+     "at most 0.5 %%)", differ, W * H);
+  free(img[0]);
+  free(img[1]);
+}
+
 static void test_follow(void)
 {
   world w;
@@ -1229,6 +1280,7 @@ int main(void)
   test_colormap();
   test_bad_sizes();
   test_frame();
+  test_far_from_origin();
   test_follow();
   test_plane();
   test_auto_camera();
