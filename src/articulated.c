@@ -96,7 +96,7 @@ struct ssArtWork {
 };
 
 /* ---------------------------------------------------------------------- */
-/* spatial algebra (world frame, about the origin): motion (w; v)          */
+/* spatial algebra (world axes, about the system's origin): motion (w; v) */
 
 /* r = a x b (motion cross motion) */
 static void mcross(double r[6], const double a[6], const double b[6])
@@ -201,8 +201,8 @@ static inline void rotate_inertia(double out[9], const double R[9], const double
           T[3 * i] * R[3 * j] + T[3 * i + 1] * R[3 * j + 1] + T[3 * i + 2] * R[3 * j + 2];
 }
 
-/* spatial inertia about the origin of mass m, COM c, inertia Ic (world,
- * about the COM):  [[Ic - m [c]x[c]x, m [c]x], [-m [c]x, m 1]], by columns
+/* spatial inertia about the system's origin of mass m, COM c (from that
+ * origin), inertia Ic (world axes, about the COM):  [[Ic - m [c]x[c]x, m [c]x], [-m [c]x, m 1]], by columns
  * (entry ij at I6[6 j + i]) */
 static void spatial_inertia(double I6[36], double mass, const double c[3],
                             const double Ic[9])
