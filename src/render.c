@@ -345,6 +345,14 @@ struct ssRenderer {
   int have_mvp;
 };
 
+int ss_camera_valid(const double pos[3], const double look_at[3])
+{
+  double dd[3];
+  ss_v3_sub(dd, look_at, pos);
+  double n = ss_v3_norm(dd);
+  return n > 1e-9 && isfinite(n);
+}
+
 ssRenderOptions ss_render_options_default(void)
 {
   ssRenderOptions o;
@@ -815,9 +823,7 @@ ssRenderer *ss_render_new(const ssModel *m, const ssRenderOptions *opt,
   const double *cp = r->cam_mode == 1 ? o.camera_pos : m->camera_pos;
   const double *cl = r->cam_mode == 1 ? o.camera_look_at : m->camera_look_at;
   if (r->cam_mode != 0) {
-    double dd[3];
-    ss_v3_sub(dd, cl, cp);
-    if (!(ss_v3_norm(dd) > 1e-9) || !isfinite(ss_v3_norm(dd))) {
+    if (!ss_camera_valid(cp, cl)) {
       ss_error_set(err, SS_ERR_VALUE, "", 0,
                    "camera position and look_at must be distinct finite points");
       ss_render_free(r);

@@ -1574,16 +1574,10 @@ static ssStatus read_camera(readCtx *c, xEl *e)
   if (!st) st = check_leaf(c, e);
   if (!st) st = get_vec(c, e, "pos", 3, 1, m->camera_pos);
   if (!st) st = get_vec(c, e, "look_at", 3, 1, m->camera_look_at);
-  if (!st) {
-    /* the renderer's test (render.c): the camera needs a direction */
-    double dx = m->camera_look_at[0] - m->camera_pos[0],
-           dy = m->camera_look_at[1] - m->camera_pos[1],
-           dz = m->camera_look_at[2] - m->camera_pos[2], dn = sqrt(dx * dx + dy * dy + dz * dz);
-    if (!(dn > 1e-9 && isfinite(dn)))
-      st = fail(c, SS_ERR_VALUE, e->line,
-                "<camera>: pos and look_at must be distinct points (%.3g m apart); "
-                "the camera looks from pos towards look_at", dn);
-  }
+  if (!st && !ss_camera_valid(m->camera_pos, m->camera_look_at))
+    st = fail(c, SS_ERR_VALUE, e->line,
+              "<camera>: pos and look_at must be distinct points (the camera looks "
+              "from pos towards look_at)");
   if (!st) st = get_num(c, e, "fov_deg", 0, &m->camera_fov_deg);
   if (!st && !(m->camera_fov_deg > 0 && m->camera_fov_deg < 180))
     st = fail(c, SS_ERR_VALUE, e->line,

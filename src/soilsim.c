@@ -486,15 +486,9 @@ static int parse_args(int argc, char **argv, Options *o)
     return usage_error("--render-every needs --render DIR");
   if (o->camera_pos_given != o->camera_look_given)
     return usage_error("--camera-pos and --camera-look-at go together");
-  if (o->camera_pos_given) {
-    double dx = o->camera_look_at[0] - o->camera_pos[0],
-           dy = o->camera_look_at[1] - o->camera_pos[1],
-           dz = o->camera_look_at[2] - o->camera_pos[2];
-    double dn = sqrt(dx * dx + dy * dy + dz * dz);
-    if (!(dn > 1e-9 && isfinite(dn)))
-      return usage_error("--camera-pos and --camera-look-at must be distinct "
-                         "points (the camera looks from one towards the other)");
-  }
+  if (o->camera_pos_given && !ss_camera_valid(o->camera_pos, o->camera_look_at))
+    return usage_error("--camera-pos and --camera-look-at must be distinct "
+                       "points (the camera looks from one towards the other)");
   if ((o->camera_pos_given || o->camera_fov > 0 || o->camera_follow || o->color) &&
       !o->render_dir)
     return usage_error("--camera-* and --color need --render DIR");

@@ -612,6 +612,9 @@ typedef struct ssRenderOptions {
 } ssRenderOptions;
 
 ssRenderOptions ss_render_options_default(void);
+/* 1 when a camera at pos looking at look_at has a direction: two finite
+ * points more than 1e-9 m apart (what ss_render_new asks of a camera) */
+int ss_camera_valid(const double pos[3], const double look_at[3]);
 
 typedef struct ssRenderer ssRenderer;
 
