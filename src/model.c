@@ -577,6 +577,16 @@ void ss_model_rollback(ssModel *m, const ssModelMark *k)
   m->nmesh = k->nmesh;
 }
 
+/* (soilsim.h) here, not in render.c: the scene reader asks it too, and a
+ * program that never renders must link without GL */
+int ss_camera_valid(const double pos[3], const double look_at[3])
+{
+  double dd[3];
+  ss_v3_sub(dd, look_at, pos);
+  double n = ss_v3_norm(dd);
+  return n > 1e-9 && isfinite(n);
+}
+
 int ss_model_add_body(ssModel *m, const ssBodyDef *def, ssError *err)
 {
   const char *f = m->source_path;

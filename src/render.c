@@ -345,14 +345,6 @@ struct ssRenderer {
   int have_mvp;
 };
 
-int ss_camera_valid(const double pos[3], const double look_at[3])
-{
-  double dd[3];
-  ss_v3_sub(dd, look_at, pos);
-  double n = ss_v3_norm(dd);
-  return n > 1e-9 && isfinite(n);
-}
-
 ssRenderOptions ss_render_options_default(void)
 {
   ssRenderOptions o;
