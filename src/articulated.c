@@ -202,8 +202,9 @@ static inline void rotate_inertia(double out[9], const double R[9], const double
 }
 
 /* spatial inertia about the system's origin of mass m, COM c (from that
- * origin), inertia Ic (world axes, about the COM):  [[Ic - m [c]x[c]x, m [c]x], [-m [c]x, m 1]], by columns
- * (entry ij at I6[6 j + i]) */
+ * origin), inertia Ic (world axes, about the COM):
+ * [[Ic - m [c]x[c]x, m [c]x], [-m [c]x, m 1]], by columns (entry ij at
+ * I6[6 j + i]) */
 static void spatial_inertia(double I6[36], double mass, const double c[3],
                             const double Ic[9])
 {

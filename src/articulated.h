@@ -115,8 +115,8 @@ void ss_art_link_motion_cols(const ssModel *m, const ssData *d, int b, const dou
                              int ldu, int ncol, double *out, int ldo);
 /* Contact rows of a point p (from the system's origin, ss_art_origin)
  * with contact frame `frame` (rows n, t1, t2) on a link: X (3 x 6) maps
- * the link's spatial velocity to the contact-frame velocity of the point.  The contact's Jacobian is X J_b,
- * its response Y X^T. */
+ * the link's spatial velocity to the contact-frame velocity of the
+ * point.  The contact's Jacobian is X J_b, its response Y X^T. */
 void ss_art_contact_rows(const double p[3], const double frame[9], double X[18]);
 /* The contact's response on link b, from its rows X: LX (3 x 6, row i =
  * Lam X_i^T) the link's velocity change per unit impulse along each

@@ -1058,8 +1058,7 @@ static ssStatus parse_state(const ssModel *m, const Parsed *f, const char *path,
       return corrupt(err, path, "a velocity above 1e5 (m/s or rad/s)");
   /* bed orientations are unit quaternions (ss_hfield_set_pose) */
   for (size_t h = 0; h < nh; h++) {
-    const double *q = s->hquat + 4 * h;
-    if (!(fabs(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] - 1) <= 1e-6))
+    if (!ss_quat_is_unit(s->hquat + 4 * h))
       return corrupt(err, path, "bad section 'HQUA'");
   }
   for (size_t k = 0; k < nhd; k++) {

@@ -243,12 +243,11 @@ int ss_dyn_check_state(const ssModel *m, const ssData *d, char *msg, size_t cap)
              m->sys_name[s], vel ? "non-finite or above 1e5 (m/s or rad/s)" : "non-finite");
     return 0;
   }
-  /* a bed's quaternion unit as ss_hfield_set_pose leaves it (to the
-   * checkpoint reader's 1e-6) */
+  /* a bed's quaternion unit as ss_hfield_set_pose leaves it and the
+   * checkpoint reader asks */
   for (int h = 0; h < m->nhfield; h++) {
-    const double *q = d->hfield_quat + 4 * h;
     if (!ss_all_within(d->hfield_pos + 3 * h, 3, DBL_MAX) ||
-        !(fabs(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] - 1) <= 1e-6)) {
+        !ss_quat_is_unit(d->hfield_quat + 4 * h)) {
       snprintf(msg, cap, "the pose of height map '%s' is non-finite or not a unit "
                "quaternion (move beds with ss_hfield_set_pose)", m->hfield_name[h]);
       return 0;

@@ -1584,8 +1584,6 @@ ssStatus ss_render_pixels(ssRenderer *r, const ssModel *m, const ssData *d,
   m4_to_gl(G, Ve);
   glLoadMatrixd(G);
   draw_planes(m, ctr, c.eye, plane_half);
-  m4_to_gl(G, V);
-  glLoadMatrixd(G);
 
   /* beds */
   for (int h = 0; h < m->nhfield; h++)

@@ -541,9 +541,9 @@ void ss_forward(const ssModel *m, ssData *d);
  * became non-finite or absurd (above SS_SPEED_MAX m/s or rad/s) or a
  * position non-finite.  SS_ERR_VALUE, before anything is stepped, if the
  * state it starts from is already so, or a bed's pose is non-finite or
- * its quaternion not unit (as written into d between steps).  A step that fails for any
- * reason leaves d exactly as it was (positions, velocities, soil,
- * warm-start cache, statistics). */
+ * its quaternion not unit (as written into d between steps).  A step
+ * that fails for any reason leaves d exactly as it was (positions,
+ * velocities, soil, warm-start cache, statistics). */
 ssStatus ss_step(const ssModel *m, ssData *d, ssError *err);
 
 /* Remove a system from the world (from the next step on). */

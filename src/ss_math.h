@@ -16,6 +16,13 @@
 static inline double ss_max(double a, double b) { return a > b ? a : b; }
 static inline double ss_min(double a, double b) { return a < b ? a : b; }
 
+/* 1 when q is a unit quaternion to 1e-6 in its squared length: a bed's
+ * orientation as a checkpoint holds it and a step accepts it */
+static inline int ss_quat_is_unit(const double q[4])
+{
+  return fabs(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] - 1) <= 1e-6;
+}
+
 /* 1 when each of v[0..n) is finite and at most vmax in magnitude */
 static inline int ss_all_within(const double *v, int n, double vmax)
 {
