@@ -10,15 +10,16 @@
  * written.  It does not hold the model: it is restored into a data made for
  * the same world, which a fingerprint of the model checks.
  *
- * Format, version 4 (versions 1, before the warm-start cache kept its
- * rates, 2, before its entries said whether their collider crept, and 3,
- * before the Newton phase's start was kept, are refused: they cannot
- * replay this build's steps).  Every integer is little-endian; every double is its
+ * Format, version 5 (versions 1, before the warm-start cache kept its
+ * rates, 2, before its entries said whether their collider crept, 3,
+ * before the Newton phase's start was kept, and 4, before rigid contacts
+ * were warm started, are refused: they cannot replay this build's
+ * steps).  Every integer is little-endian; every double is its
  * IEEE-754 bit pattern as a little-endian 64-bit integer (bit-exact).
  *
  *   header (32 bytes; the same layout in every version)
  *     0   8  magic "SOILCKPT"
- *     8   4  u32 format version (4)
+ *     8   4  u32 format version (5)
  *    12   4  u32 header size (32)
  *    16   8  u64 file size in bytes, trailer included
  *    24   4  u32 number of sections
@@ -42,7 +43,12 @@
  *     LOAD  nsoil_loaded i32, strictly ascending vertex indices
  *     WARM  nwarm entries of 60 bytes: vertex (i32), geom (i32), creep
  *           (i32: 0 or 1, only for soil entries), traction (3 f64), rate
- *           (3 f64), in the solver's sort order
+ *           (3 f64), in the solver's sort order.  Soil points: geom and
+ *           soil vertex; rigid contacts: geom and a negative key
+ *           (solver.h, ss_rigid_feature: a rigid height map or ground
+ *           plane and the collider's candidate point), a positive normal
+ *           force and rate 0; joint rows: geom -2 (PD) or -3 (limit) and
+ *           2 dof + side
  *     NEWT  the Newton phase's last two answers (ssNewtonRecord, the later
  *           first), each: step (i64, -1: none), key (u64, 0 for none),
  *           n (i32, 0 for none) and n f64 (c)
@@ -77,7 +83,7 @@
 #include <sys/stat.h>
 
 #define CKPT_MAGIC "SOILCKPT"
-#define CKPT_VERSION 4u
+#define CKPT_VERSION 5u
 #define CKPT_HEADER 32u
 #define CKPT_SECTION_HEAD 16u
 #define CKPT_TRAILER 8u
@@ -839,12 +845,23 @@ static uint64_t newton_max(const ssModel *m)
   return n < INT32_MAX ? n : INT32_MAX;
 }
 
+/* Most warm-start cache entries a model can have: a soil point for each
+ * collider and soil vertex, a rigid contact for each collider, rigid
+ * support and candidate point, the joint rows */
+static uint64_t warm_max(const ssModel *m)
+{
+  return ((uint64_t)m->nhfielddata + ((uint64_t)m->nhfield + (uint64_t)m->nplane) *
+                                         SS_RIGID_CANDIDATES) *
+             (uint64_t)m->ngeom +
+         (uint64_t)m->npd + 2 * (uint64_t)m->nv;
+}
+
 /* Largest checkpoint a model can have (bytes); bigger files are refused
  * before they are read. */
 static uint64_t max_size(const ssModel *m)
 {
   uint64_t nhd = (uint64_t)m->nhfielddata;
-  uint64_t warm = nhd * (uint64_t)m->ngeom + (uint64_t)m->npd + 2 * (uint64_t)m->nv;
+  uint64_t warm = warm_max(m);
   return CKPT_HEADER + CKPT_TRAILER + (uint64_t)NTAG * CKPT_SECTION_HEAD +
          8 + 4 * NCOUNT + 8 * NHASH + CKPT_SOURCE_MAX + OPTS_BYTES +
          CLCK_BYTES + STAT_BYTES + 8 * ((uint64_t)m->nq + (uint64_t)m->nv) +
@@ -961,6 +978,19 @@ static ssStatus read_doubles(const Parsed *f, int s, size_t n, double *out,
   return SS_OK;
 }
 
+/* Whether cache entry e, keyed as a rigid contact's (vertex < 0), names a
+ * rigid support (a rigid height map or a ground plane) and a candidate
+ * point, and holds what the solver stores for one: a positive normal
+ * force and no rate */
+static int rigid_entry(const ssModel *m, const ssWarmEntry *e)
+{
+  int support, k;
+  ss_rigid_feature_split(e->vertex, &support, &k);
+  (void)k; /* any of SS_RIGID_CANDIDATES */
+  int ok = support < m->nhfield + m->nplane && (support >= m->nhfield || !m->hfield_soil[support]);
+  return ok && e->traction[0] > 0 && e->rate[0] == 0 && e->rate[1] == 0 && e->rate[2] == 0;
+}
+
 /* Everything read from a file before it is put into the data. */
 typedef struct State {
   double time, closure;
@@ -1007,7 +1037,7 @@ static ssStatus parse_state(const ssModel *m, const Parsed *f, const char *path,
   const size_t nhd = (size_t)m->nhfielddata;
 
   /* sizes against the model before anything is allocated */
-  uint64_t warm_cap = (uint64_t)nhd * (uint64_t)m->ngeom + npd + 2 * (uint64_t)nv;
+  uint64_t warm_cap = warm_max(m);
   if (f->size[S_LOAD] % 4 || f->size[S_LOAD] / 4 > nhd)
     return corrupt(err, path, "bad size of the loaded-vertex list");
   if (f->size[S_WARM] % CKPT_WARM_BYTES ||
@@ -1087,12 +1117,13 @@ static ssStatus parse_state(const ssModel *m, const Parsed *f, const char *path,
     e->creep = r_i32(&r);
     r_f64s(&r, e->traction, 3);
     r_f64s(&r, e->rate, 3);
-    int key_ok = e->geom >= 0
-                     ? (size_t)e->vertex < nhd && e->vertex >= 0 &&
-                           e->geom < m->ngeom && soil_vertex(m, e->vertex)
+    int key_ok = e->geom >= 0 && e->vertex < 0
+                     ? e->geom < m->ngeom && rigid_entry(m, e)
+                 : e->geom >= 0
+                     ? (size_t)e->vertex < nhd && e->geom < m->ngeom && soil_vertex(m, e->vertex)
                      : (e->geom == -2 || e->geom == -3) && e->vertex >= 0 &&
                            (size_t)e->vertex < 2 * nv;
-    key_ok = key_ok && (e->creep == 0 || (e->creep == 1 && e->geom >= 0));
+    key_ok = key_ok && (e->creep == 0 || (e->creep == 1 && e->geom >= 0 && e->vertex >= 0));
     if (!key_ok || !isfinite(e->traction[0]) || !isfinite(e->traction[1]) ||
         !isfinite(e->traction[2]) || !isfinite(e->rate[0]) || !isfinite(e->rate[1]) ||
         !isfinite(e->rate[2]) || (k && ss_solver_warm_cmp(e - 1, e) > 0))

@@ -12,6 +12,13 @@
 /* Largest height map we accept (vertices); keeps nx*ny and byte sizes far
  * from overflow and memory in reach. */
 #define SS_MAX_HFIELD_VERTICES 100000000L
+/* Ground planes in one model.  With the height maps (at most
+ * SS_MAX_HFIELD_VERTICES / 4 of them) they number the rigid supports of
+ * the warm start's keys (solver.h, ss_rigid_feature), which must stay
+ * below 2^26 - 1. */
+#define SS_MAX_PLANES 1000000
+_Static_assert(SS_MAX_HFIELD_VERTICES / 4 + SS_MAX_PLANES < (1L << 26) - 1,
+               "rigid supports fit ss_rigid_feature's keys");
 
 ssOption ss_option_default(void)
 {
@@ -703,6 +710,11 @@ int ss_model_add_plane(ssModel *m, const char *name, double height,
   if (!isfinite(height)) {
     ss_error_set(err, SS_ERR_VALUE, m->source_path, line,
                  "ground '%s': height must be finite", name);
+    return -1;
+  }
+  if (m->nplane >= SS_MAX_PLANES) {
+    ss_error_set(err, SS_ERR_VALUE, m->source_path, line,
+                 "ground '%s': at most %d ground planes", name, SS_MAX_PLANES);
     return -1;
   }
   int mat = ss_model_material(m, material);

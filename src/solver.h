@@ -21,6 +21,7 @@
 #include "soilsim.h"
 #include "point.h"
 
+#include <limits.h>
 #include <stddef.h>
 #include <string.h>
 
@@ -36,7 +37,8 @@ struct ssContact {
   int sys;           /* dynamic system, -1 if the body is static */
   int geom;          /* collider */
   int hfield;        /* bed or rigid height map; -1 for a ground plane */
-  int vertex;        /* soil: absolute index into the soil arrays */
+  int vertex;        /* soil: absolute index into the soil arrays; rigid:
+                        its cache key (ss_rigid_feature) */
   int vadr, nv;      /* the system's velocity block */
   int link;          /* articulated link whose block serves the contact, or
                         -1 (J and W stored) */
@@ -98,18 +100,44 @@ struct ssContact {
  * slip directions that turn with velocities of 1e-5 m/s and less, and the
  * warm start extrapolates them only where the Newton phase fails without. */
 struct ssWarmEntry {
-  int vertex;        /* absolute soil vertex (joint rows: see row_key) */
+  int vertex;        /* absolute soil vertex; rigid contacts: their key
+                        (ss_rigid_feature, < 0); joint rows: see row_key */
   int geom;
   int creep;         /* 1: its collider crept (solver.c, CREEP_SLIP) and
                         its rate is not 0: the warm start leaves the rate
                         out, unless the Newton phase fails without */
-  double traction[3];/* impulse / (area dt), contact frame (Pa); joint
-                        rows: impulse / dt in traction[0] */
-  double rate[3];    /* traction change over the last step (Pa); 0 for rows */
+  double traction[3];/* impulse / (area dt), contact frame (Pa); rigid
+                        contacts: impulse / dt (N); joint rows: impulse /
+                        dt in traction[0] */
+  double rate[3];    /* traction change over the last step (Pa); 0 for
+                        rigid contacts and rows */
   uint64_t key;      /* the cache's order as one number, from geom and
                         vertex (ss_solver_warm_key), kept for the look-ups
                         and the sort */
 };
+
+/* A rigid contact's key in the warm-start cache, in place of a soil
+ * vertex: its support s (rigid height map h, or ground plane nhfield + p)
+ * and its collider's candidate point k (ss_shape_candidates' order, k <
+ * SS_RIGID_CANDIDATES) as INT_MIN + s SS_RIGID_CANDIDATES + k: negative,
+ * so never a soil vertex, and ascending in the order a collider's rigid
+ * contacts are made.  A candidate is a feature of the collider (a box's
+ * corner, a cylinder's lowest rim point at either end or one of its cap
+ * points), so its impulse carries over from step to step as a body rests,
+ * slides or rolls on its support.  (s < 2^26 - 1: the model's limits on
+ * height maps and ground planes keep it there.) */
+#define SS_RIGID_CANDIDATES 32
+static inline int ss_rigid_feature(int support, int k)
+{
+  return INT_MIN + support * SS_RIGID_CANDIDATES + k;
+}
+/* the support and candidate of a rigid contact's key (vertex < 0) */
+static inline void ss_rigid_feature_split(int vertex, int *support, int *k)
+{
+  unsigned u = (unsigned)vertex - 0x80000000u;
+  *support = (int)(u / SS_RIGID_CANDIDATES);
+  *k = (int)(u % SS_RIGID_CANDIDATES);
+}
 
 /* The warm-start cache's order (<0, 0, >0): by collider, then vertex,
  * the joint rows last; checkpoints hold the cache in it (checkpoint.c

@@ -449,8 +449,9 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
   double top = h >= 0 ? m->hfield_zrange[2 * h + 1] : 0;
   if (lo[2] > top + margin) return SS_OK;
 
-  double up[3] = {0, 0, 1}, pts[32][3];
-  int npt = ss_shape_candidates(&s, up, pts, 32);
+  double up[3] = {0, 0, 1}, pts[SS_RIGID_CANDIDATES][3];
+  int npt = ss_shape_candidates(&s, up, pts, SS_RIGID_CANDIDATES);
+  const int support = h >= 0 ? h : m->nhfield + plane;
   int mat = h >= 0 ? m->hfield_material[h] : m->plane_material[plane];
   const ssMaterialPair *pair = ss_model_pair(m, m->geom_material[g], mat);
   long njac = contact_jlen(m, sys);
@@ -465,7 +466,7 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
     c->type = SS_CONTACT_RIGID;
     c->geom = g;
     c->hfield = h;
-    c->vertex = -1;
+    c->vertex = ss_rigid_feature(support, k);
     ss_m3_mulv(c->pos, R, pts[k]);
     ss_v3_add(c->pos, c->pos, p);
     double nw[3];

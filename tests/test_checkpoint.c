@@ -469,10 +469,10 @@ static void damage_tests(const char *what, const ssModel *m, const ssData *src,
     ok(0, "%s: checkpoint", what);
     return;
   }
-  ok(!memcmp(good, "SOILCKPT", 8) && le(good + 8, 4) == 4 && le(good + 16, 8) == n &&
+  ok(!memcmp(good, "SOILCKPT", 8) && le(good + 8, 4) == 5 && le(good + 16, 8) == n &&
      le(good + 28, 4) == crc32_ref(good, 28) && !memcmp(good + n - 8, "CRC ", 4) &&
      le(good + n - 4, 4) == crc32_ref(good, n - 4),
-     "%s: layout: signature, version 4, size and CRC-32 in the header, CRC-32 "
+     "%s: layout: signature, version 5, size and CRC-32 in the header, CRC-32 "
      "trailer (%zu bytes)", what, n);
 
   /* the victim: a data in another state that must survive every attack */
@@ -549,8 +549,8 @@ static void damage_tests(const char *what, const ssModel *m, const ssData *src,
     int width;
     uint64_t value;
   } forge[] = {
-    {"version 3 (an older build's)", NULL, 8, 4, 3},
-    {"version 5", NULL, 8, 4, 5},
+    {"version 4 (an older build's)", NULL, 8, 4, 4},
+    {"version 6", NULL, 8, 4, 6},
     {"header size", NULL, 12, 4, 64},
     {"section count too high", NULL, 24, 4, 17},
     {"section count too low", NULL, 24, 4, 14},
@@ -659,6 +659,96 @@ static void test_damage(void)
   }
 }
 
+/* Rigid contacts' cache entries (solver.h, ss_rigid_feature): the buggy
+ * driving on concrete replays bit for bit from a checkpoint (its wheels'
+ * rim points warm start the next step: without them in the file the
+ * restored run would start them cold and part from the straight one); and
+ * a checkpoint whose rigid entry names a soil bed or no support at all,
+ * or holds what the solver never stores (no normal force, a rate, a creep
+ * flag), is refused. */
+static void test_rigid_cache(void)
+{
+  ssModel *m;
+  ssData *a;
+  ssError e;
+  if (load_scene("buggy_rigid.xml", &m, &a)) {
+    ssData *b = ss_data_new(m), *c = ss_data_new(m);
+    const int N = 600, K = 450;
+    size_t len = 0;
+    unsigned char *buf = NULL;
+    int r = b && c && run(m, a, N) && run(m, b, K) && (buf = snapshot(m, b, &len)) &&
+            ss_checkpoint_load_buffer(m, c, buf, len, &e) == SS_OK;
+    int rigid = 0;
+    for (int k = 0; r && k < b->nwarm; k++) rigid += b->warm[k].vertex < 0 && b->warm[k].geom >= 0;
+    ok(r && identical(m, b, c) && rigid >= 4,
+       "buggy_rigid.xml: checkpoint after %d steps (%d rigid contacts cached) restores", K,
+       rigid);
+    ok(r && run(m, c, N - K) && identical(m, a, c),
+       "buggy_rigid.xml: %d + %d steps after the restore = %d steps straight, bit for bit",
+       K, N - K, N);
+    free(buf);
+    ss_data_free(b);
+    ss_data_free(c);
+    ss_data_free(a);
+    ss_model_free(m);
+  } else {
+    ok(0, "buggy_rigid.xml loads");
+  }
+
+  /* a soil bed (height map 0) and, off it, a box resting on a ground
+   * plane (support nhfield + 0 = 1) */
+  m = ss_model_new();
+  int bed = add_soil_bed(m, 0.4, 0.05);
+  int plane = ss_model_add_plane(m, "ground", -0.5, NULL, 0, &e);
+  ssBodyDef bx = ss_body_def_default();
+  bx.name = "box";
+  bx.size[0] = bx.size[1] = 0.2;
+  bx.size[2] = 0.1;
+  bx.mass = 2;
+  ss_v3_set(bx.pos, 3, 0, -0.45);
+  int body = ss_model_add_body(m, &bx, &e);
+  ssData *d = bed >= 0 && plane >= 0 && body >= 0 ? ss_data_new(m) : NULL;
+  size_t n = 0;
+  unsigned char *good = d && run(m, d, 20) ? snapshot(m, d, &n) : NULL;
+  size_t at = good ? find_section(good, n, "WARM") : 0;
+  int entries = at ? (int)(le(good + at + 8, 8) / 60) : 0, first = -1;
+  for (int k = 0; k < entries && first < 0; k++)
+    if ((int32_t)le(good + at + 16 + 60 * k, 4) < 0) first = k;
+  ok(first >= 0 && entries == 4 && ss_checkpoint_load_buffer(m, d, good, n, &e) == SS_OK,
+     "a box on a ground plane beside a soil bed: its four corners cached, the "
+     "checkpoint restores");
+  struct {
+    const char *desc;
+    int off, width;
+    uint64_t value;
+  } forge[] = {
+    {"the soil bed as its support", 0, 4, 0x80000000u + 0 * SS_RIGID_CANDIDATES},
+    {"a support past the ground planes", 0, 4, 0x80000000u + 2 * SS_RIGID_CANDIDATES},
+    {"no normal force", 12, 8, 0},
+    {"a rate", 36, 8, UINT64_C(0x3ff0000000000000)},
+    {"a creep flag", 8, 4, 1},
+  };
+  int nforge = (int)(sizeof forge / sizeof forge[0]), accepted = 0;
+  unsigned char *p = good ? malloc(n) : NULL;
+  for (int k = 0; k < nforge && p && first >= 0; k++) {
+    memcpy(p, good, n);
+    put(p + at + 16 + 60 * first + forge[k].off, forge[k].value, forge[k].width);
+    reseal(p, n);
+    ss_error_clear(&e);
+    if (ss_checkpoint_load_buffer(m, d, p, n, &e) == SS_OK || !strstr(e.message, "warm-start")) {
+      diag("forged rigid entry with %s: %s", forge[k].desc, e.message[0] ? e.message : "accepted");
+      accepted++;
+    }
+  }
+  ok(p && first >= 0 && accepted == 0,
+     "%d forged rigid cache entries (a soil bed or no support named, no normal force, a "
+     "rate, a creep flag) are refused as a bad warm-start cache", nforge);
+  free(p);
+  free(good);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 static int write_file(const char *path, const void *p, size_t n)
 {
   FILE *fp = fopen(path, "wb");
@@ -713,10 +803,10 @@ static void test_foreign_and_mismatch(void)
   /* info without a model */
   ssCheckpointInfo info;
   ok(ss_checkpoint_save(m, d, path, &e) == SS_OK && ss_checkpoint_info(path, &info, &e) == SS_OK &&
-     info.version == 4 && info.step == 20 && info.time == d->time &&
+     info.version == 5 && info.step == 20 && info.time == d->time &&
      info.bytes == n && strstr(info.source, "plate.xml") &&
      info.opt.solver_max_sweeps == m->opt.solver_max_sweeps,
-     "ss_checkpoint_info: version 4, step 20, time, size, source '%s'", info.source);
+     "ss_checkpoint_info: version 5, step 20, time, size, source '%s'", info.source);
 
   /* another world */
   ssModel *ml;
@@ -1091,6 +1181,7 @@ int main(void)
   test_reproducible();
   test_foreign_and_mismatch();
   test_damage();
+  test_rigid_cache();
   test_export();
   test_failed_step();
   rmdir(tmpdir);

@@ -514,6 +514,81 @@ static void test_rigid(void)
   }
 }
 
+/* Rigid contacts are warm started (solver.h, ss_rigid_feature) and a
+ * collider's rigid contacts solved as a block (solver.c, rigid_block): a
+ * box resting on its four corners and a cylinder lying on its side (two
+ * rim points), each on a ground plane, take one sweep a step once
+ * settled, last step's impulses passing the check as they come; started
+ * cold each step they take several; a box sliding at 3 m/s stops at
+ * v^2 / (2 mu g) either way.  Warm and cold reach the same state. */
+static void test_rigid_warm(void)
+{
+  double q[2][21];
+  long sweeps[2] = {0, 0};
+  int ones[2] = {0, 0}, nq = 0, good = 1;
+  for (int warm = 1; warm >= 0; warm--) {
+    ssError e;
+    ssModel *m = ss_model_new();
+    ss_model_add_plane(m, "ground", 0, "steel", 0, &e);
+    ss_model_set_pair(m, "steel", "rubber", 0.5, 0, 0, &e);
+    ssBodyDef b = ss_body_def_default();
+    b.name = "box";
+    b.size[0] = 0.4;
+    b.size[1] = 0.3;
+    b.size[2] = 0.1;
+    b.mass = 5;
+    b.material = "rubber";
+    ss_v3_set(b.pos, 0, 0, 0.05);
+    ss_model_add_body(m, &b, &e);
+    ssBodyDef c = ss_body_def_default();
+    c.name = "log";
+    c.shape = SS_GEOM_CYLINDER;
+    c.size[0] = 0.1;
+    c.size[1] = 0.8;
+    c.mass = 10;
+    c.material = "rubber";
+    double xaxis[3] = {1, 0, 0};
+    ss_quat_from_axis_angle(c.quat, xaxis, M_PI / 2);
+    ss_v3_set(c.pos, 0, 2, 0.1);
+    ss_model_add_body(m, &c, &e);
+    ssBodyDef s = ss_body_def_default();
+    s.name = "slider";
+    s.size[0] = s.size[1] = 0.2;
+    s.size[2] = 0.1;
+    s.mass = 5;
+    s.material = "rubber";
+    ss_v3_set(s.pos, 2, 0, 0.05);
+    s.lin_vel[0] = 3;
+    ss_model_add_body(m, &s, &e);
+    m->opt.terrain_warm_start = warm;
+    ssData *d = ss_data_new(m);
+    for (int k = 0; k < 1500 && good; k++) {
+      good = ss_step(m, d, &e) == SS_OK && d->stats.converged;
+      /* the slider stops within 0.92 s; from then on all three rest */
+      if (k >= 1000) {
+        sweeps[warm] += d->stats.sweeps;
+        ones[warm] += d->stats.sweeps == 1;
+      }
+    }
+    nq = m->nq;
+    if (good && nq == 21) memcpy(q[warm], d->qpos, sizeof q[warm]);
+    good = good && nq == 21;
+    if (warm)
+      close_enough(d->qpos[14] - 2, 9.0 / (2 * 0.5 * G), 0.02 * 9.0 / (2 * 0.5 * G),
+                   "warm rigid contacts: the sliding box stops after v^2/(2 mu g)");
+    ss_data_free(d);
+    ss_model_free(m);
+  }
+  ok(good && ones[1] == 500,
+     "rigid contacts at rest, warm started: one sweep a step (%d steps of 500; cold: %d, "
+     "%.1f sweeps a step)", ones[1], ones[0], sweeps[0] / 500.0);
+  ok(good && sweeps[0] >= 2 * sweeps[1], "  started cold, at least twice the sweeps (%ld "
+     "against %ld: the block's answer, then a sweep that confirms it)", sweeps[0], sweeps[1]);
+  double dq = 0;
+  for (int k = 0; k < nq && good; k++) dq = fmax(dq, fabs(q[1][k] - q[0][k]));
+  ok(good && dq < 1e-9, "  warm and cold reach the same state (%.2g apart)", dq);
+}
+
 /* the cache entry with e's key, or NULL */
 static const ssWarmEntry *warm_find(const ssWarmEntry *w, int n, const ssWarmEntry *e)
 {
@@ -922,6 +997,7 @@ int main(void)
   test_impact_and_lift();
   test_drag();
   test_rigid();
+  test_rigid_warm();
   test_reach();
   test_contact_storage();
   test_warm_trend();
