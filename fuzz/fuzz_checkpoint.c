@@ -15,8 +15,9 @@
  *     again.
  *
  * Seeds: run the target with SS_FUZZ_WRITE_SEEDS=DIR and it writes
- * checkpoints of its world (fresh, after 1 step, after 40 steps) into DIR
- * and exits; fuzz/seed-corpus.sh does this. */
+ * checkpoints of its world (fresh, after 1 step, after 40 steps, and after
+ * 250, when the sphere rests on the ground: a rigid contact's entry in the
+ * warm-start cache) into DIR and exits; fuzz/seed-corpus.sh does this. */
 #include "fuzz_common.h"
 #include "soilsim.h"
 
@@ -73,6 +74,9 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
   }
   if (seeds) {
     write_seed(seeds, "step40.ckpt", d);
+    for (int k = 40; k < 250; k++)
+      if (ss_step(model, d, &e) != SS_OK) die("the world does not step", &e);
+    write_seed(seeds, "step250.ckpt", d);
     exit(0);
   }
   fresh = d;
