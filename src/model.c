@@ -706,15 +706,15 @@ int ss_model_add_body(ssModel *m, const ssBodyDef *def, ssError *err)
 int ss_model_add_plane(ssModel *m, const char *name, double height,
                        const char *material, int line, ssError *err)
 {
+  if (m->nplane >= SS_MAX_PLANES) {
+    ss_error_set(err, SS_ERR_VALUE, m->source_path, line,
+                 "ground '%s': at most %d ground planes", name ? name : "", SS_MAX_PLANES);
+    return -1;
+  }
   if (check_name(m, name, line, err) != SS_OK) return -1;
   if (!isfinite(height)) {
     ss_error_set(err, SS_ERR_VALUE, m->source_path, line,
                  "ground '%s': height must be finite", name);
-    return -1;
-  }
-  if (m->nplane >= SS_MAX_PLANES) {
-    ss_error_set(err, SS_ERR_VALUE, m->source_path, line,
-                 "ground '%s': at most %d ground planes", name, SS_MAX_PLANES);
     return -1;
   }
   int mat = ss_model_material(m, material);

@@ -587,6 +587,18 @@ static void test_rigid_warm(void)
   double dq = 0;
   for (int k = 0; k < nq && good; k++) dq = fmax(dq, fabs(q[1][k] - q[0][k]));
   ok(good && dq < 1e-9, "  warm and cold reach the same state (%.2g apart)", dq);
+
+  /* the keys number the rigid supports: ground planes are limited to 10^6
+   * (the count set by hand: the limit is checked before anything else) */
+  ssError e;
+  ssModel *m = ss_model_new();
+  int first = ss_model_add_plane(m, "g0", 0, NULL, 0, &e);
+  m->nplane = 1000000;
+  int refused = ss_model_add_plane(m, "g1", 0, NULL, 7, &e) < 0 && m->nplane == 1000000 &&
+                e.line == 7 && strstr(e.message, "at most 1000000 ground planes");
+  m->nplane = 1;
+  ok(first == 0 && refused, "the 1000001st ground plane is refused (%s)", e.message);
+  ss_model_free(m);
 }
 
 /* the cache entry with e's key, or NULL */
