@@ -900,29 +900,23 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err)
 /* one Gauss-Seidel visit: new impulse of contact c with the others held;
  * inside an open group g the contact sees and moves the link's spatial
  * velocity only */
-static void visit(const ssModel *m, ssData *d, ssContact *c, Group *g,
-                  double *dmax, double *lmax)
+/* contact c's velocity as a visit sees it: in an open group g from the
+ * link's spatial velocity, else from the system's */
+static inline void visit_velocity(const ssModel *m, ssData *d, const ssContact *c,
+                                  const Group *g, int row, double v[3])
 {
-  const double stol = m->opt.scalar_tolerance;
-  int packed = g->first != NULL, row = c->type == SS_CONTACT_PD || c->type == SS_CONTACT_LIMIT;
-  double v[3] = {0, 0, 0}, v0[3], old[3];
-  if (packed) rows_velocity(d->jac + c->jadr, g->V, v);
+  v[0] = v[1] = v[2] = 0;
+  if (g->first) rows_velocity(d->jac + c->jadr, g->V, v);
   else if (row) v[0] = row_velocity(d, c);
   else if (c->nv) contact_velocity(m, d, c, v);
-  memcpy(old, c->lambda, sizeof old);
-  ss_m3_mulv(v0, c->G, old);
-  ss_v3_sub(v0, v, v0);
-  switch (c->type) {
-  case SS_CONTACT_SOIL:
-    ss_point_soil(c, v0, stol);
-    break;
-  case SS_CONTACT_RIGID: ss_point_rigid(c, v0, stol); break;
-  case SS_CONTACT_PD: pd_row(c, v0); break;
-  default: limit_row(c, v0); break;
-  }
-  double dl[3];
-  ss_v3_sub(dl, c->lambda, old);
-  if (packed) {
+}
+
+/* contact c's impulse changed by dl: into the open group g (the link's
+ * spatial impulse and velocity), or into the system's velocity */
+static inline void visit_apply(const ssModel *m, ssData *d, ssContact *c, Group *g, int row,
+                               const double dl[3])
+{
+  if (g->first) {
     if (dl[0] != 0 || dl[1] != 0 || dl[2] != 0) {
       double w[6], dV[6];
       const double *X = d->jac + c->jadr;
@@ -938,6 +932,29 @@ static void visit(const ssModel *m, ssData *d, ssContact *c, Group *g,
   } else if (c->nv) {
     apply_impulse(m, d, c, dl);
   }
+}
+
+static void visit(const ssModel *m, ssData *d, ssContact *c, Group *g,
+                  double *dmax, double *lmax)
+{
+  const double stol = m->opt.scalar_tolerance;
+  int row = c->type == SS_CONTACT_PD || c->type == SS_CONTACT_LIMIT;
+  double v[3], v0[3], old[3];
+  visit_velocity(m, d, c, g, row, v);
+  memcpy(old, c->lambda, sizeof old);
+  ss_m3_mulv(v0, c->G, old);
+  ss_v3_sub(v0, v, v0);
+  switch (c->type) {
+  case SS_CONTACT_SOIL:
+    ss_point_soil(c, v0, stol);
+    break;
+  case SS_CONTACT_RIGID: ss_point_rigid(c, v0, stol); break;
+  case SS_CONTACT_PD: pd_row(c, v0); break;
+  default: limit_row(c, v0); break;
+  }
+  double dl[3];
+  ss_v3_sub(dl, c->lambda, old);
+  visit_apply(m, d, c, g, row, dl);
   double dn = fabs(dl[0]) + fabs(dl[1]) + fabs(dl[2]);
   double ln = fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]);
   if (dn > *dmax) *dmax = dn;
@@ -1021,26 +1038,278 @@ static void visit_span(const ssModel *m, ssData *d, int lo, int hi, int back, Gr
  * wheel, four corners of a box) are solved as one block within each
  * sweep: after its first pass (which counts in the sweep's measure: it
  * is the block's answer to every other contact's change since its last
- * visit) its contacts are swept again, alternating direction, until the
- * block's own largest change is within the tolerance of its largest
- * impulse, or RIGID_PASSES passes.  Such contacts are redundant or nearly
- * (a wheel's two rim points on flat ground, with its camber and its steer
- * held by the suspension's linkage, hold the same motions as the other
- * wheels' do through the chassis): the split of the load between them is
- * set only by small differences, and one pass a sweep moves it slowly.
- * Measured on buggy_rigid.xml (2000 steps, tolerance 1e-9, the warm
- * start on): one pass a sweep, 177 sweeps a step over its last 500
- * steps and 416 of them stopped at the 200-sweep cap; the block solved,
- * 41 sweeps a step and none capped after its drop. */
+ * visit), the block's own solve (block_solve: its contacts' linear system
+ * on their present states) and a pass that checks it, again, alternating
+ * direction, until the block's own largest change in a pass is within the
+ * tolerance of its largest impulse, or RIGID_PASSES passes (the solve
+ * before the first BLOCK_TRIES of them, on blocks of at most BLOCK_MAX
+ * contacts).  Such contacts are redundant or nearly (a wheel's two rim
+ * points on flat ground, with its camber and its steer held by the
+ * suspension's linkage, hold the same motions as the other wheels' do
+ * through the chassis; four corners of a box on the ground): the split of
+ * the load between them is set only by small differences, and one pass a
+ * sweep moves it slowly.  Measured on buggy_rigid.xml (2000 steps,
+ * tolerance 1e-9, the warm start on): one pass a sweep, 177 sweeps a step
+ * over its last 500 steps and 416 of them stopped at the 200-sweep cap;
+ * passes alone up to 64, 41 sweeps a step and none capped after its drop,
+ * but turning (the rack at 3 cm) most steps capped from 1 s on, the passes
+ * at their cap; with the block's solve, the same when driving straight,
+ * and turning 64-78 sweeps a step from 2 s on (172 before), a fifth to a
+ * quarter of the steps capped (three in five before): each block settles
+ * in a few passes now, and what stays slow is the coupling of the blocks
+ * through the chassis (README, Rigid contacts). */
 enum { RIGID_PASSES = 64 };
+enum { BLOCK_MAX = 16, BLOCK_TRIES = 6 };
+
+/* G_ab, the response of contact a's velocity to contact b's impulse (3 x 3,
+ * row-major), both of one system, from the rows the sweeps' set-up formed:
+ * on one link X_a Lam X_b^T = X_a . LX_b; on two links X_a (J_a Y_b) X_b^T
+ * (ss_art_link_pair); on a free body J_a W_b */
+static void block_response(const ssModel *m, ssData *d, const ssContact *a, const ssContact *b,
+                           double G[9])
+{
+  const double *Xa = d->jac + a->jadr;
+  if (a->link >= 0) {
+    const double *Xb = d->jac + b->jadr;
+    double LX[18];
+    if (a->link == b->link) {
+      memcpy(LX, Xb + 18, sizeof LX);
+    } else {
+      double P[36];
+      ss_art_link_pair(m, d, a->link, b->link, P, 6);
+      for (int k = 0; k < 3; k++)
+        for (int r = 0; r < 6; r++) {
+          const double *p = P + 6 * r, *x = Xb + 6 * k;
+          LX[6 * k + r] = p[0] * x[0] + p[1] * x[1] + p[2] * x[2] + p[3] * x[3] + p[4] * x[4] +
+                          p[5] * x[5];
+        }
+    }
+    for (int r = 0; r < 3; r++)
+      for (int k = 0; k < 3; k++) {
+        const double *x = Xa + 6 * r, *y = LX + 6 * k;
+        G[3 * r + k] = x[0] * y[0] + x[1] * y[1] + x[2] * y[2] + x[3] * y[3] + x[4] * y[4] +
+                       x[5] * y[5];
+      }
+    return;
+  }
+  const int nv = a->nv;
+  const double *Wb = d->jac + b->jadr + 3 * nv;
+  for (int r = 0; r < 3; r++)
+    for (int k = 0; k < 3; k++) {
+      double s = 0;
+      for (int i = 0; i < nv; i++) s += Xa[r * nv + i] * Wb[3 * i + k];
+      G[3 * r + k] = s;
+    }
+}
+
+/* Solves the n x n system A x = b in place (row-major, n <= 3 BLOCK_MAX)
+ * by elimination with partial pivoting, A first regularised by 1e-10 of
+ * its largest diagonal entry (a block's contacts may be exactly redundant:
+ * four corners of a box on the ground hold six motions with twelve rows);
+ * 0 where a pivot vanishes or the answer is not finite */
+static int block_linear(double *A, double *b, int n)
+{
+  double s = 0;
+  for (int i = 0; i < n; i++) s = fmax(s, fabs(A[i * n + i]));
+  if (!(s > 0)) return 0;
+  for (int i = 0; i < n; i++) A[i * n + i] += 1e-10 * s;
+  for (int k = 0; k < n; k++) {
+    int p = k;
+    for (int i = k + 1; i < n; i++)
+      if (fabs(A[i * n + k]) > fabs(A[p * n + k])) p = i;
+    if (!(fabs(A[p * n + k]) > 1e-14 * s)) return 0;
+    if (p != k) {
+      for (int j = 0; j < n; j++) {
+        double t = A[k * n + j];
+        A[k * n + j] = A[p * n + j];
+        A[p * n + j] = t;
+      }
+      double t = b[k];
+      b[k] = b[p];
+      b[p] = t;
+    }
+    for (int i = k + 1; i < n; i++) {
+      double f = A[i * n + k] / A[k * n + k];
+      if (f == 0) continue;
+      for (int j = k; j < n; j++) A[i * n + j] -= f * A[k * n + j];
+      b[i] -= f * b[k];
+    }
+  }
+  for (int k = n - 1; k >= 0; k--) {
+    double r = b[k];
+    for (int j = k + 1; j < n; j++) r -= A[k * n + j] * b[j];
+    b[k] = r / A[k * n + k];
+    if (!isfinite(b[k])) return 0;
+  }
+  return 1;
+}
+
+/* A block for block_solve: its rigid contacts c, their responses G (3n x
+ * 3n) and their velocities without the block's own impulses v0, and a
+ * guess at each contact's state: kind 0 unloaded, 1 sticking, 2 sliding
+ * along the unit slip direction u (its impulse on the cone, -mu lambda_n
+ * u). */
+typedef struct Block {
+  int n;
+  ssContact *c[BLOCK_MAX];
+  double G[3 * BLOCK_MAX][3 * BLOCK_MAX], v0[3 * BLOCK_MAX];
+  int kind[BLOCK_MAX];
+  double u[BLOCK_MAX][2];
+} Block;
+
+/* The impulses nl (3n) of block B's contacts with their states held: the
+ * loaded ones at their normal targets, the sticking ones stopped, the
+ * sliding ones' impulses on their cones along -u.  0 where the system
+ * cannot be solved. */
+static int block_impulses(const Block *B, double nl[3 * BLOCK_MAX])
+{
+  enum { N = 3 * BLOCK_MAX };
+  const int n = B->n;
+  int col[BLOCK_MAX], neq = 0;
+  for (int i = 0; i < n; i++) {
+    col[i] = neq;
+    neq += B->kind[i] == 0 ? 0 : B->kind[i] == 1 ? 3 : 1;
+  }
+  for (int i = 0; i < 3 * n; i++) nl[i] = 0;
+  if (neq == 0) return 1;
+  double A[N * N], x[N];
+  for (int i = 0; i < n; i++) {
+    if (!B->kind[i]) continue;
+    /* the rows of contact i: its normal, and its tangents where it sticks */
+    for (int a = 0; a < (B->kind[i] == 1 ? 3 : 1); a++) {
+      int r = col[i] + a, R = 3 * i + a;
+      x[r] = (a == 0 ? B->c[i]->vn_target : 0) - B->v0[R];
+      for (int j = 0; j < n; j++) {
+        if (!B->kind[j]) continue;
+        double *Ar = A + r * neq + col[j];
+        Ar[0] = B->G[R][3 * j];
+        if (B->kind[j] == 1) {
+          Ar[1] = B->G[R][3 * j + 1];
+          Ar[2] = B->G[R][3 * j + 2];
+        } else {
+          Ar[0] -= B->c[j]->mu * (B->G[R][3 * j + 1] * B->u[j][0] +
+                                  B->G[R][3 * j + 2] * B->u[j][1]);
+        }
+      }
+    }
+  }
+  if (!block_linear(A, x, neq)) return 0;
+  for (int i = 0; i < n; i++) {
+    double *l = nl + 3 * i;
+    if (!B->kind[i]) continue;
+    l[0] = x[col[i]];
+    if (B->kind[i] == 1) {
+      l[1] = x[col[i] + 1];
+      l[2] = x[col[i] + 2];
+    } else {
+      l[1] = -B->c[i]->mu * l[0] * B->u[i][0];
+      l[2] = -B->c[i]->mu * l[0] * B->u[i][1];
+    }
+  }
+  return 1;
+}
+
+/* One solve of block B's contacts (B->n and B->c set), every other
+ * contact held: the linear system of its contacts' states
+ * (block_impulses), starting from the states their impulses show, the
+ * states corrected one contact at a time (a loaded contact pulled:
+ * unloaded; a sticking one beyond its cone: sliding against that impulse;
+ * an unloaded one closing past its target: sticking) until an admissible
+ * answer, at most 2n + 2 solves.  Where a pass moves the load between
+ * nearly redundant contacts only a little, this solve moves it at once.
+ * The pass after it checks the answer and goes on from it (a sliding
+ * direction that turned).  Velocities are read and moved through the open
+ * group g, or the system's where none is open.  Returns 1 where it
+ * applied an answer, its largest change and impulse (1-norms) into *dmax
+ * and *lmax. */
+static int block_solve(const ssModel *m, ssData *d, Block *B, Group *g, double *dmax,
+                       double *lmax)
+{
+  const int n = B->n;
+  double lam[3 * BLOCK_MAX], v[3 * BLOCK_MAX], nl[3 * BLOCK_MAX];
+  for (int i = 0; i < n; i++) {
+    visit_velocity(m, d, B->c[i], g, 0, v + 3 * i);
+    memcpy(lam + 3 * i, B->c[i]->lambda, sizeof B->c[i]->lambda);
+    for (int j = 0; j < n; j++) {
+      double Gij[9];
+      block_response(m, d, B->c[i], B->c[j], Gij);
+      for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++) B->G[3 * i + a][3 * j + b] = Gij[3 * a + b];
+    }
+  }
+  for (int i = 0; i < 3 * n; i++) {
+    B->v0[i] = v[i];
+    for (int j = 0; j < 3 * n; j++) B->v0[i] -= B->G[i][j] * lam[j];
+  }
+  for (int i = 0; i < n; i++) {
+    const ssContact *c = B->c[i];
+    double ln = c->lambda[0], lt = hypot(c->lambda[1], c->lambda[2]);
+    B->kind[i] = !(ln > 0) ? 0 : lt < c->mu * ln * (1 - 1e-6) ? 1 : 2;
+    B->u[i][0] = B->u[i][1] = 0;
+    if (B->kind[i] != 2) continue;
+    /* the slip direction: the contact's velocity's, or against its
+     * impulse where it has none */
+    double s = hypot(v[3 * i + 1], v[3 * i + 2]);
+    if (s > 0) {
+      B->u[i][0] = v[3 * i + 1] / s;
+      B->u[i][1] = v[3 * i + 2] / s;
+    } else if (lt > 0) {
+      B->u[i][0] = -c->lambda[1] / lt;
+      B->u[i][1] = -c->lambda[2] / lt;
+    }
+  }
+  int ok = 0;
+  for (int round = 0; round < 2 * n + 2 && !ok; round++) {
+    if (!block_impulses(B, nl)) return 0;
+    ok = 1;
+    for (int i = 0; i < n && ok; i++) {
+      const double *l = nl + 3 * i;
+      double lt = hypot(l[1], l[2]);
+      if (B->kind[i] && !(l[0] >= 0)) {
+        B->kind[i] = 0;
+        ok = 0;
+      } else if (B->kind[i] == 1 && !(lt <= B->c[i]->mu * l[0] * (1 + 1e-9))) {
+        B->kind[i] = 2;
+        B->u[i][0] = -l[1] / lt;
+        B->u[i][1] = -l[2] / lt;
+        ok = 0;
+      } else if (!B->kind[i]) {
+        double vn = B->v0[3 * i];
+        for (int j = 0; j < 3 * n; j++) vn += B->G[3 * i][j] * nl[j];
+        if (vn < B->c[i]->vn_target - 1e-9 * fabs(B->c[i]->vn_target)) {
+          B->kind[i] = 1;
+          ok = 0;
+        }
+      }
+    }
+  }
+  if (!ok) return 0;
+  for (int i = 0; i < n; i++) {
+    ssContact *c = B->c[i];
+    double dl[3];
+    ss_v3_sub(dl, nl + 3 * i, c->lambda);
+    visit_apply(m, d, c, g, 0, dl);
+    memcpy(c->lambda, nl + 3 * i, sizeof c->lambda);
+    double dn = fabs(dl[0]) + fabs(dl[1]) + fabs(dl[2]);
+    double ln = fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]);
+    if (dn > *dmax) *dmax = dn;
+    if (ln > *lmax) *lmax = ln;
+  }
+  return 1;
+}
 
 static void rigid_block(const ssModel *m, ssData *d, int lo, int hi, int back, Group *g,
                         double *dmax, double *lmax)
 {
   const double tol = m->opt.solver_tolerance;
+  Block B;
+  B.n = hi - lo + 1 <= BLOCK_MAX ? hi - lo + 1 : 0;
+  for (int i = 0; i < B.n; i++) B.c[i] = d->contact + lo + i;
   visit_span(m, d, lo, hi, back, g, dmax, lmax);
   for (int pass = 1; pass < RIGID_PASSES; pass++) {
     double dm = 0, lm = 0;
+    if (pass <= BLOCK_TRIES && B.n) block_solve(m, d, &B, g, &dm, &lm);
+    dm = lm = 0;
     back = !back;
     visit_span(m, d, lo, hi, back, g, &dm, &lm);
     if (dm <= tol * lm) break;
