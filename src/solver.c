@@ -1038,55 +1038,36 @@ static void visit_span(const ssModel *m, ssData *d, int lo, int hi, int back, Gr
  * wheel, four corners of a box) are solved as one block within each
  * sweep: after its first pass (which counts in the sweep's measure: it
  * is the block's answer to every other contact's change since its last
- * visit), the block's own solve (block_solve: its contacts' linear system
- * on their present states) and a pass that checks it, again, alternating
- * direction, until the block's own largest change in a pass is within the
- * tolerance of its largest impulse, or RIGID_PASSES passes (the solve
- * before the first BLOCK_TRIES of them, on blocks of at most BLOCK_MAX
- * contacts).  Such contacts are redundant or nearly (a wheel's two rim
- * points on flat ground, with its camber and its steer held by the
- * suspension's linkage, hold the same motions as the other wheels' do
- * through the chassis; four corners of a box on the ground): the split of
- * the load between them is set only by small differences, and one pass a
- * sweep moves it slowly.  Measured on buggy_rigid.xml (2000 steps,
- * tolerance 1e-9, the warm start on): one pass a sweep, 177 sweeps a step
- * over its last 500 steps and 416 of them stopped at the 200-sweep cap;
- * passes alone up to 64, 41 sweeps a step and none capped after its drop,
- * but turning (the rack at 3 cm) most steps capped from 1 s on, the passes
- * at their cap; with the block's solve, the same when driving straight,
- * and turning 64-78 sweeps a step from 2 s on (172 before), a fifth to a
- * quarter of the steps capped (three in five before): each block settles
- * in a few passes now, and what stays slow is the coupling of the blocks
- * through the chassis (README, Rigid contacts). */
-enum { RIGID_PASSES = 64 };
-enum { BLOCK_MAX = 16, BLOCK_TRIES = 6 };
+ * visit), the block's own solve (block_solve) and a pass that checks it,
+ * again, alternating direction, until the block's own largest change in a
+ * pass is within the tolerance of its largest impulse, or RIGID_PASSES
+ * passes (the solve before the first BLOCK_TRIES of them, on blocks of at
+ * most BLOCK_MAX contacts).  Such contacts are redundant or nearly (a
+ * wheel's two rim points on flat ground, with its camber and its steer
+ * held by the suspension's linkage, hold the same motions as the other
+ * wheels' do through the chassis; four corners of a box on the ground):
+ * the split of the load between them is set only by small differences,
+ * which one pass a sweep moves slowly.  Measured on buggy_rigid.xml (2000
+ * steps, tolerance 1e-9, the warm start on): one pass a sweep, 177 sweeps
+ * a step over its last 500 steps and 416 of them at the 200-sweep cap;
+ * passes alone up to 64, 41 sweeps a step and none capped after its drop.
+ * Turning (the rack at 3 cm, 6000 steps): one pass, 172 sweeps a step
+ * from 2 s on and three steps in five capped; passes alone, the passes at
+ * their cap; with the block's solve, 38-40 sweeps a step and one step in
+ * 25 capped (README, Rigid contacts). */
+enum { RIGID_PASSES = 64, BLOCK_MAX = 16, BLOCK_TRIES = 6 };
 
 /* G_ab, the response of contact a's velocity to contact b's impulse (3 x 3,
- * row-major), both of one system, from the rows the sweeps' set-up formed:
- * on one link X_a Lam X_b^T = X_a . LX_b; on two links X_a (J_a Y_b) X_b^T
- * (ss_art_link_pair); on a free body J_a W_b */
-static void block_response(const ssModel *m, ssData *d, const ssContact *a, const ssContact *b,
-                           double G[9])
+ * row-major), both on one link (X_a Lam X_b^T = X_a . LX_b) or one free
+ * body (J_a W_b), from the rows the sweeps' set-up formed */
+static void block_response(const ssData *d, const ssContact *a, const ssContact *b, double G[9])
 {
   const double *Xa = d->jac + a->jadr;
   if (a->link >= 0) {
-    const double *Xb = d->jac + b->jadr;
-    double LX[18];
-    if (a->link == b->link) {
-      memcpy(LX, Xb + 18, sizeof LX);
-    } else {
-      double P[36];
-      ss_art_link_pair(m, d, a->link, b->link, P, 6);
-      for (int k = 0; k < 3; k++)
-        for (int r = 0; r < 6; r++) {
-          const double *p = P + 6 * r, *x = Xb + 6 * k;
-          LX[6 * k + r] = p[0] * x[0] + p[1] * x[1] + p[2] * x[2] + p[3] * x[3] + p[4] * x[4] +
-                          p[5] * x[5];
-        }
-    }
+    const double *LXb = d->jac + b->jadr + 18;
     for (int r = 0; r < 3; r++)
       for (int k = 0; k < 3; k++) {
-        const double *x = Xa + 6 * r, *y = LX + 6 * k;
+        const double *x = Xa + 6 * r, *y = LXb + 6 * k;
         G[3 * r + k] = x[0] * y[0] + x[1] * y[1] + x[2] * y[2] + x[3] * y[3] + x[4] * y[4] +
                        x[5] * y[5];
       }
@@ -1103,16 +1084,22 @@ static void block_response(const ssModel *m, ssData *d, const ssContact *a, cons
 }
 
 /* Solves the n x n system A x = b in place (row-major, n <= 3 BLOCK_MAX)
- * by elimination with partial pivoting, A first regularised by 1e-10 of
- * its largest diagonal entry (a block's contacts may be exactly redundant:
- * four corners of a box on the ground hold six motions with twelve rows);
- * 0 where a pivot vanishes or the answer is not finite */
-static int block_linear(double *A, double *b, int n)
+ * by elimination with partial pivoting, regularised towards xc: (A + e I)
+ * x = b + e xc, e 1e-10 of A's largest diagonal entry.  A block's contacts
+ * may be exactly redundant (four corners of a box on the ground hold six
+ * motions with twelve rows): of the answers then, the one nearest the
+ * impulses it starts from, so that a block already solved stays as it is
+ * (a pass after it changes nothing).  0 where a pivot vanishes or the
+ * answer is not finite. */
+static int block_linear(double *A, double *b, const double *xc, int n)
 {
   double s = 0;
   for (int i = 0; i < n; i++) s = fmax(s, fabs(A[i * n + i]));
   if (!(s > 0)) return 0;
-  for (int i = 0; i < n; i++) A[i * n + i] += 1e-10 * s;
+  for (int i = 0; i < n; i++) {
+    A[i * n + i] += 1e-10 * s;
+    b[i] += 1e-10 * s * xc[i];
+  }
   for (int k = 0; k < n; k++) {
     int p = k;
     for (int i = k + 1; i < n; i++)
@@ -1145,85 +1132,205 @@ static int block_linear(double *A, double *b, int n)
 }
 
 /* A block for block_solve: its rigid contacts c, their responses G (3n x
- * 3n) and their velocities without the block's own impulses v0, and a
- * guess at each contact's state: kind 0 unloaded, 1 sticking, 2 sliding
- * along the unit slip direction u (its impulse on the cone, -mu lambda_n
- * u). */
+ * 3n) and their velocities without the block's own impulses v0, and each
+ * contact's assumed state, kind: 0 unloaded, 1 sticking, 2 sliding, its
+ * tangential impulse on the cone against its slip (-mu lambda_n v_t /
+ * |v_t|) linearised about the slip vk (speed sk, direction u) and the
+ * normal impulse lk of the last answer, or, where sk or lk is 0, held
+ * along -u. */
 typedef struct Block {
   int n;
   ssContact *c[BLOCK_MAX];
   double G[3 * BLOCK_MAX][3 * BLOCK_MAX], v0[3 * BLOCK_MAX];
   int kind[BLOCK_MAX];
-  double u[BLOCK_MAX][2];
+  double u[BLOCK_MAX][2], vk[BLOCK_MAX][2], sk[BLOCK_MAX], lk[BLOCK_MAX];
 } Block;
 
-/* The impulses nl (3n) of block B's contacts with their states held: the
- * loaded ones at their normal targets, the sticking ones stopped, the
- * sliding ones' impulses on their cones along -u.  0 where the system
- * cannot be solved. */
-static int block_impulses(const Block *B, double nl[3 * BLOCK_MAX])
+/* unknowns of contact i in its state: none, its impulse (3), or a sliding
+ * contact's normal impulse alone where its direction is held (1) */
+static inline int block_unknowns(const Block *B, int i)
+{
+  if (!B->kind[i]) return 0;
+  if (B->kind[i] == 1) return 3;
+  return B->sk[i] > 0 && B->lk[i] > 0 && B->c[i]->mu > 0 ? 3 : 1;
+}
+
+/* The impulses nl (3n) of block B's contacts in their states: the loaded
+ * ones at their normal targets (vn_target), the sticking ones stopped,
+ * the sliding ones' on their cones against their slip (a Newton step on
+ * (sk / (mu lk)) (lambda_t + mu lambda_n u) + P_u (v_t - vk) = 0, P_u = I
+ * - u u^T the slip's change across u: the impulse's direction follows the
+ * slip's; or, held, lambda_t = -mu lambda_n u).  Each equation is a
+ * combination cr of the block's velocity rows plus terms own in its
+ * contact's unknowns.  lam: the impulses the solve starts from
+ * (block_linear).  0 where the system cannot be solved. */
+static int block_impulses(const Block *B, const double *lam, double nl[3 * BLOCK_MAX])
 {
   enum { N = 3 * BLOCK_MAX };
   const int n = B->n;
-  int col[BLOCK_MAX], neq = 0;
+  int col[BLOCK_MAX], nun[BLOCK_MAX], neq = 0;
   for (int i = 0; i < n; i++) {
     col[i] = neq;
-    neq += B->kind[i] == 0 ? 0 : B->kind[i] == 1 ? 3 : 1;
+    neq += nun[i] = block_unknowns(B, i);
   }
   for (int i = 0; i < 3 * n; i++) nl[i] = 0;
   if (neq == 0) return 1;
-  double A[N * N], x[N];
+  /* a held sliding contact's impulse per unit normal impulse */
+  double E[BLOCK_MAX][3];
+  for (int j = 0; j < n; j++) {
+    E[j][0] = 1;
+    E[j][1] = -B->c[j]->mu * B->u[j][0];
+    E[j][2] = -B->c[j]->mu * B->u[j][1];
+  }
+  double A[N * N], x[N], xc[N];
   for (int i = 0; i < n; i++) {
-    if (!B->kind[i]) continue;
-    /* the rows of contact i: its normal, and its tangents where it sticks */
-    for (int a = 0; a < (B->kind[i] == 1 ? 3 : 1); a++) {
-      int r = col[i] + a, R = 3 * i + a;
-      x[r] = (a == 0 ? B->c[i]->vn_target : 0) - B->v0[R];
+    const ssContact *ci = B->c[i];
+    for (int a = 0; a < nun[i]; a++) xc[col[i] + a] = lam[3 * i + a];
+    for (int a = 0; a < nun[i]; a++) {
+      int r = col[i] + a;
+      double *Ar = A + r * neq, cr[3] = {0, 0, 0}, own[3] = {0, 0, 0}, rhs = 0;
+      if (B->kind[i] == 2 && a > 0) {
+        double al = B->sk[i] / (ci->mu * B->lk[i]);
+        const double *u = B->u[i];
+        for (int b = 0; b < 2; b++) {
+          double P = (a - 1 == b) - u[a - 1] * u[b];
+          cr[1 + b] = P;
+          rhs += P * B->vk[i][b];
+        }
+        own[a] = al;
+        own[0] = al * ci->mu * u[a - 1];
+      } else {
+        cr[a] = 1;
+        rhs = a == 0 ? ci->vn_target : 0;
+      }
+      /* (the combination's rows are contact i's own three) */
+      const int R = 3 * i;
+      x[r] = rhs - (cr[0] * B->v0[R] + cr[1] * B->v0[R + 1] + cr[2] * B->v0[R + 2]);
       for (int j = 0; j < n; j++) {
-        if (!B->kind[j]) continue;
-        double *Ar = A + r * neq + col[j];
-        Ar[0] = B->G[R][3 * j];
-        if (B->kind[j] == 1) {
-          Ar[1] = B->G[R][3 * j + 1];
-          Ar[2] = B->G[R][3 * j + 2];
-        } else {
-          Ar[0] -= B->c[j]->mu * (B->G[R][3 * j + 1] * B->u[j][0] +
-                                  B->G[R][3 * j + 2] * B->u[j][1]);
+        for (int k = 0; k < nun[j]; k++) {
+          double g[3];
+          for (int q = 0; q < 3; q++)
+            g[q] = nun[j] == 3 ? B->G[R + q][3 * j + k]
+                               : B->G[R + q][3 * j] * E[j][0] + B->G[R + q][3 * j + 1] * E[j][1] +
+                                     B->G[R + q][3 * j + 2] * E[j][2];
+          Ar[col[j] + k] = cr[0] * g[0] + cr[1] * g[1] + cr[2] * g[2];
         }
       }
+      for (int k = 0; k < nun[i]; k++) Ar[col[i] + k] += own[k];
     }
   }
-  if (!block_linear(A, x, neq)) return 0;
+  if (!block_linear(A, x, xc, neq)) return 0;
   for (int i = 0; i < n; i++) {
     double *l = nl + 3 * i;
-    if (!B->kind[i]) continue;
-    l[0] = x[col[i]];
-    if (B->kind[i] == 1) {
+    if (nun[i] == 3) {
+      l[0] = x[col[i]];
       l[1] = x[col[i] + 1];
       l[2] = x[col[i] + 2];
-    } else {
-      l[1] = -B->c[i]->mu * l[0] * B->u[i][0];
-      l[2] = -B->c[i]->mu * l[0] * B->u[i][1];
+    } else if (nun[i] == 1) {
+      for (int k = 0; k < 3; k++) l[k] = E[i][k] * x[col[i]];
     }
   }
   return 1;
 }
 
-/* One solve of block B's contacts (B->n and B->c set), every other
- * contact held: the linear system of its contacts' states
- * (block_impulses), starting from the states their impulses show, the
- * states corrected one contact at a time (a loaded contact pulled:
- * unloaded; a sticking one beyond its cone: sliding against that impulse;
- * an unloaded one closing past its target: sticking) until an admissible
- * answer, at most 2n + 2 solves.  Where a pass moves the load between
- * nearly redundant contacts only a little, this solve moves it at once.
- * The pass after it checks the answer and goes on from it (a sliding
- * direction that turned).  Velocities are read and moved through the open
- * group g, or the system's where none is open.  Returns 1 where it
- * applied an answer, its largest change and impulse (1-norms) into *dmax
- * and *lmax. */
-static int block_solve(const ssModel *m, ssData *d, Block *B, Group *g, double *dmax,
-                       double *lmax)
+/* sliding contact i linearised at normal impulse ln and slip vt (its
+ * direction kept where vt is 0) */
+static void block_slide_at(Block *B, int i, double ln, const double vt[2])
+{
+  double s = hypot(vt[0], vt[1]);
+  B->kind[i] = 2;
+  B->vk[i][0] = vt[0];
+  B->vk[i][1] = vt[1];
+  B->sk[i] = s;
+  B->lk[i] = ln > 0 ? ln : 0;
+  if (s > 0) {
+    B->u[i][0] = vt[0] / s;
+    B->u[i][1] = vt[1] / s;
+  }
+}
+
+/* contact i's state from its impulse l and velocity v: sliding where its
+ * tangential impulse lies on its cone */
+static void block_state(Block *B, int i, const double l[3], const double v[3])
+{
+  const ssContact *c = B->c[i];
+  double ln = l[0], lt = hypot(l[1], l[2]);
+  B->u[i][0] = B->u[i][1] = 0;
+  B->sk[i] = B->lk[i] = 0;
+  B->kind[i] = !(ln > 0) ? 0 : lt < c->mu * ln * (1 - 1e-6) ? 1 : 2;
+  if (B->kind[i] != 2) return;
+  /* against its impulse where it has no slip */
+  if (lt > 0) {
+    B->u[i][0] = -l[1] / lt;
+    B->u[i][1] = -l[2] / lt;
+  }
+  block_slide_at(B, i, ln, v + 1);
+}
+
+/* Whether contact i's answer nl (with the block's G and v0) is admissible
+ * in its state, and where it slides also settled (its slip along the
+ * direction the step assumed, its impulse on the cone against it): 1.
+ * -1 where its state is wrong (a loaded contact pulled: unloaded; an
+ * unloaded one closing past its target: sticking; a sticking one beyond
+ * its cone: sliding against that impulse; a sliding one whose slip
+ * stopped or turned back: sticking), the state corrected only where
+ * change is set: one correction a solve, as changed together the states of
+ * redundant contacts cycle.  0 where a sliding contact is linearised
+ * again at its new slip (done). */
+static int block_admissible(Block *B, int i, const double *nl, int change)
+{
+  const ssContact *c = B->c[i];
+  const double *l = nl + 3 * i;
+  double v[3];
+  for (int a = 0; a < 3; a++) {
+    v[a] = B->v0[3 * i + a];
+    for (int j = 0; j < 3 * B->n; j++) v[a] += B->G[3 * i + a][j] * nl[j];
+  }
+  int kind = B->kind[i];
+  double u0 = B->u[i][0], u1 = B->u[i][1];
+  if (kind && !(l[0] >= 0)) {
+    kind = 0;
+  } else if (!kind) {
+    if (v[0] < c->vn_target - 1e-9 * fabs(c->vn_target)) kind = 1;
+  } else if (kind == 1) {
+    double lt = hypot(l[1], l[2]);
+    if (!(lt <= c->mu * l[0] * (1 + 1e-9)) && lt > 0) {
+      kind = 2;
+      u0 = -l[1] / lt;
+      u1 = -l[2] / lt;
+    }
+  } else {
+    double s = hypot(v[1], v[2]), dot = v[1] * u0 + v[2] * u1;
+    if (!(dot > 0)) {
+      kind = 1;
+    } else {
+      double on = fabs(l[1] + c->mu * l[0] * v[1] / s) + fabs(l[2] + c->mu * l[0] * v[2] / s);
+      if (!(dot >= (1 - 1e-12) * s && on <= 1e-9 * (c->mu * l[0]))) {
+        block_slide_at(B, i, l[0], v + 1);
+        return 0;
+      }
+    }
+  }
+  if (kind == B->kind[i]) return 1;
+  if (change) {
+    B->kind[i] = kind;
+    B->u[i][0] = u0;
+    B->u[i][1] = u1;
+    B->sk[i] = B->lk[i] = 0;
+  }
+  return -1;
+}
+
+/* One solve of block B's contacts (B->n and B->c set), every other contact
+ * held: the linear system of their states (block_impulses), from the
+ * states their impulses show, the states corrected and the sliding
+ * contacts linearised again (block_admissible) until an admissible,
+ * settled answer, at most 2n + 8 solves.  Where a pass moves the load
+ * between nearly redundant contacts only a little, this moves it at once;
+ * the pass after it checks the answer.  Velocities are read and moved
+ * through the open group g, or the system's where none is open.  Returns 1
+ * where it applied an answer. */
+static int block_solve(const ssModel *m, ssData *d, Block *B, Group *g)
 {
   const int n = B->n;
   double lam[3 * BLOCK_MAX], v[3 * BLOCK_MAX], nl[3 * BLOCK_MAX];
@@ -1232,7 +1339,7 @@ static int block_solve(const ssModel *m, ssData *d, Block *B, Group *g, double *
     memcpy(lam + 3 * i, B->c[i]->lambda, sizeof B->c[i]->lambda);
     for (int j = 0; j < n; j++) {
       double Gij[9];
-      block_response(m, d, B->c[i], B->c[j], Gij);
+      block_response(d, B->c[i], B->c[j], Gij);
       for (int a = 0; a < 3; a++)
         for (int b = 0; b < 3; b++) B->G[3 * i + a][3 * j + b] = Gij[3 * a + b];
     }
@@ -1241,46 +1348,15 @@ static int block_solve(const ssModel *m, ssData *d, Block *B, Group *g, double *
     B->v0[i] = v[i];
     for (int j = 0; j < 3 * n; j++) B->v0[i] -= B->G[i][j] * lam[j];
   }
-  for (int i = 0; i < n; i++) {
-    const ssContact *c = B->c[i];
-    double ln = c->lambda[0], lt = hypot(c->lambda[1], c->lambda[2]);
-    B->kind[i] = !(ln > 0) ? 0 : lt < c->mu * ln * (1 - 1e-6) ? 1 : 2;
-    B->u[i][0] = B->u[i][1] = 0;
-    if (B->kind[i] != 2) continue;
-    /* the slip direction: the contact's velocity's, or against its
-     * impulse where it has none */
-    double s = hypot(v[3 * i + 1], v[3 * i + 2]);
-    if (s > 0) {
-      B->u[i][0] = v[3 * i + 1] / s;
-      B->u[i][1] = v[3 * i + 2] / s;
-    } else if (lt > 0) {
-      B->u[i][0] = -c->lambda[1] / lt;
-      B->u[i][1] = -c->lambda[2] / lt;
-    }
-  }
+  for (int i = 0; i < n; i++) block_state(B, i, lam + 3 * i, v + 3 * i);
   int ok = 0;
-  for (int round = 0; round < 2 * n + 2 && !ok; round++) {
-    if (!block_impulses(B, nl)) return 0;
+  for (int round = 0; round < 2 * n + 8 && !ok; round++) {
+    if (!block_impulses(B, lam, nl)) return 0;
     ok = 1;
-    for (int i = 0; i < n && ok; i++) {
-      const double *l = nl + 3 * i;
-      double lt = hypot(l[1], l[2]);
-      if (B->kind[i] && !(l[0] >= 0)) {
-        B->kind[i] = 0;
-        ok = 0;
-      } else if (B->kind[i] == 1 && !(lt <= B->c[i]->mu * l[0] * (1 + 1e-9))) {
-        B->kind[i] = 2;
-        B->u[i][0] = -l[1] / lt;
-        B->u[i][1] = -l[2] / lt;
-        ok = 0;
-      } else if (!B->kind[i]) {
-        double vn = B->v0[3 * i];
-        for (int j = 0; j < 3 * n; j++) vn += B->G[3 * i][j] * nl[j];
-        if (vn < B->c[i]->vn_target - 1e-9 * fabs(B->c[i]->vn_target)) {
-          B->kind[i] = 1;
-          ok = 0;
-        }
-      }
+    for (int i = 0, changed = 0; i < n; i++) {
+      int a = block_admissible(B, i, nl, !changed);
+      changed |= a < 0;
+      ok &= a > 0;
     }
   }
   if (!ok) return 0;
@@ -1290,10 +1366,6 @@ static int block_solve(const ssModel *m, ssData *d, Block *B, Group *g, double *
     ss_v3_sub(dl, nl + 3 * i, c->lambda);
     visit_apply(m, d, c, g, 0, dl);
     memcpy(c->lambda, nl + 3 * i, sizeof c->lambda);
-    double dn = fabs(dl[0]) + fabs(dl[1]) + fabs(dl[2]);
-    double ln = fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]);
-    if (dn > *dmax) *dmax = dn;
-    if (ln > *lmax) *lmax = ln;
   }
   return 1;
 }
@@ -1307,9 +1379,8 @@ static void rigid_block(const ssModel *m, ssData *d, int lo, int hi, int back, G
   for (int i = 0; i < B.n; i++) B.c[i] = d->contact + lo + i;
   visit_span(m, d, lo, hi, back, g, dmax, lmax);
   for (int pass = 1; pass < RIGID_PASSES; pass++) {
+    if (pass <= BLOCK_TRIES && B.n) block_solve(m, d, &B, g);
     double dm = 0, lm = 0;
-    if (pass <= BLOCK_TRIES && B.n) block_solve(m, d, &B, g, &dm, &lm);
-    dm = lm = 0;
     back = !back;
     visit_span(m, d, lo, hi, back, g, &dm, &lm);
     if (dm <= tol * lm) break;
