@@ -1051,10 +1051,11 @@ static void visit_span(const ssModel *m, ssData *d, int lo, int hi, int back, Gr
  * steps, tolerance 1e-9, the warm start on): one pass a sweep, 177 sweeps
  * a step over its last 500 steps and 416 of them at the 200-sweep cap;
  * passes alone up to 64, 41 sweeps a step and none capped after its drop.
- * Turning (the rack at 3 cm, 6000 steps): one pass, 172 sweeps a step
- * from 2 s on and three steps in five capped; passes alone, the passes at
- * their cap; with the block's solve, 38-40 sweeps a step and one step in
- * 25 capped (README, Rigid contacts). */
+ * Turning (the rack at 3 cm, 6000 steps): one pass a sweep, every step
+ * from 1 s on at the cap; passes alone, 172 sweeps a step from 2 s on,
+ * three steps in five capped, the passes at their own cap; with the
+ * block's solve, 38-40 sweeps a step and one step in 25 capped (README,
+ * Rigid contacts). */
 enum { RIGID_PASSES = 64, BLOCK_MAX = 16, BLOCK_TRIES = 6 };
 
 /* G_ab, the response of contact a's velocity to contact b's impulse (3 x 3,
