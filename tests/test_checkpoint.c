@@ -199,34 +199,44 @@ static void replay_scene(const char *scene, int N, int K)
   ss_model_free(m);
 }
 
-/* The buggy (a 241 k-vertex bed, four wheels, closures, coil-overs, PD
- * drive) is slow: only N straight against K + restore + N - K. */
-static void test_replay_buggy(void)
+/* N steps straight against K, a checkpoint restored into a fresh data and
+ * N - K more, bit for bit (for slow scenes: without replay's file and
+ * overwrite variants); at K the cache holds at least min_rigid rigid
+ * contacts' entries */
+static void replay_straight(const char *scene, int N, int K, int min_rigid)
 {
   ssModel *m;
   ssData *a;
   ssError e;
-  if (!load_scene("buggy.xml", &m, &a)) {
-    ok(0, "buggy.xml loads");
+  if (!load_scene(scene, &m, &a)) {
+    ok(0, "%s loads", scene);
     return;
   }
   ssData *b = ss_data_new(m), *c = ss_data_new(m);
-  const int N = 100, K = 60;
   size_t len = 0;
   unsigned char *buf = NULL;
   int r = b && c && run(m, a, N) && run(m, b, K) && (buf = snapshot(m, b, &len)) &&
           ss_checkpoint_load_buffer(m, c, buf, len, &e) == SS_OK;
-  ok(r && identical(m, b, c) && b->nwarm > 0,
-     "buggy.xml: checkpoint after %d steps (%zu bytes, %d cached tractions and "
-     "joint rows) restores into a fresh data", K, len, b->nwarm);
+  int rigid = 0;
+  for (int k = 0; r && k < b->nwarm; k++) rigid += b->warm[k].vertex < 0 && b->warm[k].geom >= 0;
+  ok(r && identical(m, b, c) && b->nwarm > 0 && rigid >= min_rigid,
+     "%s: checkpoint after %d steps (%zu bytes, %d cache entries, %d of them rigid "
+     "contacts') restores into a fresh data", scene, K, len, b ? b->nwarm : 0, rigid);
   ok(r && run(m, c, N - K) && identical(m, a, c),
-     "buggy.xml: %d + %d steps after the restore = %d steps straight, bit for bit",
-     K, N - K, N);
+     "%s: %d + %d steps after the restore = %d steps straight, bit for bit", scene, K, N - K,
+     N);
   free(buf);
   ss_data_free(a);
   ss_data_free(b);
   ss_data_free(c);
   ss_model_free(m);
+}
+
+/* The buggy (a 241 k-vertex bed, four wheels, closures, coil-overs, PD
+ * drive) is slow: only N straight against K + restore + N - K. */
+static void test_replay_buggy(void)
+{
+  replay_straight("buggy.xml", 100, 60, 0);
 }
 
 static void test_replay(void)
@@ -668,33 +678,10 @@ static void test_damage(void)
  * flag), is refused. */
 static void test_rigid_cache(void)
 {
-  ssModel *m;
-  ssData *a;
-  ssError e;
-  if (load_scene("buggy_rigid.xml", &m, &a)) {
-    ssData *b = ss_data_new(m), *c = ss_data_new(m);
-    const int N = 600, K = 450;
-    size_t len = 0;
-    unsigned char *buf = NULL;
-    int r = b && c && run(m, a, N) && run(m, b, K) && (buf = snapshot(m, b, &len)) &&
-            ss_checkpoint_load_buffer(m, c, buf, len, &e) == SS_OK;
-    int rigid = 0;
-    for (int k = 0; r && k < b->nwarm; k++) rigid += b->warm[k].vertex < 0 && b->warm[k].geom >= 0;
-    ok(r && identical(m, b, c) && rigid >= 4,
-       "buggy_rigid.xml: checkpoint after %d steps (%d rigid contacts cached) restores", K,
-       rigid);
-    ok(r && run(m, c, N - K) && identical(m, a, c),
-       "buggy_rigid.xml: %d + %d steps after the restore = %d steps straight, bit for bit",
-       K, N - K, N);
-    free(buf);
-    ss_data_free(b);
-    ss_data_free(c);
-    ss_data_free(a);
-    ss_model_free(m);
-  } else {
-    ok(0, "buggy_rigid.xml loads");
-  }
+  replay_straight("buggy_rigid.xml", 600, 450, 4);
 
+  ssModel *m;
+  ssError e;
   /* a soil bed (height map 0) and, off it, a box resting on a ground
    * plane (support nhfield + 0 = 1) */
   m = ss_model_new();

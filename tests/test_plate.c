@@ -430,6 +430,21 @@ static void test_contact_storage(void)
   ss_model_free(m);
 }
 
+/* a 5 kg rubber box, 0.2 x 0.2 x 0.1 m, on the ground at x = 2 sliding
+ * along +x at 3 m/s */
+static void add_slider(ssModel *m, ssError *e)
+{
+  ssBodyDef p = ss_body_def_default();
+  p.name = "slider";
+  p.size[0] = p.size[1] = 0.2;
+  p.size[2] = 0.1;
+  p.mass = 5;
+  p.material = "rubber";
+  ss_v3_set(p.pos, 2, 0, 0.05);
+  p.lin_vel[0] = 3;
+  ss_model_add_body(m, &p, e);
+}
+
 /* rigid ground: rest, friction and restitution from the material pairs */
 static void test_rigid(void)
 {
@@ -445,15 +460,7 @@ static void test_rigid(void)
   b.material = "rubber";
   ss_v3_set(b.pos, 0, 0, 1.1);
   ss_model_add_body(m, &b, &e);
-  ssBodyDef p = ss_body_def_default();
-  p.name = "slider";
-  p.size[0] = p.size[1] = 0.2;
-  p.size[2] = 0.1;
-  p.mass = 5;
-  p.material = "rubber";
-  ss_v3_set(p.pos, 2, 0, 0.05);
-  p.lin_vel[0] = 3;
-  ss_model_add_body(m, &p, &e);
+  add_slider(m, &e);
   ssData *d = ss_data_new(m);
   /* ball falls 1 m: impact at sqrt(2 g) ~ 4.43 m/s, rebounds at e times */
   double vmin = 0, vmax_after = 0;
@@ -551,15 +558,7 @@ static void test_rigid_warm(void)
     ss_quat_from_axis_angle(c.quat, xaxis, M_PI / 2);
     ss_v3_set(c.pos, 0, 2, 0.1);
     ss_model_add_body(m, &c, &e);
-    ssBodyDef s = ss_body_def_default();
-    s.name = "slider";
-    s.size[0] = s.size[1] = 0.2;
-    s.size[2] = 0.1;
-    s.mass = 5;
-    s.material = "rubber";
-    ss_v3_set(s.pos, 2, 0, 0.05);
-    s.lin_vel[0] = 3;
-    ss_model_add_body(m, &s, &e);
+    add_slider(m, &e);
     m->opt.terrain_warm_start = warm;
     ssData *d = ss_data_new(m);
     for (int k = 0; k < 1500 && good; k++) {
