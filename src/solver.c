@@ -1056,7 +1056,7 @@ static void visit_span(const ssModel *m, ssData *d, int lo, int hi, int back, Gr
  * three steps in five capped, the passes at their own cap; with the
  * block's solve, 38-40 sweeps a step and one step in 25 capped (README,
  * Rigid contacts).  A block's solve keeps its arrays on the stack, about
- * 40 KB at BLOCK_MAX. */
+ * 60 KB at BLOCK_MAX. */
 enum { RIGID_PASSES = 64, BLOCK_MAX = 16, BLOCK_TRIES = 6 };
 
 /* G_ab, the response of contact a's velocity to contact b's impulse (3 x 3,
@@ -1474,6 +1474,7 @@ static void system_blocks(const ssModel *m, ssData *d, int first_row, double *dm
     }
     i = k > i ? k : i + 1;
     if (!B.n || ngeom < 2) continue;
+    /* (a system of more than 256 dofs keeps the collider blocks alone) */
     double keep[3 * BLOCK_MAX], *u = d->qvel + c->vadr, u0[256];
     if (c->nv > 256) continue;
     for (int j = 0; j < B.n; j++) memcpy(keep + 3 * j, B.c[j]->lambda, sizeof B.c[j]->lambda);
