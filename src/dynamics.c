@@ -235,6 +235,28 @@ int ss_dyn_check_finite(const ssModel *m, const ssData *d, int *velocity)
   return -1;
 }
 
+static void unit_quat(double q[4])
+{
+  double n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+  if (fabs(n2 - 1) > 1e-12) ss_quat_normalize(q);
+}
+
+void ss_dyn_unit_quats(const ssModel *m, ssData *d)
+{
+  for (int s = 0; s < m->nsys; s++) {
+    if (m->sys_type[s] == SS_SYS_FREE) {
+      unit_quat(d->qpos + m->sys_qadr[s] + 3);
+      continue;
+    }
+    for (int b = m->sys_bodyadr[s]; b < m->sys_bodyadr[s] + m->sys_nbody[s]; b++) {
+      if (m->body_qadr[b] < 0) continue;
+      double *q = d->qpos + m->body_qadr[b];
+      if (m->body_jnttype[b] == SS_JOINT_SPHERICAL) unit_quat(q);
+      else if (m->body_jnttype[b] == SS_JOINT_FLOATING) unit_quat(q + 3);
+    }
+  }
+}
+
 int ss_dyn_check_state(const ssModel *m, const ssData *d, char *msg, size_t cap)
 {
   int vel, s = ss_dyn_check_finite(m, d, &vel);

@@ -55,5 +55,11 @@ int ss_dyn_check_finite(const ssModel *m, const ssData *d, int *velocity);
  * else 0 with what is wrong in msg ("the velocity of 'ball' is non-finite
  * or above 1e5 (m/s or rad/s)"). */
 int ss_dyn_check_state(const ssModel *m, const ssData *d, char *msg, size_t cap);
+/* Every quaternion in qpos (free bodies; articulated floating and
+ * spherical joints) made unit where its squared length is off 1 by more
+ * than 1e-12, as MuJoCo's step does: a caller may write one between steps
+ * that is not (a zero one becomes the identity).  Those a step leaves are
+ * unit to round-off and are left alone, bit for bit. */
+void ss_dyn_unit_quats(const ssModel *m, ssData *d);
 
 #endif

@@ -442,7 +442,9 @@ typedef struct ssData {
   int in_step;            /* 1 while ss_step runs: state setters refuse */
 
   double *qpos;           /* (nq) free body: COM position (3), quat (4,
-                             unit, w x y z); finite, or a step refuses it */
+                             w x y z); finite, or a step refuses it; a
+                             step makes a quaternion written here unit
+                             first (a zero one the identity) */
   double *qvel;           /* (nv) free body: lin vel (3), ang vel (3), world;
                              each within SS_SPEED_MAX, or a step refuses it */
   unsigned char *sys_active; /* (nsys) 0 once removed from the world */

@@ -37,6 +37,9 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
   if (!saved) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
   if (m->nq) memcpy(saved, d->qpos, (size_t)m->nq * sizeof(double));
   if (m->nv) memcpy(saved + m->nq, d->qvel, (size_t)m->nv * sizeof(double));
+  /* a quaternion written between steps made unit (after the copy: a step
+   * that fails leaves it as it was written) */
+  ss_dyn_unit_quats(m, d);
   double closure0 = d->closure_error;
   ssStepStats stats0 = d->stats;
   d->in_step = 1;

@@ -634,6 +634,76 @@ static void test_rigid_mix(void)
   ss_model_free(m);
 }
 
+/* A quaternion written into qpos between steps is made unit by the next
+ * step (dynamics.h, ss_dyn_unit_quats), as MuJoCo's step does: a free
+ * box's quaternion written three times too long steps as the unit one
+ * (to round-off), a zero one as the identity, and the buggy's floating
+ * chassis written twice too long as its unit one.  Before, a free body's
+ * first step formed its frame and inertia from the long quaternion (no
+ * rotation: 4e-4 apart after one step) and a zero one lost the step's
+ * turn; the articulated kinematics normalised already. */
+static void test_unit_quats(void)
+{
+  ssError e;
+  ssModel *m = ss_model_new();
+  ssBodyDef b = ss_body_def_default();
+  b.name = "box";
+  b.size[0] = 0.4;
+  b.size[1] = 0.3;
+  b.size[2] = 0.1;
+  b.mass = 5;
+  ss_v3_set(b.pos, 0, 0, 2);
+  b.ang_vel[0] = 1;
+  ss_model_add_body(m, &b, &e);
+  ssData *a = ss_data_new(m), *c = ss_data_new(m), *z = ss_data_new(m);
+  double q[4] = {1, 0.2, -0.1, 0.3};
+  ss_quat_normalize(q);
+  for (int k = 0; k < 4; k++) {
+    a->qpos[3 + k] = q[k];
+    c->qpos[3 + k] = 3 * q[k];
+    z->qpos[3 + k] = 0;
+  }
+  int good = ss_step(m, a, &e) == SS_OK && ss_step(m, c, &e) == SS_OK &&
+             ss_step(m, z, &e) == SS_OK;
+  double dq = 0, n2 = 0;
+  for (int k = 0; k < 7 && good; k++) dq = fmax(dq, fabs(c->qpos[k] - a->qpos[k]));
+  for (int k = 3; k < 7 && good; k++) n2 += c->qpos[k] * c->qpos[k];
+  ok(good && dq < 1e-14 && fabs(n2 - 1) < 1e-14,
+     "a free box's quaternion written 3 times too long steps as the unit one (%.2g apart)", dq);
+  /* from the identity, turned by its 1 rad/s about x over the step */
+  double h = 0.5 * m->opt.timestep;
+  ok(good && fabs(z->qpos[3] - cos(h)) < 1e-15 && fabs(z->qpos[4] - sin(h)) < 1e-15 &&
+         z->qpos[5] == 0 && z->qpos[6] == 0,
+     "  a zero one as the identity (%.17g %.3g %g %g after the step)", z->qpos[3], z->qpos[4],
+     z->qpos[5], z->qpos[6]);
+  ss_data_free(a);
+  ss_data_free(c);
+  ss_data_free(z);
+  ss_model_free(m);
+
+  ssData *d1, *d2;
+  ssModel *mb, *mb2;
+  if (!load_scene_file("scenes/buggy_rigid.xml", &mb, &d1) ||
+      !load_scene_file("scenes/buggy_rigid.xml", &mb2, &d2)) {
+    ok(0, "scenes/buggy_rigid.xml loads");
+    return;
+  }
+  int root = mb->sys_bodyadr[0], qa = mb->body_qadr[root];
+  int floating = mb->body_jnttype[root] == SS_JOINT_FLOATING;
+  for (int k = 3; k < 7 && floating; k++) d2->qpos[qa + k] *= 2;
+  good = floating;
+  for (int s = 0; s < 50 && good; s++)
+    good = ss_step(mb, d1, &e) == SS_OK && ss_step(mb2, d2, &e) == SS_OK;
+  dq = 0;
+  for (int k = 0; k < mb->nq && good; k++) dq = fmax(dq, fabs(d2->qpos[k] - d1->qpos[k]));
+  ok(good && dq < 1e-12, "  the buggy's floating chassis written twice too long: 50 steps as "
+     "from the unit one (%.2g apart)", dq);
+  ss_data_free(d1);
+  ss_data_free(d2);
+  ss_model_free(mb);
+  ss_model_free(mb2);
+}
+
 /* the cache entry with e's key, or NULL */
 static const ssWarmEntry *warm_find(const ssWarmEntry *w, int n, const ssWarmEntry *e)
 {
@@ -1044,6 +1114,7 @@ int main(void)
   test_rigid();
   test_rigid_warm();
   test_rigid_mix();
+  test_unit_quats();
   test_reach();
   test_contact_storage();
   test_warm_trend();
