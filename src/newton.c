@@ -1293,9 +1293,9 @@ static void newton_matrix(const Setup *s, ssNewtonWork *w, const double *H)
   }
 }
 
-/* lu_factor's pivot of column k: the row below k with the largest
+/* ss_lu_factor's pivot of column k: the row below k with the largest
  * |A_ik| swapped into row k, whole (multipliers included); 0 if that
- * column is zero there (singular).  (Inlined into lu_factor's two
+ * column is zero there (singular).  (Inlined into ss_lu_factor's two
  * places: about 1 k instructions a buggy step in calls.) */
 static inline __attribute__((always_inline)) int lu_pivot(double *A, int *piv, int n, int k)
 {
@@ -1370,7 +1370,7 @@ static void lu_row_steps2(double *y, double f, double g, const double *x, const 
 
 /* a, b, c and d all nonzero, or else 0 where that is not sure: their
  * product is 0 or NaN where one is 0 (and NaN where one is NaN), and is
- * 0 where all are nonzero only by underflow (|p| > 0: neither).  lu_factor's pair of rows
+ * 0 where all are nonzero only by underflow (|p| > 0: neither).  ss_lu_factor's pair of rows
  * takes its two-row pass only where this holds, else the row by row
  * updates, which skip a zero multiplier's and give each entry the same
  * operations otherwise: one product test instead of four compares, each
@@ -1391,7 +1391,7 @@ static inline int all_nonzero4(double a, double b, double c, double d)
  * same order, each skipped where its multiplier is 0 as there: the same
  * factors, bit for bit, with one load and store of an entry for two
  * steps. */
-static int lu_factor(double *A, int *piv, int n)
+int ss_lu_factor(double *A, int *piv, int n)
 {
   int k = 0;
   for (; k + 1 < n; k += 2) {
@@ -1431,7 +1431,7 @@ static int lu_factor(double *A, int *piv, int n)
   return k == n || lu_pivot(A, piv, n, k);
 }
 
-static void lu_solve(const double *A, const int *piv, int n, double *x)
+void ss_lu_solve(const double *A, const int *piv, int n, double *x)
 {
   /* the factor's rows were swapped whole, multipliers included: all the
    * swaps first, then the substitutions */
@@ -2071,7 +2071,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     }
     it++;
     newton_matrix(&s, w, w->H);
-    if (!lu_factor(w->A, w->piv, n)) {
+    if (!ss_lu_factor(w->A, w->piv, n)) {
       stalled = 1;
       continue;
     }
@@ -2084,7 +2084,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
       }
       w->dy[a] = t;
     }
-    lu_solve(w->A, w->piv, n, w->dy);
+    ss_lu_solve(w->A, w->piv, n, w->dy);
     for (int k = 0; k < w->ns; k++) {
       int i = w->imp[k];
       double dV[6];

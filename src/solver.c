@@ -1098,14 +1098,14 @@ static void block_response(const ssData *d, const ssContact *a, const ssContact 
     }
 }
 
-/* Solves the n x n system A x = b in place (row-major, n <= 3 BLOCK_MAX)
- * by elimination with partial pivoting, regularised towards xc: (A + e I)
- * x = b + e xc, e 1e-10 of A's largest diagonal entry.  A block's contacts
- * may be exactly redundant (four corners of a box on the ground hold six
- * motions with twelve rows): of the answers then, the one nearest the
- * impulses it starts from, so that a block already solved stays as it is
- * (a pass after it changes nothing).  0 where a pivot vanishes or the
- * answer is not finite. */
+/* Solves the n x n system A x = b in place (row-major, n <= 3 BLOCK_MAX),
+ * regularised towards xc: (A + e I) x = b + e xc, e 1e-10 of A's largest
+ * diagonal entry, by the Newton phase's LU (ss_lu_factor).  A block's
+ * contacts may be exactly redundant (four corners of a box on the ground
+ * hold six motions with twelve rows): of the answers then, the one nearest
+ * the impulses it starts from, so that a block already solved stays as it
+ * is (a pass after it changes nothing).  0 where a pivot falls below 1e-14
+ * of that diagonal entry or the answer is not finite. */
 static int block_linear(double *A, double *b, const double *xc, int n)
 {
   double s = 0;
@@ -1115,34 +1115,13 @@ static int block_linear(double *A, double *b, const double *xc, int n)
     A[i * n + i] += 1e-10 * s;
     b[i] += 1e-10 * s * xc[i];
   }
-  for (int k = 0; k < n; k++) {
-    int p = k;
-    for (int i = k + 1; i < n; i++)
-      if (fabs(A[i * n + k]) > fabs(A[p * n + k])) p = i;
-    if (!(fabs(A[p * n + k]) > 1e-14 * s)) return 0;
-    if (p != k) {
-      for (int j = 0; j < n; j++) {
-        double t = A[k * n + j];
-        A[k * n + j] = A[p * n + j];
-        A[p * n + j] = t;
-      }
-      double t = b[k];
-      b[k] = b[p];
-      b[p] = t;
-    }
-    for (int i = k + 1; i < n; i++) {
-      double f = A[i * n + k] / A[k * n + k];
-      if (f == 0) continue;
-      for (int j = k; j < n; j++) A[i * n + j] -= f * A[k * n + j];
-      b[i] -= f * b[k];
-    }
-  }
-  for (int k = n - 1; k >= 0; k--) {
-    double r = b[k];
-    for (int j = k + 1; j < n; j++) r -= A[k * n + j] * b[j];
-    b[k] = r / A[k * n + k];
+  int piv[3 * BLOCK_MAX];
+  if (!ss_lu_factor(A, piv, n)) return 0;
+  for (int k = 0; k < n; k++)
+    if (!(fabs(A[k * n + k]) > 1e-14 * s)) return 0;
+  ss_lu_solve(A, piv, n, b);
+  for (int k = 0; k < n; k++)
     if (!isfinite(b[k])) return 0;
-  }
   return 1;
 }
 

@@ -272,6 +272,13 @@ const double *ss_newton_law(const ssData *d);
 void ss_newton_keep(ssData *d);
 void ss_newton_work_free(ssNewtonWork *w);
 
+/* Dense LU with partial pivoting of the n x n matrix A (row-major), in
+ * place, the row swaps in piv; 0 where a column has no nonzero pivot left
+ * (singular).  Then x <- A^-1 x from the factors.  (newton.c: the Newton
+ * phase's matrix and the rigid blocks' systems, solver.c.) */
+int ss_lu_factor(double *A, int *piv, int n);
+void ss_lu_solve(const double *A, const int *piv, int n, double *x);
+
 /* Each soil bed's table of s^(n-1) (ss_math.h's ssPowTable in
  * d->hfield_pow), formed again wherever its material's exponent is not
  * the one it was formed for; before each step's contacts (step.c).  The
