@@ -366,6 +366,18 @@ typedef struct WarmApply {
   BodyRun br;
 } WarmApply;
 
+/* the tangential impulse (t0, t1) scaled back into the disc of radius lim
+ * where it lies outside (a warm start's projection into its bound) */
+static inline void disc_clip(double *t0, double *t1, double lim)
+{
+  double mag = sqrt(*t0 * *t0 + *t1 * *t1);
+  if (mag > lim) {
+    double s = lim / mag;
+    *t0 *= s;
+    *t1 *= s;
+  }
+}
+
 /* soil point c's warm impulse from its cache entry e (with the creeping
  * colliders' rates or without) into lam; dt the time step, mats the beds'
  * soils (m->hfield_soilmat) */
@@ -382,12 +394,7 @@ warm_soil_impulse(const ssSoilMaterial *mats, double dt, const ssContact *c,
   /* the bound at zero slip as the laws form it (point.c, newton.c):
    * A dt c + mu lambda_n, the strength tau_f(p_n) times A dt */
   const ssSoilMaterial *mat = &mats[c->hfield];
-  double lim = scale * mat->cohesion + mat->friction_coefficient * ln;
-  double mag = sqrt(lt0 * lt0 + lt1 * lt1);
-  if (mag > lim) {
-    lt0 *= lim / mag;
-    lt1 *= lim / mag;
-  }
+  disc_clip(&lt0, &lt1, scale * mat->cohesion + mat->friction_coefficient * ln);
   lam[0] = ln;
   lam[1] = lt0;
   lam[2] = lt1;
@@ -401,12 +408,7 @@ static void rigid_warm_impulse(const ssContact *c, const ssWarmEntry *e, double 
 {
   double ln = e->traction[0] > 0 ? e->traction[0] * dt : 0;
   double lt0 = e->traction[1] * dt, lt1 = e->traction[2] * dt;
-  double lim = c->mu * ln, mag = sqrt(lt0 * lt0 + lt1 * lt1);
-  if (mag > lim) {
-    double s = mag > 0 ? lim / mag : 0;
-    lt0 *= s;
-    lt1 *= s;
-  }
+  disc_clip(&lt0, &lt1, c->mu * ln);
   lam[0] = ln;
   lam[1] = lt0;
   lam[2] = lt1;
@@ -934,6 +936,17 @@ static inline void visit_apply(const ssModel *m, ssData *d, ssContact *c, Group 
   }
 }
 
+/* the sweeps' measure: a contact's change dl and impulse l (1-norms) into
+ * the largest so far */
+static inline void measure_add(const double dl[3], const double l[3], double *dmax,
+                               double *lmax)
+{
+  double dn = fabs(dl[0]) + fabs(dl[1]) + fabs(dl[2]);
+  double ln = fabs(l[0]) + fabs(l[1]) + fabs(l[2]);
+  if (dn > *dmax) *dmax = dn;
+  if (ln > *lmax) *lmax = ln;
+}
+
 static void visit(const ssModel *m, ssData *d, ssContact *c, Group *g,
                   double *dmax, double *lmax)
 {
@@ -955,10 +968,7 @@ static void visit(const ssModel *m, ssData *d, ssContact *c, Group *g,
   double dl[3];
   ss_v3_sub(dl, c->lambda, old);
   visit_apply(m, d, c, g, row, dl);
-  double dn = fabs(dl[0]) + fabs(dl[1]) + fabs(dl[2]);
-  double ln = fabs(c->lambda[0]) + fabs(c->lambda[1]) + fabs(c->lambda[2]);
-  if (dn > *dmax) *dmax = dn;
-  if (ln > *lmax) *lmax = ln;
+  measure_add(dl, c->lambda, dmax, lmax);
 }
 
 /* contact c's end-of-step velocity v kept, and whether it is loaded (a
@@ -1391,17 +1401,18 @@ static double rigid_residual(const ssModel *m, ssData *d, ssContact *const *cs, 
 {
   double dmax = 0, lmax = 0;
   for (int i = 0; i < n; i++) {
-    ssContact c = *cs[i];
-    double v[3], v0[3];
-    contact_velocity(m, d, &c, v);
-    ss_m3_mulv(v0, c.G, c.lambda);
+    ssContact *c = cs[i];
+    double v[3], v0[3], old[3], dl[3];
+    contact_velocity(m, d, c, v);
+    ss_m3_mulv(v0, c->G, c->lambda);
     ss_v3_sub(v0, v, v0);
-    ss_point_rigid(&c, v0, m->opt.scalar_tolerance);
-    double dn = fabs(c.lambda[0] - cs[i]->lambda[0]) + fabs(c.lambda[1] - cs[i]->lambda[1]) +
-                fabs(c.lambda[2] - cs[i]->lambda[2]);
-    double ln = fabs(c.lambda[0]) + fabs(c.lambda[1]) + fabs(c.lambda[2]);
-    dmax = fmax(dmax, dn);
-    lmax = fmax(lmax, ln);
+    /* the law's answer taken and the impulse put back (ss_point_rigid
+     * writes only the impulse) */
+    memcpy(old, c->lambda, sizeof old);
+    ss_point_rigid(c, v0, m->opt.scalar_tolerance);
+    ss_v3_sub(dl, c->lambda, old);
+    measure_add(dl, c->lambda, &dmax, &lmax);
+    memcpy(c->lambda, old, sizeof old);
   }
   return lmax > 0 ? dmax / lmax : 0;
 }
@@ -1467,11 +1478,9 @@ static void system_blocks(const ssModel *m, ssData *d, int first_row, double *dm
       continue;
     }
     for (int j = 0; j < B.n; j++) {
-      double dn = fabs(B.c[j]->lambda[0] - keep[3 * j]) + fabs(B.c[j]->lambda[1] - keep[3 * j + 1]) +
-                  fabs(B.c[j]->lambda[2] - keep[3 * j + 2]);
-      double ln = fabs(B.c[j]->lambda[0]) + fabs(B.c[j]->lambda[1]) + fabs(B.c[j]->lambda[2]);
-      *dmax = fmax(*dmax, dn);
-      *lmax = fmax(*lmax, ln);
+      double dl[3];
+      ss_v3_sub(dl, B.c[j]->lambda, keep + 3 * j);
+      measure_add(dl, B.c[j]->lambda, dmax, lmax);
     }
   }
 }
