@@ -430,6 +430,28 @@ static void test_contact_storage(void)
   ss_model_free(m);
 }
 
+/* a model with a steel ground plane at z = 0, rubber on steel at friction
+ * 0.5 and the given restitution above its threshold speed */
+static ssModel *steel_ground(double restitution, double threshold, ssError *e)
+{
+  ssModel *m = ss_model_new();
+  ss_model_add_plane(m, "ground", 0, "steel", 0, e);
+  ss_model_set_pair(m, "steel", "rubber", 0.5, restitution, threshold, e);
+  return m;
+}
+
+/* a 5 kg box named "box", 0.4 x 0.3 x 0.1 m, at the origin */
+static ssBodyDef box_def(void)
+{
+  ssBodyDef b = ss_body_def_default();
+  b.name = "box";
+  b.size[0] = 0.4;
+  b.size[1] = 0.3;
+  b.size[2] = 0.1;
+  b.mass = 5;
+  return b;
+}
+
 /* a 5 kg rubber box, 0.2 x 0.2 x 0.1 m, on the ground at x = 2 sliding
  * along +x at 3 m/s */
 static void add_slider(ssModel *m, ssError *e)
@@ -449,9 +471,7 @@ static void add_slider(ssModel *m, ssError *e)
 static void test_rigid(void)
 {
   ssError e;
-  ssModel *m = ss_model_new();
-  ss_model_add_plane(m, "ground", 0, "steel", 0, &e);
-  ss_model_set_pair(m, "steel", "rubber", 0.5, 0.5, 0.01, &e);
+  ssModel *m = steel_ground(0.5, 0.01, &e);
   ssBodyDef b = ss_body_def_default();
   b.name = "ball";
   b.shape = SS_GEOM_SPHERE;
@@ -535,15 +555,8 @@ static void test_rigid_warm(void)
   int ones[2] = {0, 0}, nq = 0, good = 1;
   for (int warm = 1; warm >= 0; warm--) {
     ssError e;
-    ssModel *m = ss_model_new();
-    ss_model_add_plane(m, "ground", 0, "steel", 0, &e);
-    ss_model_set_pair(m, "steel", "rubber", 0.5, 0, 0, &e);
-    ssBodyDef b = ss_body_def_default();
-    b.name = "box";
-    b.size[0] = 0.4;
-    b.size[1] = 0.3;
-    b.size[2] = 0.1;
-    b.mass = 5;
+    ssModel *m = steel_ground(0, 0, &e);
+    ssBodyDef b = box_def();
     b.material = "rubber";
     ss_v3_set(b.pos, 0, 0, 0.05);
     ss_model_add_body(m, &b, &e);
@@ -646,12 +659,7 @@ static void test_unit_quats(void)
 {
   ssError e;
   ssModel *m = ss_model_new();
-  ssBodyDef b = ss_body_def_default();
-  b.name = "box";
-  b.size[0] = 0.4;
-  b.size[1] = 0.3;
-  b.size[2] = 0.1;
-  b.mass = 5;
+  ssBodyDef b = box_def();
   ss_v3_set(b.pos, 0, 0, 2);
   b.ang_vel[0] = 1;
   ss_model_add_body(m, &b, &e);
