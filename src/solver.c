@@ -815,6 +815,14 @@ store_entries(const ssModel *m, const ssData *d, ssWarmEntry *next, const double
       e->traction[1] = e->traction[2] = 0;
       e->rate[0] = e->rate[1] = e->rate[2] = 0;
     }
+    /* an impulse over a tiny step can overflow as a force (a heavy body's
+     * impact at dt = 1e-300): no start is better than an infinite one,
+     * which the next step could not use nor a checkpoint hold */
+    if (!(isfinite(e->traction[0]) && isfinite(e->traction[1]) && isfinite(e->traction[2]) &&
+          isfinite(e->rate[0]) && isfinite(e->rate[1]) && isfinite(e->rate[2]))) {
+      end--;
+      continue;
+    }
     e->vertex = vertex;
     e->geom = geom;
     uint64_t key = warm_key(geom, vertex);
