@@ -532,20 +532,28 @@ static int parse_args(int argc, char **argv, Options *o)
 /* checks made before the first step                                       */
 
 /* An output file must be replaceable: not a folder, and its folder must
- * take a new file (the atomic writer creates its temporary file there). */
-static ssStatus check_output(const char *path, const char *flag, ssError *err)
+ * take a new file (the atomic writer creates its temporary file there).
+ * open_output opens it (the --csv rows are written as the run goes);
+ * check_output only tries, for the outputs written at the end. */
+static ssStatus open_output(ssAtomicFile *f, const char *path, const char *flag, ssError *err)
 {
   struct stat st;
   if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
     return ss_error_set(err, SS_ERR_IO, path, 0,
                         "%s: cannot write: is a directory", flag);
-  ssAtomicFile f;
   ssError e;
   ss_error_clear(&e);
-  if (ss_atomic_open(&f, path, &e) != SS_OK)
+  if (ss_atomic_open(f, path, &e) != SS_OK)
     return ss_error_set(err, SS_ERR_IO, path, 0, "%s: %s", flag, e.message);
-  ss_atomic_abort(&f);
   return SS_OK;
+}
+
+static ssStatus check_output(const char *path, const char *flag, ssError *err)
+{
+  ssAtomicFile f;
+  ssStatus st = open_output(&f, path, flag, err);
+  if (st == SS_OK) ss_atomic_abort(&f);
+  return st;
 }
 
 /* mkdir -p: create dir and its missing parents. */
@@ -922,10 +930,8 @@ static int run(const Options *o)
     }
   }
   if (o->csv_path) {
-    /* the same test and message as the other outputs' (check_output) */
-    if (check_output(o->csv_path, "--csv", &err) != SS_OK ||
-        ss_atomic_open(&csv, o->csv_path, &err) != SS_OK)
-      goto fail;
+    /* opened at once, with the other outputs' tests and messages */
+    if (open_output(&csv, o->csv_path, "--csv", &err) != SS_OK) goto fail;
     csv_open = 1;
     csv_header((FILE *)csv.fp, m);
   }
