@@ -1149,7 +1149,9 @@ static int block_linear(double *A, double *b, const double *xc, int n)
  * tangential impulse on the cone against its slip (-mu lambda_n v_t /
  * |v_t|) linearised about the slip vk (speed sk, direction u) and the
  * normal impulse lk of the last answer, or, where sk or lk is 0, held
- * along -u. */
+ * along -u; 3 a PD row (system_blocks), one unknown within its effort
+ * bound, lambda + b v = a (pd_row), its second and third rows and columns
+ * of G zero. */
 typedef struct Block {
   int n;
   ssContact *c[BLOCK_MAX];
@@ -1173,6 +1175,7 @@ static inline int block_unknowns(const Block *B, int i)
 {
   if (!B->kind[i]) return 0;
   if (B->kind[i] == 1) return 3;
+  if (B->kind[i] == 3) return 1;
   return B->sk[i] > 0 && B->lk[i] > 0 && B->c[i]->mu > 0 ? 3 : 1;
 }
 
@@ -1210,7 +1213,12 @@ static int block_impulses(const Block *B, const double *lam, double nl[3 * BLOCK
     for (int a = 0; a < nun[i]; a++) {
       int r = col[i] + a;
       double *Ar = A + r * neq, cr[3] = {0, 0, 0}, own[3] = {0, 0, 0}, rhs = 0;
-      if (B->kind[i] == 2 && a > 0) {
+      if (B->kind[i] == 3) {
+        /* lambda + b v = a */
+        cr[0] = ci->row_b;
+        own[0] = 1;
+        rhs = ci->row_a;
+      } else if (B->kind[i] == 2 && a > 0) {
         double al = B->sk[i] / (ci->mu * B->lk[i]);
         const double *u = B->u[i];
         for (int b = 0; b < 2; b++) {
@@ -1278,6 +1286,10 @@ static void block_state(Block *B, int i, const double l[3], const double v[3])
   double ln = l[0], lt = hypot(l[1], l[2]);
   B->u[i][0] = B->u[i][1] = 0;
   B->sk[i] = B->lk[i] = 0;
+  if (c->type == SS_CONTACT_PD) {
+    B->kind[i] = 3;
+    return;
+  }
   B->kind[i] = !(ln > 0) ? 0 : lt < c->mu * ln * (1 - 1e-6) ? 1 : 2;
   if (B->kind[i] != 2) return;
   /* against its impulse where it has no slip */
@@ -1298,11 +1310,13 @@ static void block_state(Block *B, int i, const double l[3], const double v[3])
  * contact pulled: unloaded; an unloaded one closing past its target:
  * sticking; a sticking one beyond its cone: sliding against that impulse;
  * a sliding one whose slip stopped or turned back: sticking).  0 where a
- * sliding contact is linearised again at its new slip (done). */
+ * sliding contact is linearised again at its new slip (done).  -2 for a PD
+ * row past its effort bound: the solve has no state for it. */
 static int block_admissible(Block *B, int i, const double *nl, Fix *f)
 {
   const ssContact *c = B->c[i];
   const double *l = nl + 3 * i;
+  if (B->kind[i] == 3) return fabs(l[0]) < c->row_bound ? 1 : -2;
   double v[3];
   for (int a = 0; a < 3; a++) {
     v[a] = B->v0[3 * i + a];
@@ -1351,6 +1365,43 @@ static int block_admissible(Block *B, int i, const double *nl, Fix *f)
   return kind == B->kind[i] ? 1 : -1;
 }
 
+/* The responses that involve block B's PD rows (row[i] set; system_blocks,
+ * outside any group) into B->G, by trial: an impulse on each row that
+ * changes its own velocity by about 1 (1 / G, its own response) applied to
+ * the system's velocity, every member's velocity read against v (theirs
+ * now), the velocity then put back bit for bit.  That column also gives
+ * the row's line: the response is symmetric (J M^-1 J^T; the two agree to
+ * round-off in the velocities, 1e-7 of the smallest entries, 3e-8, on
+ * the turning buggy).  The rows' responses to one another are not formed
+ * anywhere else, nor a row's to a link's contact.  0 where the system has
+ * more than 256 dofs. */
+static int block_row_responses(const ssModel *m, ssData *d, Block *B, const int *row,
+                               const double *v)
+{
+  const int n = B->n;
+  const ssContact *c0 = B->c[0];
+  double *u = d->qvel + c0->vadr, keep[256];
+  Group none = {NULL, NULL, NULL, {0}, {0}, {0}};
+  if (c0->nv > 256) return 0;
+  memcpy(keep, u, (size_t)c0->nv * sizeof(double));
+  for (int r = 0; r < n; r++) {
+    if (!row[r]) continue;
+    double s = B->c[r]->G[0] > 0 ? 1 / B->c[r]->G[0] : 1;
+    row_apply(d, B->c[r], s);
+    for (int i = 0; i < n; i++) {
+      double w[3];
+      visit_velocity(m, d, B->c[i], &none, row[i], w);
+      for (int a = 0; a < 3; a++) {
+        double gi = row[i] && a ? 0 : (w[a] - v[3 * i + a]) / s;
+        B->G[3 * i + a][3 * r] = gi;
+        if (!row[i]) B->G[3 * r][3 * i + a] = gi;
+      }
+    }
+    memcpy(u, keep, (size_t)c0->nv * sizeof(double));
+  }
+  return 1;
+}
+
 /* One solve of block B's contacts (B->n and B->c set), every other contact
  * held: the linear system of their states (block_impulses), from the
  * states their impulses show, the states corrected and the sliding
@@ -1373,10 +1424,13 @@ static int block_solve(const ssModel *m, ssData *d, Block *B, Group *g)
   const int n = B->n;
   double lam[3 * BLOCK_MAX], v[3 * BLOCK_MAX], nl[3 * BLOCK_MAX];
   enum { LINKS = 8 };
-  int links[LINKS], nlinks = 0, li[BLOCK_MAX];
+  int links[LINKS], nlinks = 0, li[BLOCK_MAX], row[BLOCK_MAX], nrow = 0;
   double P[LINKS * LINKS][36];
   unsigned char have[LINKS * LINKS] = {0};
   for (int i = 0; i < n; i++) {
+    row[i] = B->c[i]->type == SS_CONTACT_PD;
+    nrow += row[i];
+    if (row[i]) continue;
     int k = 0;
     while (k < nlinks && links[k] != B->c[i]->link) k++;
     if (k == nlinks) {
@@ -1386,22 +1440,26 @@ static int block_solve(const ssModel *m, ssData *d, Block *B, Group *g)
     li[i] = k;
   }
   for (int i = 0; i < n; i++) {
-    visit_velocity(m, d, B->c[i], g, 0, v + 3 * i);
+    visit_velocity(m, d, B->c[i], g, row[i], v + 3 * i);
     memcpy(lam + 3 * i, B->c[i]->lambda, sizeof B->c[i]->lambda);
     for (int j = 0; j < n; j++) {
-      double Gij[9];
-      const double *Pij = NULL;
-      if (B->c[i]->link >= 0 && li[i] != li[j]) {
-        int q = li[i] * LINKS + li[j];
-        if (!have[q]) ss_art_link_pair(m, d, links[li[i]], links[li[j]], P[q], 6);
-        have[q] = 1;
-        Pij = P[q];
+      /* (a row's entries: block_row_responses) */
+      double Gij[9] = {0};
+      if (!row[i] && !row[j]) {
+        const double *Pij = NULL;
+        if (B->c[i]->link >= 0 && li[i] != li[j]) {
+          int q = li[i] * LINKS + li[j];
+          if (!have[q]) ss_art_link_pair(m, d, links[li[i]], links[li[j]], P[q], 6);
+          have[q] = 1;
+          Pij = P[q];
+        }
+        block_response(d, B->c[i], B->c[j], Pij, Gij);
       }
-      block_response(d, B->c[i], B->c[j], Pij, Gij);
       for (int a = 0; a < 3; a++)
         for (int b = 0; b < 3; b++) B->G[3 * i + a][3 * j + b] = Gij[3 * a + b];
     }
   }
+  if (nrow && !block_row_responses(m, d, B, row, v)) return 0;
   for (int i = 0; i < 3 * n; i++) {
     B->v0[i] = v[i];
     for (int j = 0; j < 3 * n; j++) B->v0[i] -= B->G[i][j] * lam[j];
@@ -1423,6 +1481,7 @@ static int block_solve(const ssModel *m, ssData *d, Block *B, Group *g)
     for (int i = 0; i < n; i++) {
       Fix f;
       int a = block_admissible(B, i, nl, &f);
+      if (a == -2) return 0;
       ok &= a > 0;
       if (a >= 0) continue;
       int k = nfix++;
@@ -1453,7 +1512,7 @@ static int block_solve(const ssModel *m, ssData *d, Block *B, Group *g)
     ssContact *c = B->c[i];
     double dl[3];
     ss_v3_sub(dl, nl + 3 * i, c->lambda);
-    visit_apply(m, d, c, g, 0, dl);
+    visit_apply(m, d, c, g, row[i], dl);
     memcpy(c->lambda, nl + 3 * i, sizeof c->lambda);
   }
   return 1;
@@ -1467,14 +1526,15 @@ static double rigid_residual(const ssModel *m, ssData *d, ssContact *const *cs, 
   double dmax = 0, lmax = 0;
   for (int i = 0; i < n; i++) {
     ssContact *c = cs[i];
-    double v[3], v0[3], old[3], dl[3];
-    contact_velocity(m, d, c, v);
+    double v[3] = {0, 0, 0}, v0[3], old[3], dl[3];
+    int row = c->type == SS_CONTACT_PD;
+    if (row) v[0] = row_velocity(d, c);
+    else contact_velocity(m, d, c, v);
     ss_m3_mulv(v0, c->G, c->lambda);
     ss_v3_sub(v0, v, v0);
-    /* the law's answer taken and the impulse put back (ss_point_rigid
-     * writes only the impulse) */
     memcpy(old, c->lambda, sizeof old);
-    ss_point_rigid(c, v0, m->opt.scalar_tolerance);
+    if (row) pd_row(c, v0);
+    else ss_point_rigid(c, v0, m->opt.scalar_tolerance);
     ss_v3_sub(dl, c->lambda, old);
     measure_add(dl, c->lambda, &dmax, &lmax);
     memcpy(c->lambda, old, sizeof old);
@@ -1485,7 +1545,8 @@ static double rigid_residual(const ssModel *m, ssData *d, ssContact *const *cs, 
 /* Every SYSTEM_EVERY sweeps, after the sweep: each articulated system's
  * rigid contacts on more than one collider solved together (block_solve,
  * the links' responses to one another from the factors, ss_art_link_pair),
- * those that carry load or lie within 0.1 mm of their support; the answer
+ * those that carry load or lie within 0.1 mm of their support, with its PD
+ * rows within their effort bounds (below); the answer
  * kept only where it lowers their measure (rigid_residual), else the
  * impulses and velocities put back.  The collider blocks settle each wheel
  * or foot; what stays slow is their coupling through the body they hold
@@ -1501,8 +1562,21 @@ static double rigid_residual(const ssModel *m, ssData *d, ssContact *const *cs, 
  * (states cycling between its answer and the passes').  Since block_solve
  * picks its corrections by violation: turning, every second sweep 8.9
  * sweeps a step and 24 capped, every fourth 11.1 and 23, every eighth 16.0
- * and 22, each about 0.6 s for 6000 steps. */
-enum { SYSTEM_EVERY = 4 };
+ * and 22, each about 0.6 s for 6000 steps.  The system's PD rows within
+ * their effort bounds join it (block_row_responses): a driven wheel's
+ * spin and the steering rack are held by them and by the contacts at
+ * once, and alternating between the two took most of the sweeps left.
+ * With them, every fourth sweep: straight (steps 21-2000) 5.1 sweeps a
+ * step against 9.5, 0.17 s against 0.22 s; turning 7.3 against 11.1 and
+ * 36 capped against 23, 0.45 s against 0.53 s; the rack at 1, 2 or 4 cm
+ * left or 3 cm right (steps 1001-5000) 5.6 to 6.8 against 10.3 to 10.9,
+ * 8 to 29 capped against 4 to 24, a fifth quicker.  Every second sweep:
+ * straight 3.1, turning 4.5 and 24 capped, the other racks 3.6 to 4.3
+ * and 10 to 21, the same times or a little less (the benchmark, straight:
+ * 0.042 ms a step against 0.048); every sweep 2.3, 3.8 and 23, 3.2 to 3.5
+ * and 10 to 16, a quarter slower; every third or eighth, more sweeps and
+ * no quicker. */
+enum { SYSTEM_EVERY = 2 };
 
 static void system_blocks(const ssModel *m, ssData *d, int first_row, double *dmax,
                           double *lmax)
@@ -1532,6 +1606,12 @@ static void system_blocks(const ssModel *m, ssData *d, int first_row, double *dm
     }
     i = k > i ? k : i + 1;
     if (!B.n || ngeom < 2) continue;
+    /* and its PD rows within their bounds (rows come last) */
+    for (int r = first_row; r < d->ncontact && B.n < BLOCK_MAX; r++) {
+      ssContact *e = d->contact + r;
+      if (e->type == SS_CONTACT_PD && e->sys == sys && fabs(e->lambda[0]) < e->row_bound)
+        B.c[B.n++] = e;
+    }
     /* (a system of more than 256 dofs keeps the collider blocks alone) */
     double keep[3 * BLOCK_MAX], *u = d->qvel + c->vadr, u0[256];
     if (c->nv > 256) continue;

@@ -218,9 +218,10 @@ static void test_rigid_drive(void)
      "0.8 m/s (%.4f)", qvel[1][0]);
   ok(sweeps[1] < sweeps[0], "rigid ground: the warm start takes fewer sweeps (%ld "
      "against %ld)", sweeps[1], sweeps[0]);
-  /* the wheels' blocks held together through the chassis (solver.c,
-   * system_blocks): 9.5 sweeps a step; 38 without */
-  ok(sweeps[1] <= 20L * (N - SETTLE), "rigid ground: at most 20 sweeps a step warm (%.1f)",
+  /* the wheels' blocks held together through the chassis with the drive
+   * and steering rows (solver.c, system_blocks): 3.1 sweeps a step; 9.5
+   * without the rows, 38 without the system's solve */
+  ok(sweeps[1] <= 5L * (N - SETTLE), "rigid ground: at most 5 sweeps a step warm (%.1f)",
      (double)sweeps[1] / (N - SETTLE));
 }
 
@@ -228,17 +229,19 @@ static void test_rigid_drive(void)
  * centre): its rim points stick and slide, and a wheel's two split its
  * load by small differences.  Solved by collider as blocks with the
  * blocks' own solve (solver.c, rigid_block) and the system's rigid
- * contacts together every fourth sweep (system_blocks).  Turning left
- * (rack 3 cm), steps 2001-4000 take 11.2 sweeps a step and 13 stop at
- * the 200-sweep cap.  Before the block solve corrected the state of its
- * worst violation first, to a state it had not tried, and judged a
- * sliding contact settled against the block's largest impulse, they took
- * 18.5 sweeps and 61 capped (its state corrections cycled among a
- * wheel's two rim points); the collider blocks alone took 39 sweeps and
- * capped one in 25, passes alone three in five.  Turning right (2 cm),
- * steps 1001-3000: 10.2 sweeps, 8 capped (12.4 and 21 before).  Checked
- * for both: at most 30 capped and 14 sweeps a step, the buggy turns the
- * way it is steered, the tie rods stay closed. */
+ * contacts and PD rows together every second sweep (system_blocks).
+ * Turning left (rack 3 cm), steps 2001-4000 take 4.6 sweeps a step and
+ * 14 stop at the 200-sweep cap.  Without the rows in the system's solve
+ * (every fourth sweep) 11.2 and 13; before the block solve corrected the
+ * state of its worst violation first, to a state it had not tried, and
+ * judged a sliding contact settled against the block's largest impulse,
+ * 18.5 and 61 (its state corrections cycled among a wheel's two rim
+ * points); the collider blocks alone took 39 sweeps and capped one in
+ * 25, passes alone three in five.  Turning right (2 cm), steps
+ * 1001-3000: 3.6 sweeps, 3 capped (10.2 and 8 without the rows, 12.4 and
+ * 21 before that).  Checked for both: at most 30 capped and 7 sweeps a
+ * step, the buggy turns the way it is steered, the tie rods stay
+ * closed. */
 static void rigid_turn(double rack, int from, int to)
 {
   ssModel *m;
@@ -252,9 +255,9 @@ static void rigid_turn(double rack, int from, int to)
   const double *R = d->body_xmat + 9 * chassis;
   double yaw = atan2(R[3], R[0]);
   const char *way = rack > 0 ? "left" : "right";
-  ok(r && w.unconverged <= 30 && w.sweeps <= 14L * (to - from),
+  ok(r && w.unconverged <= 30 && w.sweeps <= 7L * (to - from),
      "rigid ground, turning %s: steps %d-%d stop at the sweep cap %d times (at most 30), "
-     "%.1f sweeps a step (at most 14)", way, from + 1, to, w.unconverged,
+     "%.1f sweeps a step (at most 7)", way, from + 1, to, w.unconverged,
      (double)w.sweeps / (to - from));
   ok(r && yaw * rack > 0 && fabs(yaw) > 0.1 && fmax(w0.closure, w.closure) < 1e-6,
      "  the buggy turns %s (yaw %.3f rad), the tie rods closed (%.2g m)", way, yaw,
