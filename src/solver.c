@@ -1414,7 +1414,7 @@ static int block_row_responses(const ssModel *m, ssData *d, Block *B, const int 
  * on rigid ground and a second wheel's trade states in a cycle of four
  * while a third contact's violation, a thousand times larger, waited:
  * turning on buggy_rigid.xml, 61 of steps 2001-4000 stopped at the sweep
- * cap, 13 now.)  Where a pass moves the load between nearly redundant
+ * cap, 13 after, 14 with the PD rows in the system's solve.)  Where a pass moves the load between nearly redundant
  * contacts only a little, this moves it at once; the pass after it
  * checks the answer.  Velocities are read and moved through the open
  * group g, or the system's where none is open.  Returns 1 where it
@@ -1532,6 +1532,8 @@ static double rigid_residual(const ssModel *m, ssData *d, ssContact *const *cs, 
     else contact_velocity(m, d, c, v);
     ss_m3_mulv(v0, c->G, c->lambda);
     ss_v3_sub(v0, v, v0);
+    /* the law's answer taken and the impulse put back (ss_point_rigid and
+     * pd_row write only the impulse) */
     memcpy(old, c->lambda, sizeof old);
     if (row) pd_row(c, v0);
     else ss_point_rigid(c, v0, m->opt.scalar_tolerance);
