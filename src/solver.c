@@ -1366,23 +1366,22 @@ static int block_admissible(Block *B, int i, const double *nl, Fix *f)
 }
 
 /* The responses that involve block B's PD rows (row[i] set; system_blocks,
- * outside any group) into B->G, by trial: an impulse on each row that
- * changes its own velocity by about 1 (1 / G, its own response) applied to
- * the system's velocity, every member's velocity read against v (theirs
- * now), the velocity then put back bit for bit.  That column also gives
+ * so g holds no open group) into B->G, by trial: an impulse on each row
+ * that changes its own velocity by about 1 (1 / G, its own response)
+ * applied to the system's velocity, every member's velocity read against
+ * v (theirs now), the velocity then put back bit for bit.  That column also gives
  * the row's line: the response is symmetric (J M^-1 J^T; the two agree to
  * round-off in the velocities, 1e-7 of the smallest entries, 3e-8, on
  * the turning buggy).  The rows' responses to one another are not formed
  * anywhere else, nor a row's to a link's contact.  0 where the system has
  * more than 256 dofs. */
-static int block_row_responses(const ssModel *m, ssData *d, Block *B, const int *row,
-                               const double *v)
+static int block_row_responses(const ssModel *m, ssData *d, Block *B, const Group *g,
+                               const int *row, const double *v)
 {
   const int n = B->n;
   const ssContact *c0 = B->c[0];
   double *u = d->qvel + c0->vadr, keep[256];
-  Group none = {NULL, NULL, NULL, {0}, {0}, {0}};
-  if (c0->nv > 256) return 0;
+  if (g->first || c0->nv > 256) return 0;
   memcpy(keep, u, (size_t)c0->nv * sizeof(double));
   for (int r = 0; r < n; r++) {
     if (!row[r]) continue;
@@ -1390,7 +1389,7 @@ static int block_row_responses(const ssModel *m, ssData *d, Block *B, const int 
     row_apply(d, B->c[r], s);
     for (int i = 0; i < n; i++) {
       double w[3];
-      visit_velocity(m, d, B->c[i], &none, row[i], w);
+      visit_velocity(m, d, B->c[i], g, row[i], w);
       for (int a = 0; a < 3; a++) {
         double gi = row[i] && a ? 0 : (w[a] - v[3 * i + a]) / s;
         B->G[3 * i + a][3 * r] = gi;
@@ -1414,9 +1413,9 @@ static int block_row_responses(const ssModel *m, ssData *d, Block *B, const int 
  * on rigid ground and a second wheel's trade states in a cycle of four
  * while a third contact's violation, a thousand times larger, waited:
  * turning on buggy_rigid.xml, 61 of steps 2001-4000 stopped at the sweep
- * cap, 13 after, 14 with the PD rows in the system's solve.)  Where a pass moves the load between nearly redundant
- * contacts only a little, this moves it at once; the pass after it
- * checks the answer.  Velocities are read and moved through the open
+ * cap, 13 after, 14 with the PD rows in the system's solve.)  Where a
+ * pass moves the load between nearly redundant contacts only a little,
+ * this moves it at once; the pass after it checks the answer.  Velocities are read and moved through the open
  * group g, or the system's where none is open.  Returns 1 where it
  * applied an answer. */
 static int block_solve(const ssModel *m, ssData *d, Block *B, Group *g)
@@ -1459,7 +1458,7 @@ static int block_solve(const ssModel *m, ssData *d, Block *B, Group *g)
         for (int b = 0; b < 3; b++) B->G[3 * i + a][3 * j + b] = Gij[3 * a + b];
     }
   }
-  if (nrow && !block_row_responses(m, d, B, row, v)) return 0;
+  if (nrow && !block_row_responses(m, d, B, g, row, v)) return 0;
   for (int i = 0; i < 3 * n; i++) {
     B->v0[i] = v[i];
     for (int j = 0; j < 3 * n; j++) B->v0[i] -= B->G[i][j] * lam[j];
