@@ -1675,7 +1675,7 @@ int ss_rut_map_layout(int width, int height, double x_size, double y_size,
                       ssRutMapLayout *lay)
 {
   memset(lay, 0, sizeof *lay);
-  if (width < SS_RUT_MAP_MIN_SIDE || height < SS_RUT_MAP_MIN_SIDE ||
+  if (width < SS_RUT_MAP_MIN_WIDTH || height < SS_RUT_MAP_MIN_SIDE ||
       !(x_size > 0) || !(y_size > 0) || !isfinite(x_size) || !isfinite(y_size))
     return -1;
   int fp = height / 36 < width / 50 ? height / 36 : width / 50;
@@ -1773,16 +1773,18 @@ ssStatus ss_render_rut_map(const ssModel *m, const ssData *d, int hfield,
   }
   if (width > SS_RENDER_MAX_SIDE || height > SS_RENDER_MAX_SIDE)
     return ss_error_set(err, SS_ERR_VALUE, png_path ? png_path : "", 0,
-                        "invalid rut map size %d x %d: each side must be %d to "
-                        "%d pixels",
-                        width, height, SS_RUT_MAP_MIN_SIDE, SS_RENDER_MAX_SIDE);
+                        "invalid rut map size %d x %d: %d to %d pixels wide, "
+                        "%d to %d high",
+                        width, height, SS_RUT_MAP_MIN_WIDTH, SS_RENDER_MAX_SIDE,
+                        SS_RUT_MAP_MIN_SIDE, SS_RENDER_MAX_SIDE);
   double xs = m->hfield_size[2 * h], ys = m->hfield_size[2 * h + 1];
   ssRutMapLayout L;
   if (ss_rut_map_layout(width, height, xs, ys, &L) != 0)
     return ss_error_set(err, SS_ERR_VALUE, png_path ? png_path : "", 0,
-                        "invalid rut map size %d x %d: each side must be %d to "
-                        "%d pixels",
-                        width, height, SS_RUT_MAP_MIN_SIDE, SS_RENDER_MAX_SIDE);
+                        "invalid rut map size %d x %d: %d to %d pixels wide, "
+                        "%d to %d high",
+                        width, height, SS_RUT_MAP_MIN_WIDTH, SS_RENDER_MAX_SIDE,
+                        SS_RUT_MAP_MIN_SIDE, SS_RENDER_MAX_SIDE);
 
   int nx = m->hfield_nx[h], ny = m->hfield_ny[h];
   size_t n = (size_t)nx * (size_t)ny;

@@ -211,7 +211,8 @@ typedef struct ssRutMapLayout {
 
 /* Fill *lay for an image of width x height pixels showing a bed of
  * x_size x y_size metres.  Returns 0, or -1 when the image is too small to
- * hold a map (under SS_RUT_MAP_MIN_SIDE pixels on a side, soilsim.h). */
+ * hold a map (under SS_RUT_MAP_MIN_WIDTH pixels wide or SS_RUT_MAP_MIN_SIDE
+ * high, soilsim.h; every size from those up has room, test_render). */
 int ss_rut_map_layout(int width, int height, double x_size, double y_size,
                       ssRutMapLayout *lay);
 /* Pixel showing bed fractions (u, v) in [0, 1] (see above). */

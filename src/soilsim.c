@@ -495,10 +495,10 @@ static int parse_args(int argc, char **argv, Options *o)
   if (size_given && !o->render_dir && !o->rut_map)
     return usage_error("--size needs --render or --rut-map");
   if (o->rut_map && size_given &&
-      (o->width < SS_RUT_MAP_MIN_SIDE || o->height < SS_RUT_MAP_MIN_SIDE))
-    return usage_error("--size %dx%d is too small for --rut-map: each side "
-                       "must be at least %d pixels", o->width, o->height,
-                       SS_RUT_MAP_MIN_SIDE);
+      (o->width < SS_RUT_MAP_MIN_WIDTH || o->height < SS_RUT_MAP_MIN_SIDE))
+    return usage_error("--size %dx%d is too small for --rut-map: it must be "
+                       "at least %d pixels wide and %d high", o->width,
+                       o->height, SS_RUT_MAP_MIN_WIDTH, SS_RUT_MAP_MIN_SIDE);
   for (int i = 0; i < o->nremoval; i++)
     if (o->removal[i].step > o->steps)
       return usage_error("--remove %s: step %ld is after the last step "

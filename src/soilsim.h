@@ -633,9 +633,12 @@ ssStatus ss_render_frame(ssRenderer *r, const ssModel *m, const ssData *d,
                          const char *png_path, ssError *err);
 /* Top-down rut map of the first soil bed (or hfield >= 0): sinkage or
  * plastic sinkage as colour, colour bar labelled in millimetres, metre
- * scale.  Each side SS_RUT_MAP_MIN_SIDE to 16384 pixels (the colour bar,
- * labels and scale need the room).  Does not need a GL context. */
+ * scale.  Each side SS_RUT_MAP_MIN_SIDE to 16384 pixels, and the width at
+ * least SS_RUT_MAP_MIN_WIDTH (the colour bar and its labels beside the
+ * map take 74 pixels at the smallest font; 96 leaves the map 22).  Does
+ * not need a GL context. */
 #define SS_RUT_MAP_MIN_SIDE 64
+#define SS_RUT_MAP_MIN_WIDTH 96
 ssStatus ss_render_rut_map(const ssModel *m, const ssData *d, int hfield,
                            int plastic, int width, int height,
                            const char *png_path, ssError *err);

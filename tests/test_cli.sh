@@ -23,6 +23,7 @@ trap 'rm -rf "$tmp"' EXIT
 trap 'exit 130' INT TERM HUP
 
 usage_error() { rc_is 2 && err_has "try 'soilsim --help'"; }
+is_png() { [ "$(head -c 4 "$1" 2>/dev/null | od -An -c | tr -d ' \n')" = "211PNG" ]; }
 
 # ---------------------------------------------------------------------
 # help, version, usage errors (exit 2), no scene needed
@@ -63,9 +64,17 @@ run "$PLATE" --steps 5 --render "$tmp/cam0" --camera-pos 0,0,1 --camera-look-at 
 check "--camera-pos equal to --camera-look-at: exit 2 (a camera needs a direction)" \
   'usage_error && err_has "distinct points" && no_file "$tmp/cam0"'
 # a rut map needs room for its colour bar and scale: refused before any step
-run "$PLATE" --steps 5 --size 63x100 --rut-map "$tmp/small.png"
-check "--size 63x100 with --rut-map: exit 2 before the run (at least 64 pixels)" \
-  'usage_error && err_has "at least 64 pixels" && no_file "$tmp/small.png"'
+run "$PLATE" --steps 5 --size 96x63 --rut-map "$tmp/small.png"
+check "--size 96x63 with --rut-map: exit 2 before the run (at least 64 pixels high)" \
+  'usage_error && err_has "at least 96 pixels wide and 64 high" && no_file "$tmp/small.png"'
+# (80 wide passed this check once, ran every step and then failed: the
+# colour bar and its labels need 74 pixels beside the map)
+run "$PLATE" --steps 5 --size 80x200 --rut-map "$tmp/small.png" --csv "$tmp/small.csv"
+check "--size 80x200 with --rut-map: exit 2 before the run (at least 96 pixels wide)" \
+  'usage_error && err_has "at least 96 pixels wide" && no_file "$tmp/small.png" && no_file "$tmp/small.csv"'
+run "$PLATE" --steps 5 --size 96x64 --rut-map "$tmp/small.png"
+check "--size 96x64 with --rut-map: the smallest rut map is written" \
+  'rc_is 0 && is_png "$tmp/small.png"'
 for v in plate @5 plate@ plate@x plate@-1 plate@1.5; do
   run "$PLATE" --remove "$v"
   check "--remove '$v' is rejected (exit 2)" 'usage_error && err_has "--remove"'
@@ -280,7 +289,6 @@ check "an existing --export file is replaced" \
 # ---------------------------------------------------------------------
 # images: --render frames and --rut-map (PNG signature checked)
 
-is_png() { [ "$(head -c 4 "$1" 2>/dev/null | od -An -c | tr -d ' \n')" = "211PNG" ]; }
 
 run "$PLATE" --steps 10 --rut-map "$tmp/rut.png" --size 200x150 --quiet
 check "--rut-map writes a PNG" 'rc_is 0 && is_png "$tmp/rut.png"'

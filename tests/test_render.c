@@ -295,6 +295,42 @@ static void test_bad_sizes(void)
   free_world(&w);
 }
 
+/* The rut map's smallest sizes (soilsim.h) are the layout's: every width
+ * from SS_RUT_MAP_MIN_WIDTH and height from SS_RUT_MAP_MIN_SIDE up lays
+ * out a map inside the image, for beds long, square and wide (the CLI
+ * refuses smaller sizes before the first step, so a size it accepts never
+ * fails after the run); one pixel less either way is refused.  (The limit
+ * said 64 a side while the layout needed 82 wide: --size 80x200 ran the
+ * whole simulation, then failed.) */
+static void test_rut_map_sizes(void)
+{
+  static const double beds[][2] = {{16, 6}, {2, 2}, {0.5, 40}, {40, 0.5}};
+  long tried = 0, bad = 0;
+  int first_bad_w = 0, first_bad_h = 0;
+  for (int b = 0; b < 4; b++)
+    for (int W = SS_RUT_MAP_MIN_WIDTH; W <= 2400; W += W < 600 ? 1 : 37)
+      for (int H = SS_RUT_MAP_MIN_SIDE; H <= 2400; H += H < 600 ? 7 : 41) {
+        ssRutMapLayout L;
+        int laid = ss_rut_map_layout(W, H, beds[b][0], beds[b][1], &L);
+        int inside = laid == 0 && L.map_w >= 1 && L.map_h >= 1 && L.map_x >= 0 &&
+                     L.map_y >= 0 && L.bar_x + L.bar_w <= W && L.map_x + L.map_w <= W &&
+                     L.map_y + L.map_h <= H && L.bar_y >= 0 && L.bar_y + L.bar_h <= H;
+        tried++;
+        if (!inside && !bad++) {
+          first_bad_w = W;
+          first_bad_h = H;
+        }
+      }
+  ok(bad == 0, "rut map layout: %ld sizes from %dx%d up, 4 beds, all laid out inside "
+     "the image (first failure %dx%d)", tried, SS_RUT_MAP_MIN_WIDTH, SS_RUT_MAP_MIN_SIDE,
+     first_bad_w, first_bad_h);
+  ssRutMapLayout L;
+  ok(ss_rut_map_layout(SS_RUT_MAP_MIN_WIDTH - 1, 720, 16, 6, &L) != 0 &&
+         ss_rut_map_layout(1280, SS_RUT_MAP_MIN_SIDE - 1, 16, 6, &L) != 0,
+     "rut map layout: %dx720 and 1280x%d are refused", SS_RUT_MAP_MIN_WIDTH - 1,
+     SS_RUT_MAP_MIN_SIDE - 1);
+}
+
 /* Camera straight down over the bed centre. */
 static ssRenderOptions top_view(int W, int H)
 {
@@ -1279,6 +1315,7 @@ int main(void)
   test_png_io();
   test_colormap();
   test_bad_sizes();
+  test_rut_map_sizes();
   test_frame();
   test_far_from_origin();
   test_follow();
