@@ -453,7 +453,10 @@ typedef struct ssData {
   /* derived kinematics (ss_forward), outputs: a step forms them from
    * qpos, and keeps an articulated system's where its qpos is the one
    * they were formed at; write qpos, never these */
-  double *body_xpos;      /* (nbody x 3) COM position, world */
+  double *body_xpos;      /* (nbody x 3) origin of the body's frame, world:
+                             a free body's centre of mass, an articulated
+                             link's URDF frame (body_xipos: its centre of
+                             mass) */
   double *body_xquat;     /* (nbody x 4) */
   double *body_xmat;      /* (nbody x 9) rotation, row-major */
   double *geom_xpos;      /* (ngeom x 3) */

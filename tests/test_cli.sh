@@ -232,6 +232,15 @@ check "CSV: the solver columns (newton, residual, converged): every plate step c
   'awk -F, "NR == 1 { next } !(\$7 >= 0 && \$8 >= 0 && \$8 <= 1e-9 && \$9 == 1) { bad = 1 }
      END { exit bad }" "$tmp/a.csv"'
 
+# An articulated system's columns are its base link's frame, where its
+# <state pos> puts it (-6.2 0 0.3611 on rigid ground, still there after a
+# step), not the link's centre of mass (0.25 m behind and 0.2 m above it)
+run "$top_srcdir/scenes/buggy_rigid.xml" --steps 1 --csv "$tmp/frame.csv" --quiet
+check "CSV: the buggy's position is its base frame's (x -6.2, z 0.3611 after a step)" \
+  'rc_is 0 && [ "$(head -n 1 "$tmp/frame.csv" | cut -d, -f10-)" = "buggy.x,buggy.y,buggy.z" ] &&
+   tail -n 1 "$tmp/frame.csv" | awk -F, "{ exit !(\$10 > -6.201 && \$10 < -6.199 &&
+     \$12 > 0.360 && \$12 < 0.362) }"'
+
 # A removed system keeps its columns, empty from the row after its step.
 run "$PLATE" --steps 20 --csv "$tmp/r.csv" --remove plate@10 --quiet
 check "--remove plate@10: exit 0; rows 1..10 have positions, 11..20 are empty" \
