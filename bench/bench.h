@@ -15,6 +15,25 @@ int bench_terrain(int argc, char **argv);
  * when it is not one */
 int bench_parse_long(const char *s, long lo, long hi, long *v);
 
+/* An engine flag (--raisim, --mujoco, --bullet, --chrono, --dart, --drake,
+ * --ode, --physx, --soilsim): accepted and ignored, so that one command
+ * line can drive several engines' benchmarks (DESIGN 8).  1 when arg is
+ * one. */
+int bench_engine_flag(const char *arg);
+
+/* A --csv file made ready before any run, so that a bad path costs no
+ * benchmark: a new or empty file gets the header; an existing one must
+ * start with that header (rows of another layout are not mixed in).  0,
+ * with a message naming who ("render", "deformable_terrain"), when it
+ * cannot be opened or written or holds another header (exit 1). */
+int bench_csv_prepare(const char *who, const char *path, const char *header);
+
+/* A library error as the command line prints it: FILE:LINE (the line
+ * left out where it is not known) and the message; file is used where the
+ * error names none. */
+struct ssError;
+void bench_print_error(const struct ssError *e, const char *file);
+
 /* The project's buggy scene (scenes/buggy.xml) into out: under
  * $top_srcdir, next to the executable, its parent, the source tree named
  * in the build folder's Makefile (out-of-tree), else the working folder or

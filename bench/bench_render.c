@@ -62,6 +62,7 @@ static void usage(FILE *f)
           "  --frames N     frames to time after the first (default 10)\n"
           "  --steps K      simulation steps before rendering (default 0)\n"
           "  --csv FILE     append one row (header first if the file is new)\n"
+          "An engine flag such as --raisim is accepted and ignored.\n"
           "environment: SOILSIM_GL=osmesa|egl picks the GL backend\n");
 }
 
@@ -95,6 +96,7 @@ int bench_render(int argc, char **argv)
       usage(stdout);
       return 0;
     }
+    if (bench_engine_flag(a)) continue;
     /* --opt VALUE or --opt=VALUE */
     const char *eq = strchr(a, '=');
     char name[32];
@@ -147,13 +149,15 @@ int bench_render(int argc, char **argv)
     scene = path;
   }
 
+  static const char header[] = "bench,scene,width,height,backend,steps,frames,first_ms,"
+                                "median_ms,min_ms,max_ms,mean_ms,cpu_ms,png_frame_ms";
+  if (csv && !bench_csv_prepare("render", csv, header)) return 1;
   ssError err;
   ss_error_clear(&err);
   ssModel *m = NULL;
   ssData *d = NULL;
   if (ss_scene_load(scene, &m, &d, &err) != SS_OK) {
-    fprintf(stderr, "benchmarks: %s:%d: error: %s\n", err.file[0] ? err.file : scene,
-            err.line, err.message);
+    bench_print_error(&err, scene);
     return 1;
   }
   ssRenderOptions o = ss_render_options_default();
@@ -253,9 +257,7 @@ int bench_render(int argc, char **argv)
       fprintf(stderr, "benchmarks: render: %s: cannot open: %s\n", csv, strerror(errno));
       goto done;
     }
-    if (fseek(f, 0, SEEK_END) == 0 && ftell(f) == 0)
-      fprintf(f, "bench,scene,width,height,backend,steps,frames,first_ms,median_ms,"
-                 "min_ms,max_ms,mean_ms,cpu_ms,png_frame_ms\n");
+    /* (its header: bench_csv_prepare, before the run) */
     fprintf(f, "render,%s,%d,%d,%s,%ld,%ld,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f\n", base,
             width, height, backend, steps, frames, first * 1e3, median * 1e3,
             fastest * 1e3, slowest * 1e3, mean * 1e3, cpu * 1e3, with_png * 1e3);

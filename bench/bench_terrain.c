@@ -56,15 +56,27 @@ static double median(double *v, int n)
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-/* one CSV row (with --csv); 0 and a message when it cannot be written */
-static int csv_row(const Opt *o, const char *kind, double ms, double ns_point,
+/* one CSV row (with --csv; its header: bench_csv_prepare) with the soil's
+ * material, linear (n = 1) or nonlinear (empty for a world without soil:
+ * linear < 0), and the --scene given (quoted as
+ * RFC 4180 has it, empty for a built-in body); 0 and a message when it
+ * cannot be written */
+static int csv_row(const Opt *o, const char *kind, int linear, double ms, double ns_point,
                    double sweeps, double newton, double err)
 {
   if (!o->csv) return 1;
   FILE *f = fopen(o->csv, "a");
-  int bad = !f || fprintf(f, "%s,%s,%s,%s,%d,%d,%.6g,%.6g,%.6g,%.6g,%.6g\n", kind, o->body,
-                          o->warm ? "warm" : "cold", o->linear ? "linear" : "nonlinear",
-                          o->steps, o->repeats, ms, ns_point, sweeps, err, newton) < 0;
+  int bad = !f || fprintf(f, "%s,%s,%s,%s,%d,%d,%.6g,%.6g,%.6g,%.6g,%.6g,", kind,
+                          o->contact_law ? "" : o->body, o->warm ? "warm" : "cold",
+                          linear < 0 ? "" : linear ? "linear" : "nonlinear", o->steps, o->repeats, ms, ns_point,
+                          sweeps, err, newton) < 0;
+  if (!bad && o->scene) {
+    bad = fputc('"', f) == EOF;
+    for (const char *c = o->scene; *c && !bad; c++)
+      bad = (*c == '"' && fputc('"', f) == EOF) || fputc(*c, f) == EOF;
+    bad = bad || fputc('"', f) == EOF;
+  }
+  bad = bad || fputc('\n', f) == EOF;
   if (f && fclose(f)) bad = 1;
   if (bad)
     fprintf(stderr, "benchmarks: deformable_terrain: cannot write --csv file '%s'\n", o->csv);
@@ -77,6 +89,7 @@ static int csv_row(const Opt *o, const char *kind, double ms, double ns_point,
 typedef struct Run {
   double seconds, sweeps, newton, points, sinkage, soil_normal, dt;
   double stage[6]; /* mean wall time a step of each stage (ssStepStats) */
+  int linear;      /* the first soil bed's sinkage exponent is 1; -1 no soil */
   int ok;
 } Run;
 
@@ -161,6 +174,9 @@ static Run run_body(const Opt *o)
   }
   m->opt.terrain_warm_start = o->warm;
   d->solver_gs_only = o->sweeps_only;
+  r.linear = -1;
+  for (int h = m->nhfield - 1; h >= 0; h--)
+    if (m->hfield_soil[h]) r.linear = m->hfield_soilmat[h].sinkage_exponent == 1;
   ssError e;
   for (int k = 0; k < o->warmup; k++) {
     if (ss_step(m, d, &e) != SS_OK) {
@@ -228,7 +244,8 @@ static int bench_bodies(const Opt *o)
          o->repeats, med, ns_point,
          last.sweeps, last.newton, last.points);
   if (buggy)
-    printf("  real-time factor %.3f\n", last.dt / (1e-3 * med));
+    printf("  real-time factor %.3f (%s)\n", last.dt / (1e-3 * med),
+           o->scene ? o->scene : "scenes/buggy.xml");
   else
     printf("  sinkage %.4f mm (analytic 8.175, error %+.3f %%)\n", last.sinkage * 1e3, 100 * err);
   /* where the time goes, from the step's own stage clocks (the last
@@ -241,8 +258,8 @@ static int bench_bodies(const Opt *o)
   for (int i = 0; i < 6; i++)
     printf(" %s %.1f (%.0f %%)%s", stage_name[i], 1e6 * last.stage[i],
            total > 0 ? 100 * last.stage[i] / total : 0, i < 5 ? "," : "\n");
-  if (!csv_row(o, o->sweeps_only ? "body_sweeps_only" : "body", med, ns_point, last.sweeps,
-               last.newton, err))
+  if (!csv_row(o, o->sweeps_only ? "body_sweeps_only" : "body", last.linear, med, ns_point,
+               last.sweeps, last.newton, err))
     return 1;
   if (o->verify && buggy) {
     /* said, not refused: a loop over every body with --verify still runs */
@@ -377,7 +394,7 @@ static int bench_contact_law(const Opt *o)
   printf("checks: normal pressure %s, shear within tau_max %s, shear opposes slip %s, "
          "never adds energy %s\n", bad_p ? "FAILED" : "ok", bad_bound ? "FAILED" : "ok",
          bad_align ? "FAILED" : "ok", bad_power ? "FAILED" : "ok");
-  if (!csv_row(o, "contact_law", 0, med, 0, 0, good ? 0 : 1)) return 1;
+  if (!csv_row(o, "contact_law", o->linear, 0, med, 0, 0, good ? 0 : 1)) return 1;
   return good ? 0 : 1;
 }
 
@@ -390,7 +407,10 @@ static void terrain_usage(FILE *f)
              "  --solver=newton|sweeps  --scene=FILE (--body=buggy only)\n"
              "  --contact-law [--material=linear|nonlinear]\n"
              "Options take their value as --option=VALUE or --option VALUE; an\n"
-             "engine flag such as --raisim is accepted and ignored.\n",
+             "engine flag (--raisim, --mujoco, --bullet, --chrono, --dart, --drake,\n"
+             "--ode, --physx, --soilsim) is accepted and ignored.  --material belongs\n"
+             "to --contact-law; --body, --solver, --bed-scale, --warmup and --scene\n"
+             "to the bodies.\n",
           MAX_STEPS, MAX_REPEATS, MAX_STEPS, MAX_BED_SCALE);
 }
 
@@ -436,6 +456,7 @@ int bench_terrain(int argc, char **argv)
       {"--scene", NULL, NULL, 0, 0, NULL, &o.scene},
   };
   const int nopt = (int)(sizeof opts / sizeof opts[0]);
+  unsigned given = 0; /* bit k: opts[k] given */
   for (int i = 0; i < argc; i++) {
     const char *a = argv[i];
     if (!strcmp(a, "--")) continue;
@@ -451,7 +472,7 @@ int bench_terrain(int argc, char **argv)
       o.verify = 1;
       continue;
     }
-    if (!strcmp(a, "--raisim") || !strcmp(a, "--soilsim")) continue;
+    if (bench_engine_flag(a)) continue;
     /* --option=VALUE or --option VALUE */
     const char *eq = strchr(a, '=');
     size_t nl = eq ? (size_t)(eq - a) : strlen(a);
@@ -488,6 +509,29 @@ int bench_terrain(int argc, char **argv)
               p->name, v, p->words ? p->allowed : range);
       return 2;
     }
+    given |= 1u << (p - opts);
+  }
+  /* an option the chosen case does not read is refused, not ignored: the
+   * bodies' beds have their own soil (the plate soil of DESIGN 2.7, n = 1;
+   * the buggy scene's), and the contact law builds no body */
+  for (int k = 0; k < nopt; k++) {
+    if (!(given >> k & 1)) continue;
+    const char *nm = opts[k].name;
+    int law_only = !strcmp(nm, "--material");
+    int body_only = !strcmp(nm, "--body") || !strcmp(nm, "--solver") ||
+                    !strcmp(nm, "--bed-scale") || !strcmp(nm, "--warmup") ||
+                    !strcmp(nm, "--scene");
+    if (law_only && !o.contact_law) {
+      fprintf(stderr, "benchmarks: deformable_terrain: %s chooses the contact law's "
+                      "material: it needs --contact-law (the bodies' beds have their own "
+                      "soil)\n", nm);
+      return 2;
+    }
+    if (body_only && o.contact_law) {
+      fprintf(stderr, "benchmarks: deformable_terrain: %s does not apply to --contact-law "
+                      "(it times the law alone, on no body)\n", nm);
+      return 2;
+    }
   }
   if (o.scene && strcmp(o.body, "buggy")) {
     fprintf(stderr, "benchmarks: deformable_terrain: --scene loads a vehicle scene: it "
@@ -495,23 +539,9 @@ int bench_terrain(int argc, char **argv)
     return 2;
   }
   if (!o.steps) o.steps = o.contact_law ? 2000 : !strcmp(o.body, "buggy") ? 2000 : 1500;
-  if (o.csv) {
-    /* opened before any run, so that a bad path costs no benchmark; the
-     * header goes into a new (empty) file */
-    FILE *f = fopen(o.csv, "a");
-    if (!f) {
-      fprintf(stderr, "benchmarks: deformable_terrain: cannot open --csv file '%s': %s\n",
-              o.csv, strerror(errno));
-      return 1;
-    }
-    int bad = 0;
-    if (ftell(f) == 0)
-      bad = fprintf(f, "case,body,start,material,steps,repeats,ms_per_step,ns_per_point,"
-                       "sweeps_per_step,error,newton_per_step\n") < 0;
-    if (fclose(f) || bad) {
-      fprintf(stderr, "benchmarks: deformable_terrain: cannot write --csv file '%s'\n", o.csv);
-      return 1;
-    }
-  }
+  if (o.csv && !bench_csv_prepare("deformable_terrain", o.csv,
+                                  "case,body,start,material,steps,repeats,ms_per_step,"
+                                  "ns_per_point,sweeps_per_step,error,newton_per_step,scene"))
+    return 1;
   return o.contact_law ? bench_contact_law(&o) : bench_bodies(&o);
 }

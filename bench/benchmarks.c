@@ -1,6 +1,7 @@
 /* benchmarks.c -- the benchmark program of DESIGN 8: dispatches to the
  * named cases.  Timings are reported, never asserted. */
 #include "bench.h"
+#include "soilsim.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -30,6 +31,57 @@ int bench_parse_long(const char *s, long lo, long hi, long *v)
   if (errno || end == s || *end || x < lo || x > hi) return 0;
   *v = x;
   return 1;
+}
+
+int bench_engine_flag(const char *arg)
+{
+  static const char *const engines[] = {"--raisim", "--mujoco", "--bullet", "--chrono",
+                                        "--dart",   "--drake",  "--ode",    "--physx",
+                                        "--soilsim", NULL};
+  for (int k = 0; engines[k]; k++)
+    if (!strcmp(arg, engines[k])) return 1;
+  return 0;
+}
+
+int bench_csv_prepare(const char *who, const char *path, const char *header)
+{
+  FILE *f = fopen(path, "a+");
+  if (!f) {
+    fprintf(stderr, "benchmarks: %s: cannot open --csv file '%s': %s\n", who, path,
+            strerror(errno));
+    return 0;
+  }
+  /* "a+" reads from the start and writes at the end */
+  char line[512];
+  size_t hl = strlen(header);
+  int bad = 0, empty = fseek(f, 0, SEEK_END) == 0 && ftell(f) == 0;
+  if (empty) {
+    bad = fprintf(f, "%s\n", header) < 0;
+  } else {
+    rewind(f);
+    int same = fgets(line, sizeof line, f) && !strncmp(line, header, hl) &&
+               (line[hl] == '\n' || (line[hl] == '\r' && line[hl + 1] == '\n'));
+    if (!same) {
+      fclose(f);
+      fprintf(stderr, "benchmarks: %s: --csv file '%s' holds other columns (its first line "
+                      "is not this case's header: %s); give a new file\n", who, path, header);
+      return 0;
+    }
+  }
+  if (fclose(f) || bad) {
+    fprintf(stderr, "benchmarks: %s: cannot write --csv file '%s'\n", who, path);
+    return 0;
+  }
+  return 1;
+}
+
+void bench_print_error(const ssError *e, const char *file)
+{
+  const char *f = e->file[0] ? e->file : file;
+  if (e->line > 0)
+    fprintf(stderr, "benchmarks: %s:%d: error: %s\n", f, e->line, e->message);
+  else
+    fprintf(stderr, "benchmarks: %s: error: %s\n", f, e->message);
 }
 
 static int file_exists(const char *p)

@@ -84,7 +84,48 @@ run $T --contact-law --steps=20 --repeats=1 --csv="$tmp/b.csv"
 check '--csv=FILE: appended' 'rc_is 0'
 check 'the CSV: one header and a row per run' \
   '[ "$(wc -l <"$tmp/b.csv")" -eq 3 ] && head -1 "$tmp/b.csv" | grep -q "^case,body,start" &&
-   [ "$(grep -c "^contact_law,rigid,warm,nonlinear,20,1," "$tmp/b.csv")" -eq 2 ]'
+   [ "$(grep -c "^contact_law,,warm,nonlinear,20,1," "$tmp/b.csv")" -eq 2 ]'
+
+# a row says what ran: the contact law on no body; a body's material is
+# its bed's (the plate soil is linear, n = 1, the buggy's nonlinear, none
+# on rigid ground); the scene of --scene in the last column, quoted (each
+# once said the default: "rigid" for the law, "nonlinear" for the plate,
+# the buggy with no scene)
+run $T --body=rigid --steps=2 --repeats=1 --csv="$tmp/c.csv"
+run $T --body=buggy --steps=2 --repeats=1 --csv="$tmp/c.csv"
+run $T --body=buggy --scene="$top_srcdir/scenes/buggy_rigid.xml" --steps=2 --repeats=1 \
+  --csv="$tmp/c.csv"
+check 'the CSV: the plate linear, the buggy nonlinear, the rigid-ground scene none, and named' \
+  'head -1 "$tmp/c.csv" | grep -q ",newton_per_step,scene\$" &&
+   sed -n 2p "$tmp/c.csv" | grep -q "^body,rigid,warm,linear,2,1,.*,\$" &&
+   sed -n 3p "$tmp/c.csv" | grep -q "^body,buggy,warm,nonlinear,2,1,.*,\$" &&
+   sed -n 4p "$tmp/c.csv" | grep -q "^body,buggy,warm,,2,1,.*,\"$top_srcdir/scenes/buggy_rigid.xml\"\$" &&
+   out_has "(${top_srcdir}/scenes/buggy_rigid.xml)"'
+echo "case,body,start" >"$tmp/old.csv"
+run $T --contact-law --steps=2 --repeats=1 --csv="$tmp/old.csv"
+check 'a --csv file with other columns: refused before the run, left as it was' \
+  'rc_is 1 && err_has "holds other columns" && ! out_has "ns per contact visit" &&
+   [ "$(cat "$tmp/old.csv")" = "case,body,start" ]'
+
+# options the chosen case would not read: refused, not ignored
+run $T --body=rigid --material=linear --steps=2 --repeats=1
+check '--material without --contact-law: refused (the beds have their own soil)' \
+  'rc_is 2 && err_has "--material chooses the contact law" && ! out_has "ms/step"'
+for o in --body=buggy --solver=sweeps --bed-scale=3 --warmup=5 --scene=x.xml; do
+  run $T --contact-law "$o" --steps=2 --repeats=1
+  check "--contact-law with $o: refused" \
+    'rc_is 2 && err_has "does not apply to --contact-law" && ! out_has "ns per contact visit"'
+done
+
+# engine flags, accepted and ignored by both cases
+run $T --mujoco --contact-law --steps=2 --repeats=1
+check 'an engine flag (--mujoco) is accepted and ignored' 'rc_is 0 && out_has "ns per contact visit"'
+run --bench render --raisim --scene "$tmp/none.xml"
+check 'render: an engine flag is accepted; a scene that does not load is named, without a line 0' \
+  'rc_is 1 && err_has "none.xml: error:" && ! err_has ":0:"'
+run --bench render --csv "$tmp/no/such/dir/r.csv"
+check 'render: a --csv in a missing folder is refused before the run' \
+  'rc_is 1 && err_has "cannot open --csv file" && ! out_has "render benchmark"'
 
 echo "1..$n"
 [ "$nfail" -eq 0 ]
