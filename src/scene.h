@@ -23,8 +23,11 @@
  * (with optional white space around it).  Booleans are true/false/1/0.
  * Quaternions are w x y z; a zero quaternion is an error; others are
  * normalised (one already of unit length to 1e-14 is kept bit for bit).
- * Paths (png, text) may contain [THIS_DIR], the folder of the scene file; a
- * relative path without it is taken relative to the scene file's folder.
+ * Paths (png, text, urdf_path, res_dir) may contain [THIS_DIR], the folder
+ * of the scene file; a relative path without it is taken relative to the
+ * scene file's folder.  The model keeps the URDF and resource folder of an
+ * articulated system as absolute, normalised paths (ss_scene_path_absolute),
+ * so that the export can write them relative to its own folder.
  *
  * Structure (R = required attribute; others optional, default in brackets):
  *
@@ -154,6 +157,18 @@ ssStatus ss_scene_c_locale_begin(ssCLocale *l, const char *path, ssError *err);
 
 /* The folder of path into dir[cap]: "." for a bare name, "/" at the root. */
 void ss_scene_path_dir(const char *path, char *dir, size_t cap);
+/* path as an absolute, normalised path into out[cap]: realpath when it
+ * exists (links resolved), else relative to the working folder with ".",
+ * ".." and doubled slashes taken out by hand.  Returns 0, or -1 when it
+ * does not fit (or the working folder is unknown). */
+int ss_scene_path_absolute(const char *path, char *out, size_t cap);
+/* The absolute path target as seen from the absolute folder dir (both
+ * normalised, as ss_scene_path_absolute makes them): "../" as needed, then
+ * the rest of target ("." when they are the same).  Returns -1, leaving
+ * out unspecified, when they share nothing but the root (the caller then
+ * keeps target absolute) or it does not fit. */
+int ss_scene_path_relative(const char *target, const char *dir, char *out,
+                           size_t cap);
 
 /* ---------------------------------------------------------------------- */
 /* height-map sources (hfield_source.c)                                    */

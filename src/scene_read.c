@@ -5,6 +5,8 @@
  * (safely: xml_safe.h), then walks the tree once, building the model with
  * the model builder; every element is checked against a list of allowed
  * attributes and children so that typos are reported instead of ignored. */
+/* realpath (ss_scene_path_absolute) is an XSI function */
+#define _XOPEN_SOURCE 700
 #include "scene.h"
 #include "articulated.h"
 #include "urdf.h"
@@ -132,6 +134,97 @@ void ss_scene_path_dir(const char *path, char *dir, size_t cap)
     snprintf(dir, cap, "/");
   else
     snprintf(dir, cap, "%.*s", (int)(slash - path), path);
+}
+
+/* Lexical clean-up of an absolute path: "." and empty components dropped,
+ * ".." takes the previous one away (none above the root).  Only for paths
+ * that do not exist, where realpath has nothing to follow. */
+static void path_clean(char *p)
+{
+  char *o = p;
+  const char *s = p;
+  while (*s) {
+    while (*s == '/') s++;
+    const char *e = s;
+    while (*e && *e != '/') e++;
+    size_t n = (size_t)(e - s);
+    if (n == 0 || (n == 1 && s[0] == '.')) {
+      /* nothing */
+    } else if (n == 2 && s[0] == '.' && s[1] == '.') {
+      while (o > p && *--o != '/') {}
+    } else {
+      *o++ = '/';
+      memmove(o, s, n);
+      o += n;
+    }
+    s = e;
+  }
+  if (o == p) *o++ = '/';
+  *o = 0;
+}
+
+int ss_scene_path_absolute(const char *path, char *out, size_t cap)
+{
+  if (!path || !*path || cap < 2) return -1;
+  char *real = realpath(path, NULL);
+  if (real) {
+    int n = snprintf(out, cap, "%s", real);
+    free(real);
+    return n >= 0 && (size_t)n < cap ? 0 : -1;
+  }
+  /* a missing file: relative to the working folder, cleaned by hand */
+  size_t k = 0;
+  if (path[0] != '/') {
+    if (!getcwd(out, cap)) return -1;
+    k = strlen(out);
+    if (k + 1 >= cap) return -1;
+    out[k++] = '/';
+  }
+  size_t n = strlen(path);
+  if (k + n + 1 > cap) return -1;
+  memcpy(out + k, path, n + 1);
+  path_clean(out);
+  return 0;
+}
+
+int ss_scene_path_relative(const char *target, const char *dir, char *out,
+                           size_t cap)
+{
+  if (target[0] != '/' || dir[0] != '/') return -1;
+  /* the longest common run of whole components */
+  size_t common = 0;
+  for (size_t i = 0;; i++) {
+    int te = target[i] == 0 || target[i] == '/';
+    int de = dir[i] == 0 || dir[i] == '/';
+    if (te && de) {
+      if (i) common = i;
+      if (!target[i] || !dir[i]) break;
+    } else if (target[i] != dir[i]) {
+      break;
+    }
+  }
+  /* sharing only the root: the two are unrelated, so the absolute path
+   * survives moving the scene better than a climb to the root would */
+  if (common == 0) return -1;
+  size_t k = 0;
+  for (const char *s = dir + common; *s; s++)
+    if (*s == '/') {
+      if (k + 3 >= cap) return -1;
+      memcpy(out + k, "../", 3);
+      k += 3;
+    }
+  const char *rest = target + common;
+  if (*rest == '/') rest++;
+  size_t n = strlen(rest);
+  if (k + n + 2 > cap) return -1;
+  if (n) {
+    memcpy(out + k, rest, n + 1);
+  } else if (k) {
+    out[--k] = 0; /* "../../" -> "../.." */
+  } else {
+    memcpy(out, ".", 2);
+  }
+  return 0;
 }
 
 static int is_digit(char ch) { return ch >= '0' && ch <= '9'; }
@@ -1286,6 +1379,15 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
       st = ue.code;
     }
   }
+  /* kept absolute and normalised, so an export anywhere can name the same
+   * files (messages above keep the path as the scene gives it) */
+  char abspath[4096], absres[4096] = "";
+  if (!st && ss_scene_path_absolute(path, abspath, sizeof abspath))
+    st = fail(c, SS_ERR_VALUE, e.line, "%s: urdf_path '%s' is too long as an "
+              "absolute path", e.label, path);
+  if (!st && res && ss_scene_path_absolute(resdir, absres, sizeof absres))
+    st = fail(c, SS_ERR_VALUE, e.line, "%s: res_dir '%s' is too long as an "
+              "absolute path", e.label, resdir);
   if (!st) {
     def.name = name;
     def.fixed_base = base ? !strcmp(base, "fixed") : -1;
@@ -1298,8 +1400,8 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
     def.qpos_name = ref ? "reference_qpos" : "qpos";
     def.qvel = qvel;
     def.nqvel = nqvel;
-    def.urdf_path = path;
-    def.res_dir = res ? resdir : "";
+    def.urdf_path = abspath;
+    def.res_dir = absres;
     int sys = ss_model_add_articulated(c->m, u, &def, &c->e);
     if (sys < 0) {
       st = c->e.code ? c->e.code : SS_ERR_VALUE;

@@ -7,7 +7,20 @@
  * it reads back to the same double (see fmt_double: as exact as "%.17g",
  * but 9.81 stays "9.81").  The text goes
  * through one buffer straight to the file (no per-number library calls
- * besides the formatting), and the file is replaced atomically. */
+ * besides the formatting), and the file is replaced atomically.
+ *
+ * Files.  Height maps are written explicit and mesh bodies are refused, so
+ * the only files an export names are an articulated system's URDF
+ * (urdf_path) and resource folder (res_dir).  The reader keeps them as
+ * absolute, normalised paths (links resolved); they are written relative to
+ * the export's own folder ("../assets/arm.urdf"), which is how the reader
+ * resolves them, so an export written anywhere loads again and a folder
+ * that holds both the export and its assets can be moved or copied as a
+ * whole.  When the two share nothing but the root ("/tmp/out.xml" and
+ * "/home/me/assets/arm.urdf") the path is written absolute instead: such an
+ * export is more likely to be moved alone.  Either way the text depends
+ * only on where the files are, not on the working folder, so export ->
+ * load -> export gives the same bytes from any folder. */
 #include "scene.h"
 #include "dynamics.h"
 
@@ -18,6 +31,8 @@
 
 typedef struct wBuf {
   ssAtomicFile *f;     /* keeps the first write error; later writes do nothing */
+  char dir[4096];      /* the output file's folder, absolute and normalised
+                          ("" if unknown: paths are then written absolute) */
   size_t n;
   char b[1 << 16];
 } wBuf;
@@ -128,6 +143,23 @@ static void a_str(wBuf *w, const char *name, const char *v)
   w_s(w, "=\"");
   w_esc(w, v);
   w_s(w, "\"");
+}
+
+/* A file or folder the model was loaded from, as the reader will find it
+ * from the output's folder (see the rule at the top).  A path the model
+ * holds relative (a model built in code) is taken from the working folder,
+ * as it was opened. */
+static void a_path(wBuf *w, const char *name, const char *v)
+{
+  char abs[4096], rel[8192];
+  if (ss_scene_path_absolute(v, abs, sizeof abs)) {
+    a_str(w, name, v);
+    return;
+  }
+  if (w->dir[0] && !ss_scene_path_relative(abs, w->dir, rel, sizeof rel))
+    a_str(w, name, rel);
+  else
+    a_str(w, name, abs);
 }
 
 static void a_vec(wBuf *w, const char *name, const double *v, int n)
@@ -294,8 +326,8 @@ static void write_articulated(wBuf *w, const ssModel *m, const ssData *d, int s)
 {
   w_s(w, "    <articulated_system");
   a_str(w, "name", m->sys_name[s]);
-  a_str(w, "urdf_path", m->sys_source[s]);
-  if (m->sys_resdir[s][0]) a_str(w, "res_dir", m->sys_resdir[s]);
+  a_path(w, "urdf_path", m->sys_source[s]);
+  if (m->sys_resdir[s][0]) a_path(w, "res_dir", m->sys_resdir[s]);
   a_str(w, "base", m->sys_fixed[s] ? "fixed" : "floating");
   int b0 = m->sys_bodyadr[s], mat = 0;
   for (int g = 0; g < m->ngeom; g++)
@@ -488,6 +520,11 @@ ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
   }
   w->f = &f;
   w->n = 0;
+  /* the folder exists (the temporary file is in it), so this is its real
+   * path; if even so it cannot be had, paths are written absolute */
+  char dir[4096];
+  ss_scene_path_dir(path, dir, sizeof dir);
+  if (ss_scene_path_absolute(dir, w->dir, sizeof w->dir)) w->dir[0] = 0;
 
   ssCLocale loc;
   int have_loc = ss_scene_c_locale_push(&loc) == 0;

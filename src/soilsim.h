@@ -195,8 +195,10 @@ typedef struct ssModel {
   int *sys_nbody;       /* (nsys) */
   int *sys_line;        /* (nsys) line in the scene file (0 if built in code) */
   int *sys_fixed;       /* (nsys) articulated: 1 if the base is welded */
-  char **sys_source;    /* (nsys) articulated: URDF path ("" otherwise) */
-  char **sys_resdir;    /* (nsys) articulated: resource folder ("" if none) */
+  char **sys_source;    /* (nsys) articulated: URDF path ("" otherwise);
+                           absolute and normalised when read from a scene */
+  char **sys_resdir;    /* (nsys) articulated: resource folder ("" if none),
+                           likewise */
 
   int nq, nv;           /* generalized coordinate / velocity counts */
   double *qpos0;        /* (nq) initial positions (pos, quat for free bodies) */

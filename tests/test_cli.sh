@@ -205,6 +205,50 @@ check "articulated scene on soil runs and exports" \
 run "$tmp/arm1.xml" --steps 0 --export "$tmp/arm2.xml" --quiet
 check "articulated export, reload, export again: identical files" \
   'rc_is 0 && cmp -s "$tmp/arm1.xml" "$tmp/arm2.xml"'
+
+# the URDF and resource folder of an export are named from the export's own
+# folder, where the reader looks for them: an export written into another
+# folder (a subfolder, through "..", from another working folder) loads
+# again, nothing depends on the working folder, and a copy of the whole
+# tree loads its own assets
+w=$tmp/paths
+mkdir -p "$w/scenes" "$w/assets" "$w/sub" "$w/other"
+cp -R "$top_srcdir/assets/plate_arm" "$w/assets/"
+sed 's|urdf_path="[^"]*"|& res_dir="[THIS_DIR]/../assets/plate_arm"|' \
+  "$top_srcdir/scenes/plate_arm.xml" >"$w/scenes/plate_arm.xml"
+urdf_rel='urdf_path="../assets/plate_arm/plate_arm.urdf" res_dir="../assets/plate_arm"'
+here=$(pwd)
+SOILSIM_REL=$SOILSIM
+SOILSIM=$(cd "$(dirname "$SOILSIM")" && pwd)/soilsim
+cd "$w" || exit 1
+run scenes/plate_arm.xml --steps 10 --export sub/pa.xml --quiet
+check "export into a subfolder: the URDF and res_dir are named from there" \
+  'rc_is 0 && grep -qF "$urdf_rel" sub/pa.xml'
+run sub/pa.xml --steps 1 --export sub/pa1.xml --quiet
+check "an export in a subfolder loads again and steps" 'rc_is 0 && [ -s sub/pa1.xml ]'
+run sub/pa.xml --steps 0 --export sub/../scenes/./../other/pa.xml --quiet
+check "export through '..' into another folder: the same paths, loads from elsewhere" \
+  'rc_is 0 && grep -qF "$urdf_rel" other/pa.xml &&
+   (cd / && "$SOILSIM" "$w/other/pa.xml" --steps 1 --quiet)'
+run scenes/plate_arm.xml --steps 10 --export ./here.xml --quiet
+run ./here.xml --steps 0 --export ./here2.xml --quiet
+check "export into the working folder: no './' prefix, export -> reload -> export identical" \
+  'rc_is 0 && grep -qF "urdf_path=\"assets/plate_arm/plate_arm.urdf\"" here.xml &&
+   cmp -s here.xml here2.xml'
+cd "$w/sub" || exit 1
+run pa.xml --steps 0 --export pa2.xml --quiet
+check "export, reload from inside its folder, export again: identical files" \
+  'rc_is 0 && cmp -s pa.xml pa2.xml'
+cd "$tmp" || exit 1
+run paths/sub/pa.xml --steps 0 --export paths/sub/pa3.xml --quiet
+check "export, reload from another working folder, export again: identical files" \
+  'rc_is 0 && cmp -s paths/sub/pa.xml paths/sub/pa3.xml'
+cp -R "$w" "$tmp/moved"
+rm -rf "$w/assets"
+run moved/sub/pa.xml --steps 1 --quiet
+check "a copy of the folder with the export and its assets loads on its own" 'rc_is 0'
+cd "$here" || exit 1
+SOILSIM=$SOILSIM_REL
 # an XML export holds the whole state (with the reference configuration the
 # closures were derived from) but not the solver's warm-start cache, which
 # checkpoints carry; with warm starts off a reloaded export continues bit
