@@ -1987,6 +1987,14 @@ int ss_model_add_articulated(ssModel *m, const ssUrdf *u, const ssArtDef *def,
       return -1;
     }
   }
+  if (def->qpos && !fixed && def->pose_given) {
+    ss_error_set(err, SS_ERR_VALUE, f, line,
+                 "articulated_system '%s': %s sets the floating base's pose (its "
+                 "first 7 values: position, quaternion w x y z), and so do pos and "
+                 "quat: give one or the other", def->name,
+                 def->qpos_name ? def->qpos_name : "qpos");
+    return -1;
+  }
   if (def->qpos && def->nqpos != nq) {
     ss_error_set(err, SS_ERR_VALUE, f, line,
                  "articulated_system '%s': %s has %d values, expected %d",
@@ -2106,7 +2114,31 @@ int ss_model_add_articulated(ssModel *m, const ssUrdf *u, const ssArtDef *def,
         goto fail;
     }
   }
-  if (def->qpos) memcpy(q0, def->qpos, (size_t)nq * sizeof(double));
+  if (def->qpos) {
+    memcpy(q0, def->qpos, (size_t)nq * sizeof(double));
+    /* a floating base's or ball joint's quaternion in qpos: a zero one is
+     * refused, as <state quat> is; any other is normalised (one of unit
+     * length to 1e-14 is kept as written, so that exports read back bit
+     * for bit), as the base pose is: a rotation that is not orthonormal
+     * would scale the links it carries */
+    for (int b = m->sys_bodyadr[s]; b < m->sys_bodyadr[s] + m->sys_nbody[s]; b++) {
+      int t = m->body_jnttype[b];
+      if (t != SS_JOINT_FLOATING && t != SS_JOINT_SPHERICAL) continue;
+      double *qq = m->qpos0 + m->body_qadr[b] + (t == SS_JOINT_FLOATING ? 3 : 0);
+      double n2 = qq[0] * qq[0] + qq[1] * qq[1] + qq[2] * qq[2] + qq[3] * qq[3];
+      if (!(n2 > 0)) {
+        ss_error_set(err, SS_ERR_VALUE, f, line,
+                     "articulated_system '%s': %s values %d to %d (the %s of link '%s') "
+                     "are a quaternion of zero length (w x y z)",
+                     def->name, def->qpos_name ? def->qpos_name : "qpos",
+                     (int)(qq - q0) + 1, (int)(qq - q0) + 4,
+                     t == SS_JOINT_FLOATING ? "floating base's orientation" : "ball joint",
+                     m->body_name[b]);
+        goto fail;
+      }
+      if (fabs(n2 - 1) > 1e-14) ss_quat_normalize(qq);
+    }
+  }
   if (def->qvel) memcpy(m->qvel0 + m->sys_vadr[s], def->qvel, (size_t)nv * sizeof(double));
 
   /* closures and springs: implicit anchors and lengths come from the
@@ -2221,6 +2253,16 @@ int ss_model_add_pd(ssModel *m, int s, const char *joint, double kp, double kd,
                  ">= 0, targets finite", joint);
     return -1;
   }
+  /* two controllers on one joint would both act, summed, each within its
+   * own effort bound: what a second <pd> for the same joint means is
+   * unclear, so it is an error rather than a guess */
+  for (int k = 0; k < m->npd; k++)
+    if (m->pd_body[k] == b) {
+      ss_error_set(err, SS_ERR_VALUE, m->source_path, line,
+                   "pd: joint '%s' of articulated_system '%s' already has a PD "
+                   "controller (one per joint)", joint, m->sys_name[s]);
+      return -1;
+    }
   double gain[3] = {kp, kd, effort}, target[2] = {qt, vt};
   return ss_model_push_pd(m, b, gain, target, err);
 }

@@ -39,6 +39,10 @@ typedef struct ssArtDef {
                             link says, else floating */
   double pos[3];         /* root pose (floating: initial; fixed: weld) */
   double quat[4];
+  int pose_given;        /* pos or quat given (a scene's <state pos quat>):
+                            with qpos on a floating base, which sets the
+                            same pose, an error instead of one of them
+                            dropped */
   const double *qpos;    /* optional full initial qpos (nq), NULL = URDF zero
                             pose placed at pos/quat */
   int nqpos;

@@ -909,6 +909,12 @@ static ssStatus read_body(readCtx *c, xmlNodePtr n, ssGeomType shape)
     st = fail(c, SS_ERR_VALUE, e.line,
               "%s: mass = %g is invalid: a dynamic body needs a mass > 0 kg",
               e.label, def.mass);
+  /* a static body's mass is not used, but one written must still be a
+   * mass (a typo is reported, not dropped) */
+  if (!st && def.is_static && el_find(&e, "mass") && !(def.mass > 0))
+    st = fail(c, SS_ERR_VALUE, e.line,
+              "%s: mass = %g is invalid: must be > 0 kg (a static body's mass "
+              "is not used; it may be left out)", e.label, def.mass);
   if (!st) st = get_material(c, &e, &def.material);
   if (!st && el_find(&e, "rgba")) {
     st = get_vec(c, &e, "rgba", 4, 0, def.rgba);
@@ -949,6 +955,20 @@ static ssStatus read_body(readCtx *c, xmlNodePtr n, ssGeomType shape)
   if (!st && !seen_dim)
     st = fail(c, SS_ERR_PARSE, e.line, "%s: missing its <dim> element",
               e.label);
+  /* a static body never moves: a velocity or a force given it would be
+   * dropped without a word */
+  if (!st && def.is_static) {
+    int moving = 0;
+    for (int k = 0; k < 3; k++) moving |= def.lin_vel[k] != 0 || def.ang_vel[k] != 0;
+    if (moving)
+      st = fail(c, SS_ERR_VALUE, e.line,
+                "%s: a static body does not move: its <state> lin_vel and "
+                "ang_vel must be 0 (or left out)", e.label);
+    else if (nxf)
+      st = fail(c, SS_ERR_VALUE, xf[0].line,
+                "%s: a static body does not move: <external_force> is allowed "
+                "on dynamic bodies only", e.label);
+  }
   if (!st) {
     def.line = e.line;
     int s = ss_model_add_body(c->m, &def, &c->e);
@@ -1336,6 +1356,7 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
       if (!st) st = get_list(c, &se, "reference_qpos", &nref, &ref);
       if (!st) st = get_vec(c, &se, "pos", 3, 0, def.pos);
       if (!st) st = get_vec(c, &se, "quat", 4, 0, def.quat);
+      def.pose_given = el_find(&se, "pos") || el_find(&se, "quat");
       if (!st && quat_is_zero(def.quat))
         st = fail(c, SS_ERR_VALUE, se.line, "%s: quat has zero length", se.label);
       el_free(&se);

@@ -292,6 +292,34 @@ static void test_this_dir(void)
   }
 }
 
+/* A floating base's quaternion in qpos is normalised, as <state quat> is
+ * (it was taken as written: qpos "... 2 0 0 0 ..." doubled every link's
+ * offset from the base); one of unit length stays bit for bit. */
+static void test_qpos_quaternion(void)
+{
+  static const char *const quats[2] = {"2 0 0 0", "0.6 0 0.8 0"};
+  static const double want[2][4] = {{1, 0, 0, 0}, {0.6, 0, 0.8, 0}};
+  for (int k = 0; k < 2; k++) {
+    char xml[1024];
+    snprintf(xml, sizeof xml,
+             "<raisim><objects><articulated_system name=\"carrier\" "
+             "urdf_path=\"%s/assets/plate_arm/plate_arm.urdf\">"
+             "<state qpos=\"0 0 0.5 %s 0 0 0\"/></articulated_system></objects></raisim>",
+             srcdir(), quats[k]);
+    ssModel *m = NULL;
+    ssData *d = NULL;
+    ssError e;
+    ssStatus st = load_str(xml, &m, &d, &e);
+    if (st) diag("%s:%d: %s", e.file, e.line, e.message);
+    const double *q = st ? NULL : m->qpos0 + m->sys_qadr[0] + 3;
+    ok(q && !memcmp(q, want[k], sizeof want[k]),
+       "qpos quaternion %s of a floating base is stored as %g %g %g %g", quats[k],
+       q ? q[0] : 0, q ? q[1] : 0, q ? q[2] : 0, q ? q[3] : 0);
+    ss_data_free(d);
+    ss_model_free(m);
+  }
+}
+
 /* Odd doubles: thirds, subnormals, signed zero, huge and tiny. */
 static double odd(int k)
 {
@@ -856,6 +884,7 @@ int main(void)
   test_spellings();
   test_separators();
   test_this_dir();
+  test_qpos_quaternion();
   test_round_trip();
   test_built_in_code();
   test_numbers();
