@@ -545,8 +545,11 @@ void ss_forward(const ssModel *m, ssData *d);
 /* One time step.  SS_ERR_NUMERIC (naming the step and body) if a velocity
  * became non-finite or absurd (above SS_SPEED_MAX m/s or rad/s) or a
  * position non-finite.  SS_ERR_VALUE, before anything is stepped, if the
- * state it starts from is already so, or a bed's pose is non-finite or
- * its quaternion not unit (as written into d between steps).  A step
+ * state it starts from is already so, a bed's pose is non-finite or its
+ * quaternion not unit, or the clock is outside what <clock> allows (as
+ * written into d between steps), or the time would not stay finite.
+ * SS_ERR_STATE, nothing stepped, when d->step is LONG_MAX: the step
+ * counter's limit.  A step
  * that fails for any reason leaves d exactly as it was (positions,
  * velocities, soil, warm-start cache, statistics). */
 ssStatus ss_step(const ssModel *m, ssData *d, ssError *err);

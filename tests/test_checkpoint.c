@@ -15,6 +15,8 @@
 #include "tap.h"
 #include "worlds.h"
 
+#include <float.h>
+#include <limits.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -1187,6 +1189,107 @@ static void test_failed_step(void)
   failed_step("plate_arm.xml", 200);
 }
 
+/* ---------------------------------------------------------------------- */
+/* the clock's limits (README and man page, <clock>)                       */
+
+/* scenes/plate.xml with <clock time="1" step="STEP"/> after its
+ * <timeStep>, read as the scene reader reads a file */
+static int load_plate_at(long step, ssModel **m, ssData **d)
+{
+  char path[512], clock[96];
+  snprintf(path, sizeof path, "%s/scenes/plate.xml", srcdir());
+  snprintf(clock, sizeof clock, "<clock time=\"1\" step=\"%ld\"/>", step);
+  FILE *f = fopen(path, "rb");
+  char *xml = f ? malloc(1 << 20) : NULL, *out = xml ? malloc((1 << 20) + 128) : NULL;
+  size_t n = out ? fread(xml, 1, (1 << 20) - 1, f) : 0;
+  if (f) fclose(f);
+  const char *ts = "<timeStep value=\"0.001\"/>";
+  char *at = n ? (xml[n] = 0, strstr(xml, ts)) : NULL;
+  ssError e;
+  int r = 0;
+  if (at) {
+    size_t head = (size_t)(at - xml) + strlen(ts);
+    memcpy(out, xml, head);
+    strcpy(out + head, clock);
+    memcpy(out + head + strlen(clock), xml + head, n - head);
+    r = ss_scene_load_buffer(out, n + strlen(clock), path, m, d, &e) == SS_OK;
+    if (!r) diag("plate.xml with %s: %s", clock, e.message);
+  } else {
+    diag("cannot read %s or find its %s", path, ts);
+  }
+  free(xml);
+  free(out);
+  return r;
+}
+
+/* A <clock> 7 steps short of the step counter's limit (LONG_MAX, the
+ * largest step the scene and checkpoint readers take): 7 steps run, the
+ * next is refused with nothing changed (the counter would overflow), and
+ * the checkpoint and the export of the state at the limit read back with
+ * its clock.  The time stays finite (at DBL_MAX a step adds nothing it
+ * cannot hold), and a clock set outside what <clock> allows is refused
+ * before a step and by the checkpoint writer. */
+static void test_step_limit(void)
+{
+  ssModel *m = NULL, *m2 = NULL;
+  ssData *d = NULL, *c = NULL, *d2 = NULL;
+  if (!load_plate_at(LONG_MAX - 7, &m, &d)) {
+    ok(0, "plate.xml with a clock at step LONG_MAX - 7 loads");
+    return;
+  }
+  int r = run(m, d, 7);
+  ok(r && d->step == LONG_MAX && d->time > 1,
+     "a <clock> 7 steps short of the limit: 7 steps run (step %ld, t = %.6g s)",
+     d->step, d->time);
+  size_t la = 0, lb = 0;
+  unsigned char *a = snapshot(m, d, &la), *b;
+  ssError e;
+  ss_error_clear(&e);
+  ssStatus st = ss_step(m, d, &e);
+  b = snapshot(m, d, &lb);
+  ok(st == SS_ERR_STATE && strstr(e.message, "step counter is at its maximum") &&
+         strstr(e.message, "nothing was stepped") && a && b && la == lb &&
+         !memcmp(a, b, la),
+     "at step LONG_MAX the next step is refused, nothing changed (%s)", e.message);
+  free(b);
+
+  c = ss_data_new(m);
+  ok(a && c && ss_checkpoint_load_buffer(m, c, a, la, &e) == SS_OK && identical(m, d, c) &&
+         ss_step(m, c, &e) == SS_ERR_STATE,
+     "the checkpoint at the limit restores and refuses to step on too");
+  char path[600];
+  tmp_path(path, sizeof path, "limit.xml");
+  r = ss_scene_export(m, d, path, &e) == SS_OK &&
+      ss_scene_load(path, &m2, &d2, &e) == SS_OK;
+  ok(r && d2->step == LONG_MAX && d2->time == d->time &&
+         ss_step(m2, d2, &e) == SS_ERR_STATE,
+     "its export reloads with the clock written (step %ld) and refuses to step on",
+     r ? d2->step : -1);
+  unlink(path);
+
+  /* the time */
+  ss_data_reset(m, c);
+  c->time = DBL_MAX;
+  ok(run(m, c, 2) && c->time == DBL_MAX && c->step == 2,
+     "a clock at t = DBL_MAX steps and its time stays finite");
+  ss_data_reset(m, c);
+  c->time = -1;
+  st = ss_step(m, c, &e);
+  ok(st == SS_ERR_VALUE && strstr(e.message, "clock") && c->step == 0 && c->time == -1,
+     "a negative time set between steps is refused (%s)", e.message);
+  unsigned char *bad = NULL;
+  size_t nbad = 0;
+  ok(ss_checkpoint_save_buffer(m, c, &bad, &nbad, &e) == SS_ERR_VALUE && !bad &&
+         strstr(e.message, "clock"),
+     "and no checkpoint holds it (%s)", e.message);
+  free(a);
+  ss_data_free(c);
+  ss_data_free(d);
+  ss_model_free(m);
+  ss_data_free(d2);
+  ss_model_free(m2);
+}
+
 int main(void)
 {
   const char *t = getenv("TMPDIR");
@@ -1208,6 +1311,7 @@ int main(void)
   test_cache_overflow();
   test_export();
   test_failed_step();
+  test_step_limit();
   rmdir(tmpdir);
   return done_testing();
 }
