@@ -583,6 +583,7 @@ static void damage_tests(const char *what, const ssModel *m, const ssData *src,
     {"tolerance NaN", "OPTS", 16 + 36, 8, UINT64_C(0x7ff8000000000000)},
     {"negative step count", "CLCK", 16 + 8, 8, UINT64_C(0xFFFFFFFFFFFFFFFF)},
     {"time +inf", "CLCK", 16, 8, UINT64_C(0x7ff0000000000000)},
+    {"time -1 s", "CLCK", 16, 8, UINT64_C(0xbff0000000000000)},
     {"qpos NaN", "QPOS", 16, 8, UINT64_C(0x7ff8000000000001)},
     {"qvel 2e5 (above SS_SPEED_MAX)", "QVEL", 16, 8, UINT64_C(0x41086a0000000000)},
     {"negative plastic sinkage", "PLAS", 16, 8, UINT64_C(0xbff0000000000000)},
@@ -1290,6 +1291,60 @@ static void test_step_limit(void)
   ss_model_free(m2);
 }
 
+/* A checkpoint forged with a correct checksum but a clock the scene
+ * reader would refuse (time negative or not finite; the step count is
+ * checked by the forge table above) is refused as corrupted with a
+ * message naming the clock, by the loader and by the info reader, the
+ * data unchanged: its export could not be read back. */
+static void test_forged_clock(void)
+{
+  ssModel *m;
+  ssData *d;
+  if (!load_scene("plate.xml", &m, &d)) {
+    ok(0, "plate.xml loads");
+    return;
+  }
+  size_t n = 0;
+  unsigned char *good = run(m, d, 20) ? snapshot(m, d, &n) : NULL;
+  unsigned char *p = good ? malloc(n) : NULL;
+  size_t at = good ? find_section(good, n, "CLCK") : 0;
+  ssData *twin = ss_data_new(m);
+  if (!p || !at || !twin || !run(m, twin, 20)) {
+    ok(0, "forged clocks: a checkpoint with a clock section");
+    free(good);
+    free(p);
+    ss_data_free(twin);
+    ss_data_free(d);
+    ss_model_free(m);
+    return;
+  }
+  const double times[] = {-1.0, -1e-300, -INFINITY, NAN};
+  int refused = 0, named = 0, info = 0;
+  for (int k = 0; k < 4; k++) {
+    memcpy(p, good, n);
+    uint64_t bits;
+    memcpy(&bits, &times[k], 8);
+    put(p + at + 16, bits, 8);
+    reseal(p, n);
+    ssError e;
+    ssCheckpointInfo ci;
+    ss_error_clear(&e);
+    refused += ss_checkpoint_load_buffer(m, d, p, n, &e) == SS_ERR_PARSE;
+    named += strstr(e.message, "clock time") && strstr(e.message, "finite and >= 0");
+    diag("forged time %g: %s", times[k], e.message);
+    info += ss_checkpoint_info_buffer(p, n, &ci, &e) == SS_ERR_PARSE;
+  }
+  ok(refused == 4 && named == 4 && info == 4 && same_state(m, d, twin),
+     "checkpoints with a correct checksum and a time of -1, -1e-300, -inf or NaN "
+     "are refused as corrupted, naming the clock, data unchanged (%d, %d, %d)",
+     refused, named, info);
+  free(good);
+  free(p);
+  ss_data_free(twin);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 int main(void)
 {
   const char *t = getenv("TMPDIR");
@@ -1312,6 +1367,7 @@ int main(void)
   test_export();
   test_failed_step();
   test_step_limit();
+  test_forged_clock();
   rmdir(tmpdir);
   return done_testing();
 }
