@@ -44,6 +44,15 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
                         "step %ld: the time %.17g s plus the time step %g s is "
                         "not finite; nothing was stepped", d->step + 1, d->time,
                         m->opt.timestep);
+  /* each bed's material as ss_model_validate checks it: a program may
+   * edit m->hfield_soilmat between steps, and with an invalid one nothing
+   * is simulated (DESIGN 2.5); a few comparisons per bed */
+  ssError bad_soil;
+  ssStatus st = ss_model_validate_soil(m, &bad_soil);
+  if (st)
+    return ss_error_set(err, st, NULL, 0, "step %ld (t = %.6g s): %s; nothing "
+                        "was stepped", d->step + 1, d->time + m->opt.timestep,
+                        bad_soil.message);
   /* keep the coordinates and velocities so a failed step leaves d where it
    * was; the soil state and the warm-start cache are written only once
    * every check has passed */
@@ -59,7 +68,6 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
   ssStepStats stats0 = d->stats;
   d->in_step = 1;
   double *t = d->stats.time_stage, t0 = now(), t1;
-  ssStatus st = SS_OK;
 
   /* poses of bodies and colliders from qpos (an articulated system's
    * stand where the last step left them for this qpos) */

@@ -1345,6 +1345,74 @@ static void test_forged_clock(void)
   ss_model_free(m);
 }
 
+/* A soil material edited between steps (a supported use: test_plate's
+ * power tables) into one ss_model_validate refuses: ss_step refuses it
+ * with the same message, before anything is stepped (DESIGN 2.5), and
+ * once mended the world steps on as if the edit had never been made. */
+static void test_edited_material(void)
+{
+  ssModel *m;
+  ssData *d;
+  if (!load_scene("plate.xml", &m, &d)) {
+    ok(0, "plate.xml loads");
+    return;
+  }
+  const struct {
+    const char *field;
+    size_t off;
+    double v;
+  } edit[] = {
+    {"damping", offsetof(ssSoilMaterial, damping), -1e5},
+    {"bekker_kphi", offsetof(ssSoilMaterial, bekker_kphi), -1e3},
+    {"bekker_kphi", offsetof(ssSoilMaterial, bekker_kphi), 0}, /* k_c is 0 too */
+    {"elastic_stiffness", offsetof(ssSoilMaterial, elastic_stiffness), 0},
+    {"sinkage_exponent", offsetof(ssSoilMaterial, sinkage_exponent), -1},
+    {"cohesion", offsetof(ssSoilMaterial, cohesion), NAN},
+    {"friction_coefficient", offsetof(ssSoilMaterial, friction_coefficient), INFINITY},
+  };
+  const int nedit = (int)(sizeof edit / sizeof edit[0]);
+  int settled = run(m, d, 20), refused = 0, same_msg = 0, unchanged = 0;
+  ssSoilMaterial *mat = &m->hfield_soilmat[0], keep = *mat;
+  for (int k = 0; k < nedit; k++) {
+    *(double *)((char *)mat + edit[k].off) = edit[k].v;
+    ssError ev, e;
+    ss_error_clear(&e);
+    int invalid = ss_model_validate(m, &ev) == SS_ERR_VALUE;
+    size_t la = 0, lb = 0;
+    unsigned char *a = snapshot(m, d, &la), *b;
+    ssStatus st = ss_step(m, d, &e);
+    b = snapshot(m, d, &lb);
+    refused += invalid && st == SS_ERR_VALUE;
+    same_msg += invalid && strstr(e.message, ev.message) &&
+                strstr(e.message, edit[k].field) && strstr(e.message, "nothing was stepped");
+    unchanged += a && b && la == lb && !memcmp(a, b, la);
+    diag("%s = %g: %s", edit[k].field, edit[k].v, e.message);
+    free(a);
+    free(b);
+    *mat = keep;
+  }
+  ok(settled && refused == nedit && same_msg == nedit && unchanged == nedit,
+     "%d soil materials edited between steps into invalid ones: each step "
+     "refused with ss_model_validate's message, nothing changed (%d, %d, %d)",
+     nedit, refused, same_msg, unchanged);
+  ssModel *m2 = NULL;
+  ssData *d2 = NULL;
+  size_t la = 0, lb = 0;
+  unsigned char *a = NULL, *b = NULL;
+  if (run(m, d, 10) && load_scene("plate.xml", &m2, &d2) && run(m2, d2, 30)) {
+    a = snapshot(m, d, &la);
+    b = snapshot(m2, d2, &lb);
+  }
+  ok(a && b && la == lb && !memcmp(a, b, la),
+     "the material mended, the world steps on bit for bit as if never edited");
+  free(a);
+  free(b);
+  ss_data_free(d2);
+  ss_model_free(m2);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 int main(void)
 {
   const char *t = getenv("TMPDIR");
@@ -1368,6 +1436,7 @@ int main(void)
   test_failed_step();
   test_step_limit();
   test_forged_clock();
+  test_edited_material();
   rmdir(tmpdir);
   return done_testing();
 }
