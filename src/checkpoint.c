@@ -36,7 +36,8 @@
  *     OPTS  ssOption: timestep, gravity x y z (f64), solver_max_sweeps (i32),
  *           solver_tolerance, scalar_tolerance (f64), terrain_warm_start
  *           (i32), contact_margin, rigid_erp (f64)
- *     CLCK  time (f64), step (i64), closure_error (f64)
+ *     CLCK  time (f64), step (i64), closure_error (f64); time and step
+ *           as <clock> takes them (finite and >= 0 s; 0 to LONG_MAX)
  *     QPOS  nq f64          QVEL  nv f64          SYSA  nsys u8
  *     PDTG  npd x 2 f64     HPOS  nhfield x 3 f64 HQUA  nhfield x 4 f64
  *     SINK, PLAS, SHEA      nhfielddata f64 each (sinkage, plastic, shear)
@@ -795,10 +796,19 @@ static ssStatus parse_clock(const Parsed *f, const char *path, double *time,
   *time = r_f64(&r);
   int64_t s = (int64_t)r_u64(&r);
   *closure = r_f64(&r);
-  if (!isfinite(*time) || s < 0 || (uint64_t)s > (uint64_t)LONG_MAX ||
-      !isfinite(*closure))
+  /* the rules of <clock> (scene_read.c): a state the scene reader would
+   * refuse must not come in this way, or its export could not be read */
+  if (!(isfinite(*time) && *time >= 0))
     return ss_error_set(err, SS_ERR_PARSE, path, 0,
-                        "checkpoint is corrupted: bad time or step count");
+                        "checkpoint is corrupted: clock time = %g is invalid: "
+                        "must be finite and >= 0 s", *time);
+  if (s < 0 || (uint64_t)s > (uint64_t)LONG_MAX)
+    return ss_error_set(err, SS_ERR_PARSE, path, 0,
+                        "checkpoint is corrupted: clock step = %lld is invalid: "
+                        "must be in [0, %ld]", (long long)s, LONG_MAX);
+  if (!isfinite(*closure))
+    return ss_error_set(err, SS_ERR_PARSE, path, 0,
+                        "checkpoint is corrupted: bad closure error");
   *step = (long)s;
   return SS_OK;
 }

@@ -259,6 +259,12 @@ void ss_dyn_unit_quats(const ssModel *m, ssData *d)
 
 int ss_dyn_check_state(const ssModel *m, const ssData *d, char *msg, size_t cap)
 {
+  /* the clock as the scene and checkpoint readers take it (<clock>) */
+  if (!(isfinite(d->time) && d->time >= 0) || d->step < 0) {
+    snprintf(msg, cap, "the clock (time %g s, step %ld) is invalid: the time "
+             "must be finite and >= 0 s, the step count >= 0", d->time, d->step);
+    return 0;
+  }
   int vel, s = ss_dyn_check_finite(m, d, &vel);
   if (s >= 0) {
     snprintf(msg, cap, "the %s of '%s' is %s", vel ? "velocity" : "position",

@@ -903,12 +903,17 @@ ssStatus ss_model_validate(const ssModel *m, ssError *err)
   if (!isfinite(o->rigid_erp) || o->rigid_erp < 0 || o->rigid_erp > 1)
     return ss_error_set(err, SS_ERR_VALUE, f, 0,
                         "rigid_erp %g: must be in [0, 1]", o->rigid_erp);
+  return ss_model_validate_soil(m, err);
+}
+
+ssStatus ss_model_validate_soil(const ssModel *m, ssError *err)
+{
   for (int h = 0; h < m->nhfield; h++)
     if (m->hfield_soil[h]) {
       ssError e2;
       if (ss_soil_material_validate(&m->hfield_soilmat[h], &e2) != SS_OK)
-        return ss_error_set(err, SS_ERR_VALUE, f, 0, "heightmap '%s': %s",
-                            m->hfield_name[h], e2.message);
+        return ss_error_set(err, SS_ERR_VALUE, m->source_path, 0,
+                            "heightmap '%s': %s", m->hfield_name[h], e2.message);
     }
   return SS_OK;
 }

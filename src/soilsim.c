@@ -877,6 +877,14 @@ static int run(const Options *o)
   apply_solver_overrides(o, m);
   for (int i = 0; i < o->nckpt; i++)
     if (check_output(o->ckpt[i].path, "--checkpoint", &err) != SS_OK) goto fail;
+  /* the step counter's limit, which ss_step refuses to pass: said before
+   * the first step rather than after the steps that still fit */
+  if (o->steps > LONG_MAX - d->step) {
+    ss_error_set(&err, SS_ERR_VALUE, o->restore ? o->restore : o->scene, 0,
+                 "--steps %ld: the world starts at step %ld (its clock) and "
+                 "the step counter stops at %ld", o->steps, d->step, LONG_MAX);
+    goto fail;
+  }
   if (o->rut_map && first_soil_bed(m) < 0) {
     ss_error_set(&err, SS_ERR_VALUE, o->scene, 0,
                  "--rut-map: the scene has no soil bed");

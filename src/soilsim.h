@@ -392,6 +392,10 @@ int ss_model_find_sys(const ssModel *m, const char *name);
 int ss_model_find_hfield(const ssModel *m, const char *name);
 /* Checks the whole model (options, materials, sizes); call once built. */
 ssStatus ss_model_validate(const ssModel *m, ssError *err);
+/* The part of it that checks every soil bed's material (DESIGN 2.5);
+ * ss_step calls it too, since a program may edit m->hfield_soilmat
+ * between steps. */
+ssStatus ss_model_validate_soil(const ssModel *m, ssError *err);
 /* Effective width b of a geom on a bed whose normal is n_bed (DESIGN 2.4),
  * given the geom's world rotation (row-major 3x3). */
 double ss_geom_width(const ssModel *m, int geom, const double xmat[9],
@@ -547,8 +551,12 @@ void ss_forward(const ssModel *m, ssData *d);
 /* One time step.  SS_ERR_NUMERIC (naming the step and body) if a velocity
  * became non-finite or absurd (above SS_SPEED_MAX m/s or rad/s) or a
  * position non-finite.  SS_ERR_VALUE, before anything is stepped, if the
- * state it starts from is already so, or a bed's pose is non-finite or
- * its quaternion not unit (as written into d between steps).  A step
+ * state it starts from is already so, a bed's pose is non-finite or its
+ * quaternion not unit, the clock is outside what <clock> allows (as
+ * written into d between steps) or the time would not stay finite, or a
+ * soil bed's material is invalid (as edited into m between steps;
+ * ss_model_validate_soil).  SS_ERR_STATE, nothing stepped, when d->step
+ * is LONG_MAX: the step counter's limit.  A step
  * that fails for any reason leaves d exactly as it was (positions,
  * velocities, soil, warm-start cache, statistics). */
 ssStatus ss_step(const ssModel *m, ssData *d, ssError *err);

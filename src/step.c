@@ -5,6 +5,8 @@
 #include "solver.h"
 #include "terrain.h"
 
+#include <limits.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -20,6 +22,13 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
 {
   if (d->in_step)
     return ss_error_set(err, SS_ERR_STATE, NULL, 0, "ss_step called re-entrantly");
+  /* the step counter's limit: a <clock> or a checkpoint may start it
+   * anywhere in [0, LONG_MAX], and one more step would overflow it (its
+   * export or checkpoint could then not be read back) */
+  if (d->step == LONG_MAX)
+    return ss_error_set(err, SS_ERR_STATE, NULL, 0,
+                        "the step counter is at its maximum (%ld steps); "
+                        "nothing was stepped", d->step);
   /* the state a step starts from: a caller may have written it between
    * steps (or a checkpoint restored it), and none of it is used before
    * it has passed the test that every step's result passes */
@@ -29,6 +38,21 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
                         "step %ld (t = %.6g s): %s before the step (set between "
                         "steps or restored); nothing was stepped", d->step + 1,
                         d->time + m->opt.timestep, why);
+  /* the time (finite, as just checked) stays finite after the step */
+  if (!isfinite(d->time + m->opt.timestep))
+    return ss_error_set(err, SS_ERR_VALUE, NULL, 0,
+                        "step %ld: the time %.17g s plus the time step %g s is "
+                        "not finite; nothing was stepped", d->step + 1, d->time,
+                        m->opt.timestep);
+  /* each bed's material as ss_model_validate checks it: a program may
+   * edit m->hfield_soilmat between steps, and with an invalid one nothing
+   * is simulated (DESIGN 2.5); a few comparisons per bed */
+  ssError bad_soil;
+  ssStatus st = ss_model_validate_soil(m, &bad_soil);
+  if (st)
+    return ss_error_set(err, st, NULL, 0, "step %ld (t = %.6g s): %s; nothing "
+                        "was stepped", d->step + 1, d->time + m->opt.timestep,
+                        bad_soil.message);
   /* keep the coordinates and velocities so a failed step leaves d where it
    * was; the soil state and the warm-start cache are written only once
    * every check has passed */
@@ -44,7 +68,6 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
   ssStepStats stats0 = d->stats;
   d->in_step = 1;
   double *t = d->stats.time_stage, t0 = now(), t1;
-  ssStatus st = SS_OK;
 
   /* poses of bodies and colliders from qpos (an articulated system's
    * stand where the last step left them for this qpos) */

@@ -15,6 +15,8 @@
 #include "tap.h"
 #include "worlds.h"
 
+#include <float.h>
+#include <limits.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -581,6 +583,7 @@ static void damage_tests(const char *what, const ssModel *m, const ssData *src,
     {"tolerance NaN", "OPTS", 16 + 36, 8, UINT64_C(0x7ff8000000000000)},
     {"negative step count", "CLCK", 16 + 8, 8, UINT64_C(0xFFFFFFFFFFFFFFFF)},
     {"time +inf", "CLCK", 16, 8, UINT64_C(0x7ff0000000000000)},
+    {"time -1 s", "CLCK", 16, 8, UINT64_C(0xbff0000000000000)},
     {"qpos NaN", "QPOS", 16, 8, UINT64_C(0x7ff8000000000001)},
     {"qvel 2e5 (above SS_SPEED_MAX)", "QVEL", 16, 8, UINT64_C(0x41086a0000000000)},
     {"negative plastic sinkage", "PLAS", 16, 8, UINT64_C(0xbff0000000000000)},
@@ -1187,6 +1190,229 @@ static void test_failed_step(void)
   failed_step("plate_arm.xml", 200);
 }
 
+/* ---------------------------------------------------------------------- */
+/* the clock's limits (README and man page, <clock>)                       */
+
+/* scenes/plate.xml with <clock time="1" step="STEP"/> after its
+ * <timeStep>, read as the scene reader reads a file */
+static int load_plate_at(long step, ssModel **m, ssData **d)
+{
+  char path[512], clock[96];
+  snprintf(path, sizeof path, "%s/scenes/plate.xml", srcdir());
+  snprintf(clock, sizeof clock, "<clock time=\"1\" step=\"%ld\"/>", step);
+  FILE *f = fopen(path, "rb");
+  char *xml = f ? malloc(1 << 20) : NULL, *out = xml ? malloc((1 << 20) + 128) : NULL;
+  size_t n = out ? fread(xml, 1, (1 << 20) - 1, f) : 0;
+  if (f) fclose(f);
+  const char *ts = "<timeStep value=\"0.001\"/>";
+  char *at = n ? (xml[n] = 0, strstr(xml, ts)) : NULL;
+  ssError e;
+  int r = 0;
+  if (at) {
+    size_t head = (size_t)(at - xml) + strlen(ts);
+    memcpy(out, xml, head);
+    strcpy(out + head, clock);
+    memcpy(out + head + strlen(clock), xml + head, n - head);
+    r = ss_scene_load_buffer(out, n + strlen(clock), path, m, d, &e) == SS_OK;
+    if (!r) diag("plate.xml with %s: %s", clock, e.message);
+  } else {
+    diag("cannot read %s or find its %s", path, ts);
+  }
+  free(xml);
+  free(out);
+  return r;
+}
+
+/* A <clock> 7 steps short of the step counter's limit (LONG_MAX, the
+ * largest step the scene and checkpoint readers take): 7 steps run, the
+ * next is refused with nothing changed (the counter would overflow), and
+ * the checkpoint and the export of the state at the limit read back with
+ * its clock.  The time stays finite (at DBL_MAX a step adds nothing it
+ * cannot hold), and a clock set outside what <clock> allows is refused
+ * before a step and by the checkpoint writer. */
+static void test_step_limit(void)
+{
+  ssModel *m = NULL, *m2 = NULL;
+  ssData *d = NULL, *c = NULL, *d2 = NULL;
+  if (!load_plate_at(LONG_MAX - 7, &m, &d)) {
+    ok(0, "plate.xml with a clock at step LONG_MAX - 7 loads");
+    return;
+  }
+  int r = run(m, d, 7);
+  ok(r && d->step == LONG_MAX && d->time > 1,
+     "a <clock> 7 steps short of the limit: 7 steps run (step %ld, t = %.6g s)",
+     d->step, d->time);
+  size_t la = 0, lb = 0;
+  unsigned char *a = snapshot(m, d, &la), *b;
+  ssError e;
+  ss_error_clear(&e);
+  ssStatus st = ss_step(m, d, &e);
+  b = snapshot(m, d, &lb);
+  ok(st == SS_ERR_STATE && strstr(e.message, "step counter is at its maximum") &&
+         strstr(e.message, "nothing was stepped") && a && b && la == lb &&
+         !memcmp(a, b, la),
+     "at step LONG_MAX the next step is refused, nothing changed (%s)", e.message);
+  free(b);
+
+  c = ss_data_new(m);
+  ok(a && c && ss_checkpoint_load_buffer(m, c, a, la, &e) == SS_OK && identical(m, d, c) &&
+         ss_step(m, c, &e) == SS_ERR_STATE,
+     "the checkpoint at the limit restores and refuses to step on too");
+  char path[600];
+  tmp_path(path, sizeof path, "limit.xml");
+  r = ss_scene_export(m, d, path, &e) == SS_OK &&
+      ss_scene_load(path, &m2, &d2, &e) == SS_OK;
+  ok(r && d2->step == LONG_MAX && d2->time == d->time &&
+         ss_step(m2, d2, &e) == SS_ERR_STATE,
+     "its export reloads with the clock written (step %ld) and refuses to step on",
+     r ? d2->step : -1);
+  unlink(path);
+
+  /* the time */
+  ss_data_reset(m, c);
+  c->time = DBL_MAX;
+  ok(run(m, c, 2) && c->time == DBL_MAX && c->step == 2,
+     "a clock at t = DBL_MAX steps and its time stays finite");
+  ss_data_reset(m, c);
+  c->time = -1;
+  st = ss_step(m, c, &e);
+  ok(st == SS_ERR_VALUE && strstr(e.message, "clock") && c->step == 0 && c->time == -1,
+     "a negative time set between steps is refused (%s)", e.message);
+  unsigned char *bad = NULL;
+  size_t nbad = 0;
+  ok(ss_checkpoint_save_buffer(m, c, &bad, &nbad, &e) == SS_ERR_VALUE && !bad &&
+         strstr(e.message, "clock"),
+     "and no checkpoint holds it (%s)", e.message);
+  free(a);
+  ss_data_free(c);
+  ss_data_free(d);
+  ss_model_free(m);
+  ss_data_free(d2);
+  ss_model_free(m2);
+}
+
+/* A checkpoint forged with a correct checksum but a clock the scene
+ * reader would refuse (time negative or not finite; the step count is
+ * checked by the forge table above) is refused as corrupted with a
+ * message naming the clock, by the loader and by the info reader, the
+ * data unchanged: its export could not be read back. */
+static void test_forged_clock(void)
+{
+  ssModel *m;
+  ssData *d;
+  if (!load_scene("plate.xml", &m, &d)) {
+    ok(0, "plate.xml loads");
+    return;
+  }
+  size_t n = 0;
+  unsigned char *good = run(m, d, 20) ? snapshot(m, d, &n) : NULL;
+  unsigned char *p = good ? malloc(n) : NULL;
+  size_t at = good ? find_section(good, n, "CLCK") : 0;
+  ssData *twin = ss_data_new(m);
+  if (!p || !at || !twin || !run(m, twin, 20)) {
+    ok(0, "forged clocks: a checkpoint with a clock section");
+    free(good);
+    free(p);
+    ss_data_free(twin);
+    ss_data_free(d);
+    ss_model_free(m);
+    return;
+  }
+  const double times[] = {-1.0, -1e-300, -INFINITY, NAN};
+  int refused = 0, named = 0, info = 0;
+  for (int k = 0; k < 4; k++) {
+    memcpy(p, good, n);
+    uint64_t bits;
+    memcpy(&bits, &times[k], 8);
+    put(p + at + 16, bits, 8);
+    reseal(p, n);
+    ssError e;
+    ssCheckpointInfo ci;
+    ss_error_clear(&e);
+    refused += ss_checkpoint_load_buffer(m, d, p, n, &e) == SS_ERR_PARSE;
+    named += strstr(e.message, "clock time") && strstr(e.message, "finite and >= 0");
+    diag("forged time %g: %s", times[k], e.message);
+    info += ss_checkpoint_info_buffer(p, n, &ci, &e) == SS_ERR_PARSE;
+  }
+  ok(refused == 4 && named == 4 && info == 4 && same_state(m, d, twin),
+     "checkpoints with a correct checksum and a time of -1, -1e-300, -inf or NaN "
+     "are refused as corrupted, naming the clock, data unchanged (%d, %d, %d)",
+     refused, named, info);
+  free(good);
+  free(p);
+  ss_data_free(twin);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
+/* A soil material edited between steps (a supported use: test_plate's
+ * power tables) into one ss_model_validate refuses: ss_step refuses it
+ * with the same message, before anything is stepped (DESIGN 2.5), and
+ * once mended the world steps on as if the edit had never been made. */
+static void test_edited_material(void)
+{
+  ssModel *m;
+  ssData *d;
+  if (!load_scene("plate.xml", &m, &d)) {
+    ok(0, "plate.xml loads");
+    return;
+  }
+  const struct {
+    const char *field;
+    size_t off;
+    double v;
+  } edit[] = {
+    {"damping", offsetof(ssSoilMaterial, damping), -1e5},
+    {"bekker_kphi", offsetof(ssSoilMaterial, bekker_kphi), -1e3},
+    {"bekker_kphi", offsetof(ssSoilMaterial, bekker_kphi), 0}, /* k_c is 0 too */
+    {"elastic_stiffness", offsetof(ssSoilMaterial, elastic_stiffness), 0},
+    {"sinkage_exponent", offsetof(ssSoilMaterial, sinkage_exponent), -1},
+    {"cohesion", offsetof(ssSoilMaterial, cohesion), NAN},
+    {"friction_coefficient", offsetof(ssSoilMaterial, friction_coefficient), INFINITY},
+  };
+  const int nedit = (int)(sizeof edit / sizeof edit[0]);
+  int settled = run(m, d, 20), refused = 0, same_msg = 0, unchanged = 0;
+  ssSoilMaterial *mat = &m->hfield_soilmat[0], keep = *mat;
+  for (int k = 0; k < nedit; k++) {
+    *(double *)((char *)mat + edit[k].off) = edit[k].v;
+    ssError ev, e;
+    ss_error_clear(&e);
+    int invalid = ss_model_validate(m, &ev) == SS_ERR_VALUE;
+    size_t la = 0, lb = 0;
+    unsigned char *a = snapshot(m, d, &la), *b;
+    ssStatus st = ss_step(m, d, &e);
+    b = snapshot(m, d, &lb);
+    refused += invalid && st == SS_ERR_VALUE;
+    same_msg += invalid && strstr(e.message, ev.message) &&
+                strstr(e.message, edit[k].field) && strstr(e.message, "nothing was stepped");
+    unchanged += a && b && la == lb && !memcmp(a, b, la);
+    diag("%s = %g: %s", edit[k].field, edit[k].v, e.message);
+    free(a);
+    free(b);
+    *mat = keep;
+  }
+  ok(settled && refused == nedit && same_msg == nedit && unchanged == nedit,
+     "%d soil materials edited between steps into invalid ones: each step "
+     "refused with ss_model_validate's message, nothing changed (%d, %d, %d)",
+     nedit, refused, same_msg, unchanged);
+  ssModel *m2 = NULL;
+  ssData *d2 = NULL;
+  size_t la = 0, lb = 0;
+  unsigned char *a = NULL, *b = NULL;
+  if (run(m, d, 10) && load_scene("plate.xml", &m2, &d2) && run(m2, d2, 30)) {
+    a = snapshot(m, d, &la);
+    b = snapshot(m2, d2, &lb);
+  }
+  ok(a && b && la == lb && !memcmp(a, b, la),
+     "the material mended, the world steps on bit for bit as if never edited");
+  free(a);
+  free(b);
+  ss_data_free(d2);
+  ss_model_free(m2);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 int main(void)
 {
   const char *t = getenv("TMPDIR");
@@ -1208,6 +1434,9 @@ int main(void)
   test_cache_overflow();
   test_export();
   test_failed_step();
+  test_step_limit();
+  test_forged_clock();
+  test_edited_material();
   rmdir(tmpdir);
   return done_testing();
 }

@@ -303,6 +303,34 @@ for f in "$top_srcdir"/tests/data/blowup/*.xml; do
 done
 [ "$nblow" -gt 0 ] || skip "no files in tests/data/blowup"
 
+# the step counter's limit (<clock step> at most 2^63 - 1; past it the
+# count would overflow): --steps that would pass it is refused before the
+# first step, nothing written; a run that ends at it exports a clock and
+# checkpoints one that read back, and neither steps on
+sed 's|<timeStep value="0.001"/>|&<clock time="1" step="9223372036854775800"/>|' \
+  "$PLATE" >"$tmp/clock.xml"
+rm -f "$tmp/clock.csv"
+run "$tmp/clock.xml" --steps 10 --export "$tmp/keep.xml" --csv "$tmp/clock.csv"
+check "a clock 7 steps short of the step counter's limit: --steps 10 exits 1 before the first step; no CSV; export untouched" \
+  'rc_is 1 && err_has "clock.xml: error: --steps 10:" &&
+   err_has "stops at 9223372036854775807" && no_file "$tmp/clock.csv" &&
+   [ "$(cat "$tmp/keep.xml")" = "precious export" ] && no_tmp "$tmp"'
+run "$tmp/clock.xml" --steps 7 --export "$tmp/clock_end.xml" \
+  --checkpoint "$tmp/clock_end.ckpt@7" -q
+check "--steps 7 reaches the limit: the export's clock says step 9223372036854775807" \
+  'rc_is 0 && grep -q "step=\"9223372036854775807\"" "$tmp/clock_end.xml"'
+run "$tmp/clock_end.xml" --steps 0 -q
+check "that export reads back" 'rc_is 0'
+run "$tmp/clock_end.xml" --steps 1
+check "that export refuses one step more, naming the limit" \
+  'rc_is 1 && err_has "clock_end.xml: error: --steps 1:" &&
+   err_has "stops at 9223372036854775807"'
+run "$tmp/clock.xml" --restore "$tmp/clock_end.ckpt" --steps 0 -q
+check "the checkpoint at the limit restores" 'rc_is 0'
+run "$tmp/clock.xml" --restore "$tmp/clock_end.ckpt" --steps 1
+check "the checkpoint at the limit refuses one step more" \
+  'rc_is 1 && err_has "clock_end.ckpt: error: --steps 1:"'
+
 # =====================================================================
 # 3. nothing lost
 
