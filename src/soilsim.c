@@ -4,7 +4,8 @@
  * first step, steps the world, and writes the requested outputs: an export
  * of the final world, a per-step CSV, rendered frames and a rut map.  Each
  * output file is replaced atomically, so a failed or interrupted run never
- * leaves a half-written file behind.
+ * leaves a half-written file behind (a device or FIFO, /dev/stdout for
+ * one, is written in place: see ss_atomic_open).
  *
  * Exit status: 0 success; 1 bad input or a failed run (the message names
  * the file and line); 2 bad usage.  Only this file prints or exits. */
@@ -531,16 +532,14 @@ static int parse_args(int argc, char **argv, Options *o)
 /* ---------------------------------------------------------------------- */
 /* checks made before the first step                                       */
 
-/* An output file must be replaceable: not a folder, and its folder must
- * take a new file (the atomic writer creates its temporary file there).
- * open_output opens it (the --csv rows are written as the run goes);
- * check_output only tries, for the outputs written at the end. */
+/* An output must be writable as ss_atomic_open writes it: a new or
+ * replaced file needs a folder that takes its temporary file (a folder is
+ * refused), a stream (/dev/stdout, a FIFO) write permission.  open_output
+ * opens it (the --csv rows are written as the run goes); check_output
+ * only tries, for the outputs written later, and never opens a FIFO (its
+ * reader would see the end of the output before it began). */
 static ssStatus open_output(ssAtomicFile *f, const char *path, const char *flag, ssError *err)
 {
-  struct stat st;
-  if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
-    return ss_error_set(err, SS_ERR_IO, path, 0,
-                        "%s: cannot write: is a directory", flag);
   ssError e;
   ss_error_clear(&e);
   if (ss_atomic_open(f, path, &e) != SS_OK)
@@ -550,10 +549,11 @@ static ssStatus open_output(ssAtomicFile *f, const char *path, const char *flag,
 
 static ssStatus check_output(const char *path, const char *flag, ssError *err)
 {
-  ssAtomicFile f;
-  ssStatus st = open_output(&f, path, flag, err);
-  if (st == SS_OK) ss_atomic_abort(&f);
-  return st;
+  ssError e;
+  ss_error_clear(&e);
+  if (ss_atomic_check(path, &e) != SS_OK)
+    return ss_error_set(err, SS_ERR_IO, path, 0, "%s: %s", flag, e.message);
+  return SS_OK;
 }
 
 /* mkdir -p: create dir and its missing parents. */
@@ -808,43 +808,63 @@ static void apply_solver_overrides(const Options *o, ssModel *m)
   if (o->warm_start >= 0) m->opt.terrain_warm_start = o->warm_start;
 }
 
-static void print_summary(const Options *o, const ssModel *m, const ssData *d,
-                          long steps, double wall, long nframes,
-                          long unconverged, const ssCheckpointInfo *restored)
+/* Whether an output is the pipe or file standard output writes to
+ * (--csv /dev/stdout | ...): the summary then goes to standard error, out
+ * of the data.  A terminal or /dev/null keeps it on standard output. */
+static int output_is_stdout(const Options *o)
+{
+  struct stat so, st;
+  if (fstat(STDOUT_FILENO, &so) != 0 || S_ISCHR(so.st_mode)) return 0;
+  const char *path[3] = {o->export_path, o->csv_path, o->rut_map};
+  for (int i = 0; i < 3 + o->nckpt; i++) {
+    const char *p = i < 3 ? path[i] : o->ckpt[i - 3].path;
+    if (p && stat(p, &st) == 0 && st.st_dev == so.st_dev &&
+        st.st_ino == so.st_ino)
+      return 1;
+  }
+  return 0;
+}
+
+static void print_summary(FILE *out, const Options *o, const ssModel *m,
+                          const ssData *d, long steps, double wall,
+                          long nframes, long unconverged,
+                          const ssCheckpointInfo *restored)
 {
   double sim = (double)steps * m->opt.timestep;
-  printf("scene       %s\n", o->scene);
+  fprintf(out, "scene       %s\n", o->scene);
   if (restored)
-    printf("restored    %s (step %ld, t = %.6g s)\n", o->restore,
-           restored->step, restored->time);
-  printf("steps       %ld (dt %g s)\n", steps, m->opt.timestep);
+    fprintf(out, "restored    %s (step %ld, t = %.6g s)\n", o->restore,
+            restored->step, restored->time);
+  fprintf(out, "steps       %ld (dt %g s)\n", steps, m->opt.timestep);
   double gap = d->time - sim;
   if (gap > 0.5 * m->opt.timestep || gap < -0.5 * m->opt.timestep)
-    printf("simulated   %.6g s (scene time now %.6g s)\n", sim, d->time);
+    fprintf(out, "simulated   %.6g s (scene time now %.6g s)\n", sim, d->time);
   else
-    printf("simulated   %.6g s\n", sim);
+    fprintf(out, "simulated   %.6g s\n", sim);
   if (wall > 0 && steps > 0)
-    printf("wall time   %.3f s (real-time factor %.3g)\n", wall, sim / wall);
+    fprintf(out, "wall time   %.3f s (real-time factor %.3g)\n", wall,
+            sim / wall);
   else
-    printf("wall time   %.3f s\n", wall);
+    fprintf(out, "wall time   %.3f s\n", wall);
   if (steps > 0) {
-    printf("sweeps      %d", d->stats.sweeps);
+    fprintf(out, "sweeps      %d", d->stats.sweeps);
     if (d->stats.newton > 0)
-      printf(" after %d Newton iteration%s", d->stats.newton, d->stats.newton == 1 ? "" : "s");
-    printf(" (last step)");
+      fprintf(out, " after %d Newton iteration%s", d->stats.newton,
+              d->stats.newton == 1 ? "" : "s");
+    fprintf(out, " (last step)");
     if (unconverged)
-      printf("; %ld step%s stopped at the sweep cap", unconverged,
-             unconverged == 1 ? "" : "s");
-    printf("\n");
+      fprintf(out, "; %ld step%s stopped at the sweep cap", unconverged,
+              unconverged == 1 ? "" : "s");
+    fputc('\n', out);
   }
-  if (o->export_path) printf("export      %s\n", o->export_path);
-  if (o->csv_path) printf("csv         %s\n", o->csv_path);
+  if (o->export_path) fprintf(out, "export      %s\n", o->export_path);
+  if (o->csv_path) fprintf(out, "csv         %s\n", o->csv_path);
   if (o->render_dir)
-    printf("frames      %s/frame_*.png (%ld)\n", o->render_dir, nframes);
-  if (o->rut_map) printf("rut map     %s\n", o->rut_map);
+    fprintf(out, "frames      %s/frame_*.png (%ld)\n", o->render_dir, nframes);
+  if (o->rut_map) fprintf(out, "rut map     %s\n", o->rut_map);
   for (int i = 0; i < o->nckpt; i++)
-    printf("checkpoint  %s (after step %ld)\n", o->ckpt[i].path,
-           o->ckpt[i].step);
+    fprintf(out, "checkpoint  %s (after step %ld)\n", o->ckpt[i].path,
+            o->ckpt[i].step);
 }
 
 static int run(const Options *o)
@@ -996,8 +1016,8 @@ static int run(const Options *o)
     if (ss_atomic_commit(&csv, &err) != SS_OK) goto fail;
   }
   if (!o->quiet)
-    print_summary(o, m, d, done, wall, nframes, unconverged,
-                  o->restore ? &restored : NULL);
+    print_summary(output_is_stdout(o) ? stderr : stdout, o, m, d, done, wall,
+                  nframes, unconverged, o->restore ? &restored : NULL);
   status = 0;
   goto cleanup;
 
