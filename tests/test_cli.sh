@@ -94,11 +94,13 @@ check "a value given to a flag: exit 2" 'usage_error && err_has "--quiet"'
 run "$PLATE" --export "$tmp/same" --csv "$tmp/same"
 check "--export and --csv on one path: exit 2" 'usage_error'
 
-# Outputs that are not new plain files.  A character device or FIFO is
-# written in place: the atomic writer's rename put a regular file in its
-# place (as root, /dev/null itself).  A symbolic link is followed (its
-# target replaced, the link kept), and a replaced file keeps its mode (a
-# 0600 file came back 0644).
+# Outputs that are not new plain files, and one file under two spellings.
+# A character device or FIFO is written in place: the atomic writer's
+# rename put a regular file in its place (as root, /dev/null itself).  A
+# symbolic link is followed (its target replaced, the link kept), and a
+# replaced file keeps its mode (a 0600 file came back 0644).  Two outputs
+# on one file (./, a link, the --render folder or one of its frame names)
+# are refused before the first step and create nothing.
 if [ "$(id -u)" -eq 0 ]; then
   mkdir "$tmp/dev"
   for d in csv xml png ckpt; do mknod "$tmp/dev/null.$d" c 1 3; done
@@ -156,6 +158,29 @@ run "$PLATE" --steps 3 --export "$tmp/private.xml" --quiet
 check "a replaced 0600 file stays 0600" \
   'rc_is 0 && grep -q "<raisim" "$tmp/private.xml" &&
    [ "$(ls -l "$tmp/private.xml" | cut -c1-10)" = "-rw-------" ]'
+run "$PLATE" --steps 5 --export "$tmp/same.xml" --csv "$tmp/./same.xml"
+check "--export F and --csv ./F: exit 2 naming both, nothing written" \
+  'usage_error && err_has "--export" && err_has "--csv" && no_file "$tmp/same.xml"'
+run "$PLATE" --steps 5 --export "$tmp/same.xml" --checkpoint "$tmp/./same.xml@1"
+check "--export F and --checkpoint ./F@1: exit 2 naming both" \
+  'usage_error && err_has "--export" && err_has "--checkpoint" && no_file "$tmp/same.xml"'
+run "$PLATE" --steps 5 --checkpoint "$tmp/k@1" --checkpoint "$tmp/./k@0"
+check "--checkpoint K@1 and --checkpoint ./K@0: exit 2" \
+  'usage_error && err_has "--checkpoint" && no_file "$tmp/k"'
+run "$PLATE" --steps 5 --export "$tmp/linked/target.csv" --csv "$tmp/link.csv"
+check "--export F and --csv LINK-TO-F: exit 2 naming both" \
+  'usage_error && err_has "--export" && err_has "--csv"'
+for o in --rut-map --export --csv; do
+  run "$PLATE" --steps 5 --render "$tmp/D" "$o" "$tmp/D"
+  check "--render D and $o D: exit 2 before the first step, no folder D" \
+    'usage_error && err_has "--render" && err_has "$o" && no_file "$tmp/D"'
+done
+run "$PLATE" --steps 5 --render "$tmp/D" --checkpoint "$tmp/D@2"
+check "--render D and --checkpoint D@2: exit 2, no folder D" \
+  'usage_error && err_has "--render" && err_has "--checkpoint" && no_file "$tmp/D"'
+run "$PLATE" --steps 1 --render "$tmp/fr" --rut-map "$tmp/fr/frame_000001.png"
+check "--render fr and --rut-map fr/frame_000001.png (a frame): exit 2, no folder" \
+  'usage_error && err_has "--render" && err_has "--rut-map" && no_file "$tmp/fr"'
 
 # ---------------------------------------------------------------------
 # bad input (exit 1): the message names the file and the line
