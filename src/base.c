@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 ssStatus ss_error_set(ssError *err, ssStatus code, const char *file, int line,
@@ -45,12 +46,39 @@ const char *ss_status_name(ssStatus code)
   return "unknown error";
 }
 
-/* The temporary file lives in the destination folder so that rename() is
- * atomic; its name carries the pid so concurrent writers do not collide.
- * O_EXCL | O_NOFOLLOW: a name that exists already (a leftover of a killed
- * run with the same pid, or a link planted there) is never opened; the
- * next suffix is tried instead. */
-ssStatus ss_atomic_open(ssAtomicFile *f, const char *path, ssError *err)
+/* ---------------------------------------------------------------------- */
+/* output files                                                            */
+
+enum { OUTPUT_NEW, OUTPUT_REPLACE, OUTPUT_STREAM };
+
+/* f->target: path with the symbolic links of its last component followed,
+ * as open() would follow them (a relative link is read from the link's
+ * folder); 0 or an errno. */
+static int follow_links(ssAtomicFile *f)
+{
+  char *t = f->target;
+  size_t cap = sizeof f->target;
+  snprintf(t, cap, "%s", f->path);
+  for (int hops = 0;; hops++) {
+    struct stat ls;
+    if (lstat(t, &ls) != 0 || !S_ISLNK(ls.st_mode)) return 0;
+    if (hops == 40) return ELOOP;
+    char link[sizeof f->target];
+    ssize_t n = readlink(t, link, sizeof link);
+    if (n < 0) return errno;
+    if ((size_t)n >= sizeof link) return ENAMETOOLONG;
+    link[n] = 0;
+    char *slash = strrchr(t, '/');
+    size_t keep = link[0] == '/' || !slash ? 0 : (size_t)(slash - t) + 1;
+    if (keep + (size_t)n >= cap) return ENAMETOOLONG;
+    memcpy(t + keep, link, (size_t)n + 1);
+  }
+}
+
+/* What path is (see ss_atomic_open): fills f->path and f->target, *kind
+ * and, for a file to replace, *st. */
+static ssStatus atomic_resolve(ssAtomicFile *f, const char *path,
+                               struct stat *st, int *kind, ssError *err)
 {
   memset(f, 0, sizeof *f);
   if (!path || !*path)
@@ -58,18 +86,116 @@ ssStatus ss_atomic_open(ssAtomicFile *f, const char *path, ssError *err)
   if (strlen(path) >= sizeof f->path)
     return ss_error_set(err, SS_ERR_IO, path, 0, "output path too long");
   snprintf(f->path, sizeof f->path, "%s", path);
+  if (stat(path, st) == 0) {
+    if (S_ISCHR(st->st_mode) || S_ISFIFO(st->st_mode)) {
+      /* /dev/stdout of a pipe leads to "pipe:[N]", no path: never follow
+       * a stream's links, open it by the name given */
+      snprintf(f->target, sizeof f->target, "%s", path);
+      *kind = OUTPUT_STREAM;
+      return SS_OK;
+    }
+    if (S_ISDIR(st->st_mode))
+      return ss_error_set(err, SS_ERR_IO, path, 0,
+                          "cannot write: is a directory");
+    if (!S_ISREG(st->st_mode))
+      return ss_error_set(err, SS_ERR_IO, path, 0,
+                          "cannot write: not a regular file, character "
+                          "device or FIFO");
+    *kind = OUTPUT_REPLACE;
+  } else if (errno == ENOENT) {
+    *kind = OUTPUT_NEW; /* nothing there, or a link to nothing yet */
+  } else {
+    int e = errno;
+    return ss_error_set(err, SS_ERR_IO, path, 0, "cannot write: %s",
+                        strerror(e));
+  }
+  int e = follow_links(f);
+  if (e)
+    return ss_error_set(err, SS_ERR_IO, path, 0, "cannot write: %s",
+                        strerror(e));
+  return SS_OK;
+}
+
+/* The temporary file takes the replaced file's owner and group where the
+ * system allows (root; a group the writer is in), as sed -i does, then
+ * its permission bits (rwx only: no set-id bit is passed on to new
+ * contents).  0, or -1 with errno when the bits cannot be set. */
+static int keep_owner_and_mode(int fd, const struct stat *st)
+{
+  if ((st->st_uid != geteuid() || st->st_gid != getegid()) &&
+      fchown(fd, st->st_uid, st->st_gid) != 0 &&
+      fchown(fd, (uid_t)-1, st->st_gid) != 0) {
+    /* the writer's owner and group, as for a new file */
+  }
+  return fchmod(fd, st->st_mode & 0777);
+}
+
+/* A character device or FIFO, opened in place for writing (a FIFO waits
+ * for its reader, as a shell's > does). */
+static ssStatus open_stream(ssAtomicFile *f, ssError *err)
+{
+  int fd = open(f->path, O_WRONLY | O_NOCTTY | O_CLOEXEC);
+  if (fd < 0) {
+    int e = errno;
+    return ss_error_set(err, SS_ERR_IO, f->path, 0, "cannot write: %s",
+                        strerror(e));
+  }
+  /* the name may have been replaced since the stat: never write into the
+   * middle of a regular file that took its place */
+  struct stat st;
+  if (fstat(fd, &st) != 0 || !(S_ISCHR(st.st_mode) || S_ISFIFO(st.st_mode))) {
+    close(fd);
+    return ss_error_set(err, SS_ERR_IO, f->path, 0,
+                        "cannot write: changed while being opened");
+  }
+  FILE *fp = fdopen(fd, "w");
+  if (!fp) {
+    int e = errno;
+    close(fd);
+    return ss_error_set(err, SS_ERR_IO, f->path, 0, "cannot write: %s",
+                        strerror(e));
+  }
+  f->fp = fp;
+  f->direct = 1;
+  return SS_OK;
+}
+
+/* The behaviour is described in soilsim.h.  The temporary file
+ * TARGET.tmpPID (TARGET.tmpPID.K when that name is taken) lives in the
+ * destination's folder so that rename() is atomic; its name carries the
+ * pid so concurrent writers do not collide.  O_EXCL | O_NOFOLLOW: a name
+ * that exists already (a leftover of a killed run with the same pid, or a
+ * link planted there) is never opened; the next suffix is tried instead. */
+ssStatus ss_atomic_open(ssAtomicFile *f, const char *path, ssError *err)
+{
+  struct stat st;
+  int kind = OUTPUT_NEW;
+  ssStatus s = atomic_resolve(f, path, &st, &kind, err);
+  if (s != SS_OK) return s;
+  if (kind == OUTPUT_STREAM) return open_stream(f, err);
+
   int fd = -1, e = EEXIST;
   for (int k = 0; k < 100 && fd < 0 && e == EEXIST; k++) {
     if (k == 0)
-      snprintf(f->tmp_path, sizeof f->tmp_path, "%s.tmp%ld", path, (long)getpid());
+      snprintf(f->tmp_path, sizeof f->tmp_path, "%s.tmp%ld", f->target,
+               (long)getpid());
     else
-      snprintf(f->tmp_path, sizeof f->tmp_path, "%s.tmp%ld.%d", path, (long)getpid(), k);
+      snprintf(f->tmp_path, sizeof f->tmp_path, "%s.tmp%ld.%d", f->target,
+               (long)getpid(), k);
     fd = open(f->tmp_path, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
     e = fd < 0 ? errno : 0;
   }
   if (fd < 0) {
     f->tmp_path[0] = 0;
     return ss_error_set(err, SS_ERR_IO, path, 0, "cannot write: %s", strerror(e));
+  }
+  if (kind == OUTPUT_REPLACE && keep_owner_and_mode(fd, &st) != 0) {
+    e = errno;
+    close(fd);
+    unlink(f->tmp_path);
+    f->tmp_path[0] = 0;
+    return ss_error_set(err, SS_ERR_IO, path, 0,
+                        "cannot keep the file's permissions: %s", strerror(e));
   }
   FILE *fp = fdopen(fd, "w");
   if (!fp) {
@@ -81,6 +207,28 @@ ssStatus ss_atomic_open(ssAtomicFile *f, const char *path, ssError *err)
   }
   f->fp = fp;
   return SS_OK;
+}
+
+ssStatus ss_atomic_check(const char *path, ssError *err)
+{
+  ssAtomicFile f;
+  struct stat st;
+  int kind = OUTPUT_NEW;
+  ssStatus s = atomic_resolve(&f, path, &st, &kind, err);
+  if (s != SS_OK) return s;
+  if (kind == OUTPUT_STREAM) {
+    /* not opened: a FIFO would wait for its reader here, and closing it
+     * again would hand the reader an end of file before the output */
+    if (access(path, W_OK) != 0) {
+      int e = errno;
+      return ss_error_set(err, SS_ERR_IO, path, 0, "cannot write: %s",
+                          strerror(e));
+    }
+    return SS_OK;
+  }
+  s = ss_atomic_open(&f, path, err);
+  if (s == SS_OK) ss_atomic_abort(&f);
+  return s;
 }
 
 int ss_atomic_write(ssAtomicFile *f, const void *buf, size_t n)
@@ -106,7 +254,8 @@ ssStatus ss_atomic_commit(ssAtomicFile *f, ssError *err)
   int bad = fflush(fp) != 0;
   if (bad && !e) e = errno;
   if (e || ferror(fp)) bad = 1;
-  if (!bad && fsync(fileno(fp)) != 0 && errno != EINVAL) {
+  /* a stream has nothing to sync (fsync fails with EINVAL on pipes) */
+  if (!bad && !f->direct && fsync(fileno(fp)) != 0 && errno != EINVAL) {
     bad = 1;
     e = errno;
   }
@@ -116,13 +265,16 @@ ssStatus ss_atomic_commit(ssAtomicFile *f, ssError *err)
   }
   f->fp = NULL;
   if (bad) {
-    unlink(f->tmp_path);
+    if (f->tmp_path[0]) unlink(f->tmp_path);
+    f->tmp_path[0] = 0;
     return ss_error_set(err, SS_ERR_IO, f->path, 0, "write failed: %s",
                         strerror(e ? e : EIO));
   }
-  if (rename(f->tmp_path, f->path) != 0) {
+  if (f->direct) return SS_OK;
+  if (rename(f->tmp_path, f->target) != 0) {
     e = errno;
     unlink(f->tmp_path);
+    f->tmp_path[0] = 0;
     return ss_error_set(err, SS_ERR_IO, f->path, 0, "cannot replace file: %s",
                         strerror(e));
   }
@@ -130,6 +282,8 @@ ssStatus ss_atomic_commit(ssAtomicFile *f, ssError *err)
   return SS_OK;
 }
 
+/* A stream keeps what has been written to it; stdio's buffer goes out
+ * with the close, as it would at exit. */
 void ss_atomic_abort(ssAtomicFile *f)
 {
   if (f->fp) {

@@ -4,10 +4,13 @@
  * first step, steps the world, and writes the requested outputs: an export
  * of the final world, a per-step CSV, rendered frames and a rut map.  Each
  * output file is replaced atomically, so a failed or interrupted run never
- * leaves a half-written file behind.
+ * leaves a half-written file behind (a device or FIFO, /dev/stdout for
+ * one, is written in place: see ss_atomic_open).
  *
  * Exit status: 0 success; 1 bad input or a failed run (the message names
  * the file and line); 2 bad usage.  Only this file prints or exits. */
+/* realpath() is XSI, beyond the _POSIX_C_SOURCE the build sets */
+#define _XOPEN_SOURCE 700
 #include "soilsim.h"
 
 #include <errno.h>
@@ -270,11 +273,9 @@ static int add_checkpoint(Options *o, const char *arg)
   if (!at || at == arg || !parse_long(at + 1, 0, LONG_MAX, &step))
     return usage_error("invalid --checkpoint value '%s': expected FILE@STEP "
                        "with STEP an integer >= 0", arg);
+  /* one file given twice is refused with the other outputs on one file,
+   * in check_clashes */
   size_t n = (size_t)(at - arg);
-  for (int i = 0; i < o->nckpt; i++)
-    if (strlen(o->ckpt[i].path) == n && !memcmp(o->ckpt[i].path, arg, n))
-      return usage_error("--checkpoint writes '%.*s' twice ('%s' and '%s')",
-                         (int)n, arg, o->ckpt[i].arg, arg);
   CheckpointReq *c = realloc(o->ckpt, (size_t)(o->nckpt + 1) * sizeof *c);
   if (!c) {
     fputs("soilsim: error: out of memory\n", stderr);
@@ -325,6 +326,184 @@ static int add_removal(Options *o, const char *arg)
   r[o->nremoval].step = step;
   o->nremoval++;
   return -1;
+}
+
+/* ---------------------------------------------------------------------- */
+/* outputs on one file                                                     */
+
+/* One output, for telling whether two outputs are one file. */
+typedef struct OutputName {
+  const char *flag; /* "--export", ... */
+  const char *arg;  /* as given (a checkpoint's FILE@STEP), for messages */
+  char *abs;        /* the normalised absolute path (owned) */
+  int exists;       /* dev and ino are those of the file there now */
+  dev_t dev;
+  ino_t ino;
+} OutputName;
+
+/* dir (consumed) with the path component last[0..n) appended: "." adds
+ * nothing and ".." takes dir's last component off (dir has no links to
+ * resolve first: it came from realpath, or does not exist).  NULL when
+ * out of memory. */
+static char *append_component(char *dir, const char *last, size_t n)
+{
+  if (n == 0 || (n == 1 && last[0] == '.')) return dir;
+  if (n == 2 && last[0] == '.' && last[1] == '.') {
+    char *slash = strrchr(dir, '/');
+    if (slash == dir) slash[1] = 0;
+    else if (slash) *slash = 0;
+    return dir;
+  }
+  size_t d = strlen(dir);
+  size_t sep = d > 0 && dir[d - 1] != '/';
+  char *r = malloc(d + sep + n + 1);
+  if (r) {
+    memcpy(r, dir, d);
+    if (sep) r[d] = '/';
+    memcpy(r + d + sep, last, n);
+    r[d + sep + n] = 0;
+  }
+  free(dir);
+  return r;
+}
+
+/* The absolute form of an output path (malloc'd; NULL when out of
+ * memory): realpath of the path where it exists; else its folder's,
+ * found the same way (it may not exist yet either: --render creates
+ * folders), with the last component appended.  A link to nothing yet
+ * counts as the path it names, where the writers create the file. */
+static char *normalise_path(const char *path, int depth)
+{
+  char *r = realpath(path, NULL);
+  if (r) return r;
+  if (depth > 64) return strdup(path); /* a cycle, or a folder deleted under us */
+  struct stat ls;
+  char link[PATH_MAX];
+  ssize_t nl;
+  if (lstat(path, &ls) == 0 && S_ISLNK(ls.st_mode) &&
+      (nl = readlink(path, link, sizeof link - 1)) > 0) {
+    link[nl] = 0;
+    const char *slash = strrchr(path, '/');
+    size_t keep = link[0] == '/' || !slash ? 0 : (size_t)(slash - path) + 1;
+    char *t = malloc(keep + (size_t)nl + 1);
+    if (!t) return NULL;
+    memcpy(t, path, keep);
+    memcpy(t + keep, link, (size_t)nl + 1);
+    r = normalise_path(t, depth + 1);
+    free(t);
+    return r;
+  }
+  size_t n = strlen(path);
+  while (n > 1 && path[n - 1] == '/') n--;
+  size_t b = n;
+  while (b > 0 && path[b - 1] != '/') b--;
+  char *dir = b ? strndup(path, b) : strdup(".");
+  if (!dir) return NULL;
+  char *pd = normalise_path(dir, depth + 1);
+  free(dir);
+  return pd ? append_component(pd, path + b, n - b) : NULL;
+}
+
+static int same_output(const OutputName *a, const OutputName *b)
+{
+  if (a->exists && b->exists) return a->dev == b->dev && a->ino == b->ino;
+  return !strcmp(a->abs, b->abs);
+}
+
+/* Whether name is a frame's: frame_%06ld.png, as render_step names them.
+ * Every such name in the --render folder is the renderer's, whether or
+ * not this run's --steps and --render-every reach that step. */
+static int is_frame_name(const char *name)
+{
+  const char *digits = name + 6, *dot = strrchr(name, '.');
+  if (strncmp(name, "frame_", 6) || !dot || strcmp(dot, ".png")) return 0;
+  char buf[32], again[32];
+  size_t nd = (size_t)(dot - digits);
+  if (nd == 0 || nd >= sizeof buf) return 0;
+  memcpy(buf, digits, nd);
+  buf[nd] = 0;
+  long k;
+  if (strspn(buf, "0123456789") != nd || !parse_long(buf, 0, LONG_MAX, &k))
+    return 0;
+  snprintf(again, sizeof again, "%06ld", k);
+  return !strcmp(again, buf);
+}
+
+/* Two outputs on one file would overwrite each other, one of them lost
+ * (or fail after the whole run, when one is the --render folder): a usage
+ * error, found before anything is created.  Paths are compared by their
+ * absolute form and, where both exist, by device and inode, so e.xml,
+ * ./e.xml, a symbolic link to it and a hard link are one file.  --render
+ * DIR owns DIR (a folder, with its missing parents) and the frame names
+ * in it.  Returns -1, 2, or 1 when out of memory. */
+static int check_clashes(const Options *o)
+{
+  int n = 0, rc = -1;
+  OutputName *out = calloc((size_t)o->nckpt + 4, sizeof *out);
+  if (!out) goto nomem;
+  const char *file[3] = {o->export_path, o->csv_path, o->rut_map};
+  const char *flag[3] = {"--export", "--csv", "--rut-map"};
+  for (int i = 0; i < 3 + o->nckpt + 1; i++) {
+    const char *path, *f, *arg;
+    if (i < 3) {
+      path = arg = file[i];
+      f = flag[i];
+    } else if (i < 3 + o->nckpt) {
+      path = o->ckpt[i - 3].path;
+      arg = o->ckpt[i - 3].arg;
+      f = "--checkpoint";
+    } else {
+      path = arg = o->render_dir; /* last: out[n - 1] when given */
+      f = "--render";
+    }
+    if (!path) continue;
+    OutputName *u = &out[n++];
+    u->flag = f;
+    u->arg = arg;
+    u->abs = normalise_path(path, 0);
+    if (!u->abs) goto nomem;
+    struct stat st;
+    if (stat(path, &st) == 0) {
+      u->exists = 1;
+      u->dev = st.st_dev;
+      u->ino = st.st_ino;
+    }
+  }
+  int nfile = o->render_dir ? n - 1 : n;
+  for (int i = 0; i < nfile && rc < 0; i++)
+    for (int j = i + 1; j < nfile && rc < 0; j++)
+      if (same_output(&out[i], &out[j]))
+        rc = usage_error("%s '%s' and %s '%s' write the same file",
+                         out[i].flag, out[i].arg, out[j].flag, out[j].arg);
+  if (o->render_dir && rc < 0) {
+    const OutputName *r = &out[n - 1];
+    size_t nr = strlen(r->abs);
+    for (int i = 0; i < nfile && rc < 0; i++) {
+      const OutputName *u = &out[i];
+      size_t nu = strlen(u->abs);
+      const char *slash = strrchr(u->abs, '/');
+      if (same_output(r, u))
+        rc = usage_error("--render '%s' and %s '%s' name one path: the "
+                         "folder of the frames", r->arg, u->flag, u->arg);
+      else if (nu < nr && !strncmp(r->abs, u->abs, nu) &&
+               (r->abs[nu] == '/' || u->abs[nu - 1] == '/'))
+        rc = usage_error("%s '%s' is a folder of --render '%s'", u->flag,
+                         u->arg, r->arg);
+      else if (slash && (size_t)(slash - u->abs) == (nr > 1 ? nr : 0) &&
+               !strncmp(u->abs, r->abs, nr > 1 ? nr : 0) &&
+               is_frame_name(slash + 1))
+        rc = usage_error("%s '%s' has the name of a frame of --render '%s'",
+                         u->flag, u->arg, r->arg);
+    }
+  }
+  goto done;
+nomem:
+  fputs("soilsim: error: out of memory\n", stderr);
+  rc = EXIT_RUN_FAILED;
+done:
+  for (int i = 0; i < n; i++) free(out[i].abs);
+  free(out);
+  return rc;
 }
 
 /* Returns -1 to go on running, or the exit status (0 after --help or
@@ -512,35 +691,21 @@ static int parse_args(int argc, char **argv, Options *o)
                          "(--steps %ld%s)", o->ckpt[i].arg, o->ckpt[i].step,
                          o->steps, steps_given ? "" : ", the default");
 
-  /* two outputs on one path would overwrite each other */
-  const char *out[3] = {o->export_path, o->csv_path, o->rut_map};
-  const char *flag[3] = {"--export", "--csv", "--rut-map"};
-  for (int i = 0; i < 3; i++)
-    for (int j = i + 1; j < 3; j++)
-      if (out[i] && out[j] && !strcmp(out[i], out[j]))
-        return usage_error("%s and %s both write '%s'", flag[i], flag[j],
-                           out[i]);
-  for (int i = 0; i < 3; i++)
-    for (int k = 0; k < o->nckpt; k++)
-      if (out[i] && !strcmp(out[i], o->ckpt[k].path))
-        return usage_error("%s and --checkpoint %s both write '%s'", flag[i],
-                           o->ckpt[k].arg, out[i]);
-  return -1;
+  /* two outputs on one file would overwrite each other */
+  return check_clashes(o);
 }
 
 /* ---------------------------------------------------------------------- */
 /* checks made before the first step                                       */
 
-/* An output file must be replaceable: not a folder, and its folder must
- * take a new file (the atomic writer creates its temporary file there).
- * open_output opens it (the --csv rows are written as the run goes);
- * check_output only tries, for the outputs written at the end. */
+/* An output must be writable as ss_atomic_open writes it: a new or
+ * replaced file needs a folder that takes its temporary file (a folder is
+ * refused), a stream (/dev/stdout, a FIFO) write permission.  open_output
+ * opens it (the --csv rows are written as the run goes); check_output
+ * only tries, for the outputs written later, and never opens a FIFO (its
+ * reader would see the end of the output before it began). */
 static ssStatus open_output(ssAtomicFile *f, const char *path, const char *flag, ssError *err)
 {
-  struct stat st;
-  if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
-    return ss_error_set(err, SS_ERR_IO, path, 0,
-                        "%s: cannot write: is a directory", flag);
   ssError e;
   ss_error_clear(&e);
   if (ss_atomic_open(f, path, &e) != SS_OK)
@@ -550,10 +715,11 @@ static ssStatus open_output(ssAtomicFile *f, const char *path, const char *flag,
 
 static ssStatus check_output(const char *path, const char *flag, ssError *err)
 {
-  ssAtomicFile f;
-  ssStatus st = open_output(&f, path, flag, err);
-  if (st == SS_OK) ss_atomic_abort(&f);
-  return st;
+  ssError e;
+  ss_error_clear(&e);
+  if (ss_atomic_check(path, &e) != SS_OK)
+    return ss_error_set(err, SS_ERR_IO, path, 0, "%s: %s", flag, e.message);
+  return SS_OK;
 }
 
 /* mkdir -p: create dir and its missing parents. */
@@ -808,43 +974,63 @@ static void apply_solver_overrides(const Options *o, ssModel *m)
   if (o->warm_start >= 0) m->opt.terrain_warm_start = o->warm_start;
 }
 
-static void print_summary(const Options *o, const ssModel *m, const ssData *d,
-                          long steps, double wall, long nframes,
-                          long unconverged, const ssCheckpointInfo *restored)
+/* Whether an output is the pipe or file standard output writes to
+ * (--csv /dev/stdout | ...): the summary then goes to standard error, out
+ * of the data.  A terminal or /dev/null keeps it on standard output. */
+static int output_is_stdout(const Options *o)
+{
+  struct stat so, st;
+  if (fstat(STDOUT_FILENO, &so) != 0 || S_ISCHR(so.st_mode)) return 0;
+  const char *path[3] = {o->export_path, o->csv_path, o->rut_map};
+  for (int i = 0; i < 3 + o->nckpt; i++) {
+    const char *p = i < 3 ? path[i] : o->ckpt[i - 3].path;
+    if (p && stat(p, &st) == 0 && st.st_dev == so.st_dev &&
+        st.st_ino == so.st_ino)
+      return 1;
+  }
+  return 0;
+}
+
+static void print_summary(FILE *out, const Options *o, const ssModel *m,
+                          const ssData *d, long steps, double wall,
+                          long nframes, long unconverged,
+                          const ssCheckpointInfo *restored)
 {
   double sim = (double)steps * m->opt.timestep;
-  printf("scene       %s\n", o->scene);
+  fprintf(out, "scene       %s\n", o->scene);
   if (restored)
-    printf("restored    %s (step %ld, t = %.6g s)\n", o->restore,
-           restored->step, restored->time);
-  printf("steps       %ld (dt %g s)\n", steps, m->opt.timestep);
+    fprintf(out, "restored    %s (step %ld, t = %.6g s)\n", o->restore,
+            restored->step, restored->time);
+  fprintf(out, "steps       %ld (dt %g s)\n", steps, m->opt.timestep);
   double gap = d->time - sim;
   if (gap > 0.5 * m->opt.timestep || gap < -0.5 * m->opt.timestep)
-    printf("simulated   %.6g s (scene time now %.6g s)\n", sim, d->time);
+    fprintf(out, "simulated   %.6g s (scene time now %.6g s)\n", sim, d->time);
   else
-    printf("simulated   %.6g s\n", sim);
+    fprintf(out, "simulated   %.6g s\n", sim);
   if (wall > 0 && steps > 0)
-    printf("wall time   %.3f s (real-time factor %.3g)\n", wall, sim / wall);
+    fprintf(out, "wall time   %.3f s (real-time factor %.3g)\n", wall,
+            sim / wall);
   else
-    printf("wall time   %.3f s\n", wall);
+    fprintf(out, "wall time   %.3f s\n", wall);
   if (steps > 0) {
-    printf("sweeps      %d", d->stats.sweeps);
+    fprintf(out, "sweeps      %d", d->stats.sweeps);
     if (d->stats.newton > 0)
-      printf(" after %d Newton iteration%s", d->stats.newton, d->stats.newton == 1 ? "" : "s");
-    printf(" (last step)");
+      fprintf(out, " after %d Newton iteration%s", d->stats.newton,
+              d->stats.newton == 1 ? "" : "s");
+    fprintf(out, " (last step)");
     if (unconverged)
-      printf("; %ld step%s stopped at the sweep cap", unconverged,
-             unconverged == 1 ? "" : "s");
-    printf("\n");
+      fprintf(out, "; %ld step%s stopped at the sweep cap", unconverged,
+              unconverged == 1 ? "" : "s");
+    fputc('\n', out);
   }
-  if (o->export_path) printf("export      %s\n", o->export_path);
-  if (o->csv_path) printf("csv         %s\n", o->csv_path);
+  if (o->export_path) fprintf(out, "export      %s\n", o->export_path);
+  if (o->csv_path) fprintf(out, "csv         %s\n", o->csv_path);
   if (o->render_dir)
-    printf("frames      %s/frame_*.png (%ld)\n", o->render_dir, nframes);
-  if (o->rut_map) printf("rut map     %s\n", o->rut_map);
+    fprintf(out, "frames      %s/frame_*.png (%ld)\n", o->render_dir, nframes);
+  if (o->rut_map) fprintf(out, "rut map     %s\n", o->rut_map);
   for (int i = 0; i < o->nckpt; i++)
-    printf("checkpoint  %s (after step %ld)\n", o->ckpt[i].path,
-           o->ckpt[i].step);
+    fprintf(out, "checkpoint  %s (after step %ld)\n", o->ckpt[i].path,
+            o->ckpt[i].step);
 }
 
 static int run(const Options *o)
@@ -1004,8 +1190,8 @@ static int run(const Options *o)
     if (ss_atomic_commit(&csv, &err) != SS_OK) goto fail;
   }
   if (!o->quiet)
-    print_summary(o, m, d, done, wall, nframes, unconverged,
-                  o->restore ? &restored : NULL);
+    print_summary(output_is_stdout(o) ? stderr : stdout, o, m, d, done, wall,
+                  nframes, unconverged, o->restore ? &restored : NULL);
   status = 0;
   goto cleanup;
 

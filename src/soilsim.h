@@ -601,7 +601,8 @@ ssStatus ss_scene_load_buffer(const char *buf, size_t len,
                               const char *base_path, ssModel **mout,
                               ssData **dout, ssError *err);
 /* Write the whole world (model + current state + soil arrays) as XML,
- * atomically (temporary file, then rename). */
+ * atomically (temporary file, then rename; a stream such as /dev/stdout
+ * is written in place, see ss_atomic_open). */
 ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
                          ssError *err);
 
@@ -680,8 +681,8 @@ typedef struct ssCheckpointInfo {
   size_t bytes;       /* size of the checkpoint */
 } ssCheckpointInfo;
 
-/* Write the state of d, atomically (temporary file, then rename).  Only
- * between steps. */
+/* Write the state of d, atomically (temporary file, then rename; see
+ * ss_atomic_open).  Only between steps. */
 ssStatus ss_checkpoint_save(const ssModel *m, const ssData *d,
                             const char *path, ssError *err);
 /* Restore a checkpoint into d, which must have been made for m
@@ -713,28 +714,58 @@ ssStatus ss_checkpoint_info_buffer(const void *buf, size_t len,
 void ss_option_copy_solver(ssOption *dst, const ssOption *src);
 
 /* ---------------------------------------------------------------------- */
-/* atomic output files (temporary file in the same folder, then rename)    */
+/* output files: atomic (temporary file, then rename), or streams        */
 
 typedef struct ssAtomicFile {
   void *fp;            /* FILE*, open for writing while active */
   int error;           /* errno of the first failed write, 0 if none */
-  char path[1024];
-  char tmp_path[1056];
+  int direct;          /* 1: a character device or FIFO, written in place */
+  char path[1024];     /* the path as given (messages) */
+  char target[1024];   /* the file replaced: path, its symbolic links followed */
+  char tmp_path[1056]; /* target.tmpPID while writing; empty for a stream */
 } ssAtomicFile;
 
-/* Opens a new temporary file PATH.tmpPID (PATH.tmpPID.K when that name is
- * taken) in the destination folder, created exclusively and never through
- * a symbolic link, so a file or link planted under that name is neither
- * followed nor overwritten. */
+/* Opens PATH for writing.  What that means depends on what PATH is now
+ * (stat, following symbolic links):
+ *
+ * - nothing: a new file, made by renaming a complete temporary file;
+ * - a regular file: replaced by renaming a complete temporary file that
+ *   has been given the old file's permission bits (rwx; a 0600 file stays
+ *   0600) and, where the system allows it (root; a group the writer is
+ *   in), its owner and group;
+ * - a symbolic link, to a file or to nothing yet: followed, link after
+ *   link, and the file it leads to is written as above, the temporary file
+ *   in that file's folder (renaming in the link's folder would put a
+ *   regular file in place of the link);
+ * - a character device or a FIFO (/dev/null, /dev/stdout, a terminal, a
+ *   pipe): written in place, with no temporary file and no rename, which
+ *   would put a regular file in place of the device or FIFO (as root,
+ *   /dev/null itself); a FIFO's open waits for its reader.  Atomicity does
+ *   not apply to a stream: what was written before a failure stays
+ *   written;
+ * - a directory, a block device, a socket: an error naming the path
+ *   ("cannot write: is a directory").
+ *
+ * The temporary file is TARGET.tmpPID (TARGET.tmpPID.K when that name is
+ * taken), created exclusively and never through a symbolic link, so a
+ * file or link planted under that name is neither followed nor
+ * overwritten. */
 ssStatus ss_atomic_open(ssAtomicFile *f, const char *path, ssError *err);
+/* Whether PATH can be written, as ss_atomic_open would write it, without
+ * writing it: a temporary file is created and removed; a stream is not
+ * opened (a FIFO would wait for its reader, and closing it would give the
+ * reader an end of file), only checked for write permission. */
+ssStatus ss_atomic_check(const char *path, ssError *err);
 /* Writes n bytes; returns 0, or -1 after a failure, whose errno is kept
  * for the message of ss_atomic_commit (later writes do nothing). */
 int ss_atomic_write(ssAtomicFile *f, const void *buf, size_t n);
-/* Flush, sync, close and rename over path; on failure (including an
- * earlier failed write, whose reason it reports: "write failed: No space
- * left on device") the temporary file is removed and the old file stays. */
+/* Flush, sync, close and rename over the target (a stream: flush and
+ * close); on failure (including an earlier failed write, whose reason it
+ * reports: "write failed: No space left on device") the temporary file is
+ * removed and the old file stays. */
 ssStatus ss_atomic_commit(ssAtomicFile *f, ssError *err);
-/* Close and delete the temporary file (safe to call after commit). */
+/* Close and delete the temporary file (safe to call after commit); a
+ * stream is closed. */
 void ss_atomic_abort(ssAtomicFile *f);
 
 #ifdef __cplusplus

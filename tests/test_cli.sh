@@ -94,6 +94,94 @@ check "a value given to a flag: exit 2" 'usage_error && err_has "--quiet"'
 run "$PLATE" --export "$tmp/same" --csv "$tmp/same"
 check "--export and --csv on one path: exit 2" 'usage_error'
 
+# Outputs that are not new plain files, and one file under two spellings.
+# A character device or FIFO is written in place: the atomic writer's
+# rename put a regular file in its place (as root, /dev/null itself).  A
+# symbolic link is followed (its target replaced, the link kept), and a
+# replaced file keeps its mode (a 0600 file came back 0644).  Two outputs
+# on one file (./, a link, the --render folder or one of its frame names)
+# are refused before the first step and create nothing.
+if [ "$(id -u)" -eq 0 ]; then
+  mkdir "$tmp/dev"
+  for d in csv xml png ckpt; do mknod "$tmp/dev/null.$d" c 1 3; done
+  run "$PLATE" --steps 3 --csv "$tmp/dev/null.csv" --export "$tmp/dev/null.xml" \
+    --rut-map "$tmp/dev/null.png" --checkpoint "$tmp/dev/null.ckpt@2" --quiet
+  check "outputs to copies of /dev/null (mknod c 1 3): written in place, still devices" \
+    'rc_is 0 && [ -c "$tmp/dev/null.csv" ] && [ -c "$tmp/dev/null.xml" ] &&
+     [ -c "$tmp/dev/null.png" ] && [ -c "$tmp/dev/null.ckpt" ] && no_tmp "$tmp/dev"'
+  # the export goes to a FIFO: checked before the first step without being
+  # opened (the reader would see an end of file), then written in place
+  mkfifo "$tmp/dev/fifo"
+  cat "$tmp/dev/fifo" >"$tmp/dev/fifo.xml" &
+  reader=$!
+  run "$PLATE" --steps 3 --export "$tmp/dev/fifo" --quiet
+  i=0
+  while [ $i -lt 50 ] && kill -0 "$reader" 2>/dev/null; do
+    sleep 0.1 2>/dev/null || sleep 1
+    i=$((i + 1))
+  done
+  kill "$reader" 2>/dev/null
+  wait "$reader" 2>/dev/null
+  rc1=$rc
+  run "$PLATE" --steps 3 --export "$tmp/dev/plain.xml" --quiet
+  check "--export to a FIFO: its reader gets the whole export, the FIFO stays" \
+    '[ "$rc1" -eq 0 ] && [ -p "$tmp/dev/fifo" ] && [ -s "$tmp/dev/plain.xml" ] &&
+     cmp -s "$tmp/dev/fifo.xml" "$tmp/dev/plain.xml" && no_tmp "$tmp/dev"'
+else
+  skip "not root: no device node (mknod) for the output tests"
+  skip "not root: the FIFO output test is run as root only"
+fi
+# /dev/stdout is a link to /proc/self/fd/1; a link of our own to it is
+# the same output, and a writer that renamed over it would replace only
+# that link, never the system's /dev/stdout
+if [ -e /proc/self/fd/1 ] && ln -s /proc/self/fd/1 "$tmp/stdout"; then
+  last_cmd="soilsim --steps 3 --csv $tmp/stdout | cat"
+  CI='' $TIMEOUT "$SOILSIM" "$PLATE" --steps 3 --csv "$tmp/stdout" 2>"$tmp/err" |
+    cat >"$tmp/piped.csv"
+  rc=$?
+  check "--csv /dev/stdout (a link to /proc/self/fd/1) into a pipe: the CSV alone, the summary on stderr" \
+    'rc_is 0 && [ -L "$tmp/stdout" ] && [ "$(wc -l <"$tmp/piped.csv")" -eq 4 ] &&
+     head -n 1 "$tmp/piped.csv" | grep -q "^step,time," && err_has "csv         $tmp/stdout"'
+else
+  skip "no /proc/self/fd/1 to stand for /dev/stdout"
+fi
+mkdir "$tmp/linked"
+echo "old" >"$tmp/linked/target.csv"
+ln -s linked/target.csv "$tmp/link.csv"
+run "$PLATE" --steps 3 --csv "$tmp/link.csv" --quiet
+check "--csv to a symbolic link: the file it points to is replaced, the link stays" \
+  'rc_is 0 && [ -L "$tmp/link.csv" ] && [ "$(wc -l <"$tmp/linked/target.csv")" -eq 4 ] &&
+   no_tmp "$tmp" && no_tmp "$tmp/linked"'
+echo "old" >"$tmp/private.xml"
+chmod 600 "$tmp/private.xml"
+run "$PLATE" --steps 3 --export "$tmp/private.xml" --quiet
+check "a replaced 0600 file stays 0600" \
+  'rc_is 0 && grep -q "<raisim" "$tmp/private.xml" &&
+   [ "$(ls -l "$tmp/private.xml" | cut -c1-10)" = "-rw-------" ]'
+run "$PLATE" --steps 5 --export "$tmp/same.xml" --csv "$tmp/./same.xml"
+check "--export F and --csv ./F: exit 2 naming both, nothing written" \
+  'usage_error && err_has "--export" && err_has "--csv" && no_file "$tmp/same.xml"'
+run "$PLATE" --steps 5 --export "$tmp/same.xml" --checkpoint "$tmp/./same.xml@1"
+check "--export F and --checkpoint ./F@1: exit 2 naming both" \
+  'usage_error && err_has "--export" && err_has "--checkpoint" && no_file "$tmp/same.xml"'
+run "$PLATE" --steps 5 --checkpoint "$tmp/k@1" --checkpoint "$tmp/./k@0"
+check "--checkpoint K@1 and --checkpoint ./K@0: exit 2" \
+  'usage_error && err_has "--checkpoint" && no_file "$tmp/k"'
+run "$PLATE" --steps 5 --export "$tmp/linked/target.csv" --csv "$tmp/link.csv"
+check "--export F and --csv LINK-TO-F: exit 2 naming both" \
+  'usage_error && err_has "--export" && err_has "--csv"'
+for o in --rut-map --export --csv; do
+  run "$PLATE" --steps 5 --render "$tmp/D" "$o" "$tmp/D"
+  check "--render D and $o D: exit 2 before the first step, no folder D" \
+    'usage_error && err_has "--render" && err_has "$o" && no_file "$tmp/D"'
+done
+run "$PLATE" --steps 5 --render "$tmp/D" --checkpoint "$tmp/D@2"
+check "--render D and --checkpoint D@2: exit 2, no folder D" \
+  'usage_error && err_has "--render" && err_has "--checkpoint" && no_file "$tmp/D"'
+run "$PLATE" --steps 1 --render "$tmp/fr" --rut-map "$tmp/fr/frame_000001.png"
+check "--render fr and --rut-map fr/frame_000001.png (a frame): exit 2, no folder" \
+  'usage_error && err_has "--render" && err_has "--rut-map" && no_file "$tmp/fr"'
+
 # ---------------------------------------------------------------------
 # bad input (exit 1): the message names the file and the line
 
