@@ -1108,6 +1108,17 @@ static int run(const Options *o)
       goto fail;
     }
   }
+  /* a name the scene does not hold is the option's error, said with the
+   * scene it was looked for in (the renderer's own message names neither) */
+  if (o->camera_follow) {
+    int s = ss_model_find_sys(m, o->camera_follow);
+    if (s < 0 || m->sys_nbody[s] < 1) {
+      ss_error_set(&err, SS_ERR_NOTFOUND, o->scene, 0,
+                   "--camera-follow '%s': the scene has no body or articulated "
+                   "system of that name", o->camera_follow);
+      goto fail;
+    }
+  }
   if (o->color) ropt.color_mode = o->color - 1;
   if (o->render_dir) {
     char probe[2048];

@@ -605,8 +605,8 @@ run "$PLATE" --steps 0 --camera-fov 30
 check "--camera-fov without --render: exit 2" 'usage_error'
 run "$PLATE" --steps 5 --render "$tmp/camD" --camera-pos 0,0,3 --camera-look-at 0,0.001,0 \
   --camera-follow nobody
-check "--camera-follow of an unknown body: exit 1 before stepping" \
-  'rc_is 1 && [ ! -e "$tmp/camD/frame_000005.png" ]'
+check "--camera-follow of an unknown body: exit 1 before stepping, naming the option and the scene" \
+  'rc_is 1 && [ ! -e "$tmp/camD/frame_000005.png" ] && err_has "plate.xml: error: --camera-follow" && err_has "nobody"'
 run "$PLATE" --steps 0 --render "$tmp/camE" --color rainbow
 check "--color with an unknown mode: exit 2" 'usage_error && err_has "rainbow"'
 
