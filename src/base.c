@@ -4,6 +4,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <stdarg.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -174,14 +175,20 @@ ssStatus ss_atomic_open(ssAtomicFile *f, const char *path, ssError *err)
   if (s != SS_OK) return s;
   if (kind == OUTPUT_STREAM) return open_stream(f, err);
 
+  /* the name's last component, cut so that with the suffix it stays a
+   * legal name (NAME_MAX): an output named with 246 to 255 characters
+   * failed with "File name too long" for its temporary file alone */
+  const char *slash = strrchr(f->target, '/');
+  size_t base = slash ? (size_t)(slash - f->target) + 1 : 0, len = strlen(f->target) - base;
   int fd = -1, e = EEXIST;
   for (int k = 0; k < 100 && fd < 0 && e == EEXIST; k++) {
+    char suffix[48];
     if (k == 0)
-      snprintf(f->tmp_path, sizeof f->tmp_path, "%s.tmp%ld", f->target,
-               (long)getpid());
+      snprintf(suffix, sizeof suffix, ".tmp%ld", (long)getpid());
     else
-      snprintf(f->tmp_path, sizeof f->tmp_path, "%s.tmp%ld.%d", f->target,
-               (long)getpid(), k);
+      snprintf(suffix, sizeof suffix, ".tmp%ld.%d", (long)getpid(), k);
+    size_t keep = len + strlen(suffix) > NAME_MAX ? NAME_MAX - strlen(suffix) : len;
+    snprintf(f->tmp_path, sizeof f->tmp_path, "%.*s%s", (int)(base + keep), f->target, suffix);
     fd = open(f->tmp_path, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
     e = fd < 0 ? errno : 0;
   }

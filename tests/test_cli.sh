@@ -225,6 +225,13 @@ check "unwritable --csv path: exit 1 before stepping, naming the option" \
 run "$PLATE" --steps 2000000000 --csv "$tmp"
 check "--csv naming a directory: exit 1 before stepping" \
   'rc_is 1 && err_has "--csv: cannot write: is a directory"'
+# a name of the longest legal length (255 bytes): its temporary file's name
+# is cut to stay legal too (it failed, "File name too long")
+long=$(printf '%0255d' 0)
+mkdir -p "$tmp/long"
+run "$PLATE" --steps 2 --csv "$tmp/long/$long" --export "$tmp/long/x$(printf '%0254d' 0)" --quiet
+check "outputs named with 255 characters are written, no temporary file left" \
+  'rc_is 0 && [ -s "$tmp/long/$long" ] && [ -s "$tmp/long/x$(printf "%0254d" 0)" ] && no_tmp "$tmp/long"'
 run "$PLATE" --steps 2000000000 --export "$tmp"
 check "--export naming a directory: exit 1 before stepping" \
   'rc_is 1 && err_has "directory"'
