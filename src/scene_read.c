@@ -399,7 +399,18 @@ static ssStatus el_open(readCtx *c, xmlNodePtr node, const char *parent_label,
     snprintf(e->label, sizeof e->label, "%s <%s>", parent_label, e->name);
   else
     snprintf(e->label, sizeof e->label, "<%s>", e->name);
+  /* the format has no namespaces: a prefixed name would otherwise be
+   * read by its local part (q:mass as mass) */
+  if (node->ns && node->ns->prefix)
+    return fail(c, SS_ERR_PARSE, e->line,
+                "namespaced element <%s:%s> (the scene format has no namespaces)",
+                (const char *)node->ns->prefix, e->raw);
   for (xmlAttrPtr a = node->properties; a; a = a->next) {
+    if (a->ns && a->ns->prefix)
+      return fail(c, SS_ERR_PARSE, e->line,
+                  "%s: namespaced attribute '%s:%s' (the scene format has no "
+                  "namespaces)", e->label, (const char *)a->ns->prefix,
+                  (const char *)a->name);
     if (e->nattr == MAX_ATTR)
       return fail(c, SS_ERR_PARSE, e->line, "%s: too many attributes (at most %d)",
                   e->label, MAX_ATTR);
@@ -699,6 +710,13 @@ static int child_el(readCtx *c, xmlNodePtr k, const xEl *parent,
 {
   if (k->type != XML_ELEMENT_NODE) {
     *st = check_other_node(c, k, parent);
+    return 0;
+  }
+  if (k->ns && k->ns->prefix) {
+    *st = fail(c, SS_ERR_PARSE, ss_xml_line(k),
+               "%s: namespaced element <%s:%s> (the scene format has no "
+               "namespaces)", parent->label, (const char *)k->ns->prefix,
+               (const char *)k->name);
     return 0;
   }
   norm_name((const char *)k->name, kn);

@@ -150,6 +150,13 @@ static ssStatus el_open(uCtx *c, xmlNodePtr node, const char *parent_label,
   else
     snprintf(e->label, sizeof e->label, "<%s>", e->name);
   for (xmlAttrPtr a = node->properties; a; a = a->next) {
+    /* URDF has no namespaced attributes: read by its local part, a
+     * prefixed one (xacro:mass) would stand for another */
+    if (a->ns && a->ns->prefix)
+      return fail(c, SS_ERR_PARSE, e->line,
+                  "%s: namespaced attribute '%s:%s' (expand xacro files "
+                  "first)", e->label, (const char *)a->ns->prefix,
+                  (const char *)a->name);
     if (e->nattr == MAX_ATTR)
       return fail(c, SS_ERR_PARSE, e->line,
                   "%s: too many attributes (at most %d)", e->label, MAX_ATTR);

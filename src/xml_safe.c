@@ -120,9 +120,15 @@ static void judge(xmlParserCtxtPtr p, xmlDocPtr doc, const xmlGuard *g,
       r->line = le ? le->line : 0;
       snprintf(r->message, sizeof r->message, "%s",
                le && le->message ? le->message : "malformed document");
-      size_t n = strlen(r->message);
-      while (n > 0 && r->message[n - 1] == '\n') r->message[--n] = 0;
     }
+    /* one line, as every other message (libxml2 ends its messages with a
+     * newline and puts the bad bytes of an encoding error on a line of
+     * their own) */
+    size_t n = strlen(r->message);
+    while (n > 0 && (r->message[n - 1] == '\n' || r->message[n - 1] == ' '))
+      r->message[--n] = 0;
+    for (char *q = r->message; *q; q++)
+      if (*q == '\n') *q = ' ';
   } else if (doc->intSubset || doc->extSubset || g->entity_refused) {
     r->fail = SS_XML_DOCTYPE;
     r->line = 1;

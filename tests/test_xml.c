@@ -320,6 +320,21 @@ static void test_qpos_quaternion(void)
   }
 }
 
+/* libxml2's messages on one line, as every other (an encoding error put
+ * its bad bytes on a second line) */
+static void test_one_line_errors(void)
+{
+  static const char bad[] = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<raisim>\xff\xfe</raisim>\n";
+  ssModel *m = NULL;
+  ssData *d = NULL;
+  ssError e;
+  ssStatus st = load_str(bad, &m, &d, &e);
+  ok(st != SS_OK && !m && strstr(e.message, "UTF-8") && !strchr(e.message, '\n'),
+     "a file that is not UTF-8: refused, the message on one line (%s)", e.message);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 /* Odd doubles: thirds, subnormals, signed zero, huge and tiny. */
 static double odd(int k)
 {
@@ -885,6 +900,7 @@ int main(void)
   test_separators();
   test_this_dir();
   test_qpos_quaternion();
+  test_one_line_errors();
   test_round_trip();
   test_built_in_code();
   test_numbers();
