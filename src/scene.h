@@ -43,8 +43,9 @@
  *     <camera pos=R look_at=R fov_deg [45] follow/>  follow names a body
  *     <objects>
  *       <ground name=R height [0] material [default]/>
- *       <box|sphere|cylinder|capsule name=R mass=R(dynamic only) material
- *            body_type [dynamic|static] rgba="r g b a" (each in [0, 1])>
+ *       <box|sphere|cylinder|capsule name=R mass=R(dynamic; static: optional,
+ *            > 0) material body_type [dynamic|static] rgba="r g b a" (each
+ *            in [0, 1])>   (a static body: no velocity, no external force)
  *         <dim .../>R   box: x y z (full edges); sphere: radius;
  *                       cylinder, capsule: radius height (along local z)
  *         <state pos [0 0 0] quat [1 0 0 0] lin_vel [0] ang_vel [0]/>
@@ -55,7 +56,14 @@
  *                  quat [1 0 0 0] + one of the four forms below>
  *         <soil .../>   optional: makes the map a soil bed
  *       </heightmap>
- *       <mesh>, <articulated_system>: SS_ERR_UNSUPPORTED ("not supported yet")
+ *       <articulated_system name=R urdf_path=R res_dir base [floating|fixed]
+ *            material>   (read_articulated: a URDF, urdf.h)
+ *         <state qpos qvel pos quat reference_qpos/>   (a floating base's pose
+ *                       from qpos or from pos quat, not both)
+ *         <pd joint=R p_gain d_gain position_target velocity_target
+ *             effort_limit/>   (0..64, at most one per joint)
+ *       </articulated_system>
+ *       <mesh>: SS_ERR_UNSUPPORTED ("not supported yet")
  *     </objects>
  *     <material>
  *       <default friction [0.8] restitution [0] restitution_threshold [0]/>
