@@ -1,7 +1,8 @@
 /* collide.c -- footprints, exact vertical ray casts, contact candidates and
- * effective widths of box, sphere, cylinder and capsule colliders
- * (DESIGN 2.4, 2.6).  Pure functions: no allocation, no printing (one
- * constant table, the footprints' circle, is formed at first use). */
+ * effective widths of box, sphere, cylinder and capsule colliders, and the
+ * footprints of point sets (a mesh's vertices) (DESIGN 2.4, 2.6).  Pure
+ * functions: no allocation, no printing (one constant table, the
+ * footprints' circle, is formed at first use). */
 #include "collide.h"
 
 #include <math.h>
@@ -46,28 +47,23 @@ static int pt_less(const pt2 *a, const pt2 *b)
  * equal under pt_less are equal. */
 SS_SORT_RUNS(sort_point_runs, pt2, pt_less)
 
-/* n <= HULL_IN_MAX, the size of the one caller's array (convex_hull's
- * input); qsort may allocate for inputs of this size */
-static void sort_points(pt2 *p, int n)
-{
-  pt2 buf[HULL_IN_MAX];
-  const pt2 *v = sort_point_runs(p, buf, n);
-  if (v != p) memcpy(p, v, (size_t)n * sizeof *p);
-}
-
 static double cross3(const pt2 *o, const pt2 *a, const pt2 *b)
 {
   return (a->x - o->x) * (b->y - o->y) - (a->y - o->y) * (b->x - o->x);
 }
 
-/* Andrew's monotone chain; strictly convex turns only, so collinear and
- * duplicated points (degenerate projections) are dropped.  Sorts p. */
-static void convex_hull(pt2 *p, int n, ssPoly2 *out)
+/* Andrew's monotone chain into h (room for 2 n + 2), with buf (n) the
+ * sort's scratch (the caller's arrays: qsort may allocate; buf and h may
+ * be one array, the sort done before the chain begins); strictly
+ * convex turns only, so collinear and duplicated points (degenerate
+ * projections) are dropped.  Sorts p.  Returns the hull's count:
+ * counter-clockwise from the least point (pt_less); a single point where
+ * the points do not spread. */
+static int hull_chain(pt2 *p, int n, pt2 *buf, pt2 *h)
 {
-  pt2 h[2 * HULL_IN_MAX + 2];
-  out->n = 0;
-  if (n <= 0) return;
-  sort_points(p, n);
+  if (n <= 0) return 0;
+  const pt2 *v = sort_point_runs(p, buf, n);
+  if (v != p) memcpy(p, v, (size_t)n * sizeof *p);
 
   /* collinearity tolerance scaled by the point set's extent */
   double ylo = p[0].y, yhi = p[0].y;
@@ -77,10 +73,8 @@ static void convex_hull(pt2 *p, int n, ssPoly2 *out)
   }
   double ext = fmax(p[n - 1].x - p[0].x, yhi - ylo);
   if (!(ext > 0)) {
-    out->n = 1;
-    out->x[0] = p[0].x;
-    out->y[0] = p[0].y;
-    return;
+    h[0] = p[0];
+    return 1;
   }
   double tol = HULL_COLLINEAR_EPS * ext * ext;
 
@@ -96,12 +90,94 @@ static void convex_hull(pt2 *p, int n, ssPoly2 *out)
   }
   k--; /* the last point repeats the first */
   if (k < 1) k = 1;
+  return k;
+}
+
+/* hull_chain of the footprint points p (n <= HULL_IN_MAX) into out */
+static void convex_hull(pt2 *p, int n, ssPoly2 *out)
+{
+  pt2 buf[HULL_IN_MAX], h[2 * HULL_IN_MAX + 2];
+  int k = hull_chain(p, n, buf, h);
   if (k > SS_POLY_MAX) k = SS_POLY_MAX; /* cannot happen: k <= n */
   out->n = k;
   for (int i = 0; i < k; i++) {
     out->x[i] = h[i].x;
     out->y[i] = h[i].y;
   }
+}
+
+/* hull_reduce's order of vertices: least triangle first, then the first
+ * in the polygon's order (so that the cut does not depend on how the
+ * heap happens to hold them) */
+static int tri_before(const double *a, int i, int j)
+{
+  return a[i] < a[j] || (a[i] == a[j] && i < j);
+}
+
+/* the heap hp[0, n) (pos: each vertex's place in it) with its entry at
+ * place k moved up or down to where tri_before puts it */
+static void heap_fix(int *hp, int *pos, const double *a, int n, int k)
+{
+  int v = hp[k];
+  while (k > 0 && tri_before(a, v, hp[(k - 1) / 2])) {
+    hp[k] = hp[(k - 1) / 2];
+    pos[hp[k]] = k;
+    k = (k - 1) / 2;
+  }
+  for (;;) {
+    int c = 2 * k + 1;
+    if (c >= n) break;
+    if (c + 1 < n && tri_before(a, hp[c + 1], hp[c])) c++;
+    if (!tri_before(a, hp[c], v)) break;
+    hp[k] = hp[c];
+    pos[hp[k]] = k;
+    k = c;
+  }
+  hp[k] = v;
+  pos[v] = k;
+}
+
+/* The convex polygon h[0, k) (k <= SS_HULL_POINTS_MAX) cut down to max
+ * vertices: the vertex whose triangle with its two neighbours is least
+ * removed, one at a time (the first in h's order on ties), and that
+ * triangle's area lost.  What remains is convex, counter-clockwise and
+ * inside the polygon, and keeps h's order.  The triangles in a heap:
+ * O(k log k).  Returns the count. */
+static int hull_reduce(pt2 *h, int k, int max)
+{
+  int prev[SS_HULL_POINTS_MAX], next[SS_HULL_POINTS_MAX];
+  int hp[SS_HULL_POINTS_MAX], pos[SS_HULL_POINTS_MAX];
+  double a[SS_HULL_POINTS_MAX];
+  if (k <= max || k > SS_HULL_POINTS_MAX) return k < max ? k : max;
+  for (int i = 0; i < k; i++) {
+    prev[i] = i > 0 ? i - 1 : k - 1;
+    next[i] = i + 1 < k ? i + 1 : 0;
+  }
+  for (int i = 0; i < k; i++) {
+    a[i] = cross3(&h[prev[i]], &h[i], &h[next[i]]);
+    hp[i] = i;
+    pos[i] = i;
+  }
+  for (int i = k / 2 - 1; i >= 0; i--) heap_fix(hp, pos, a, k, i);
+  for (int n = k; n > max;) {
+    /* the least off the heap (the last entry in its place), its
+     * neighbours joined and their triangles formed anew */
+    int best = hp[0], l = prev[best], r = next[best];
+    hp[0] = hp[--n];
+    pos[hp[0]] = 0;
+    pos[best] = -1;
+    if (n > 0) heap_fix(hp, pos, a, n, 0);
+    next[l] = r;
+    prev[r] = l;
+    a[l] = cross3(&h[prev[l]], &h[l], &h[r]);
+    heap_fix(hp, pos, a, n, pos[l]);
+    a[r] = cross3(&h[l], &h[r], &h[next[r]]);
+    heap_fix(hp, pos, a, n, pos[r]);
+  }
+  int m = 0;
+  for (int i = 0; i < k; i++)
+    if (pos[i] >= 0) h[m++] = h[i];
+  return m;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -408,6 +484,29 @@ void ss_shape_footprint(const ssShape *s, ssPoly2 *out)
     return;
   }
   convex_hull(p, np, out);
+}
+
+int ss_points_footprint(const double *q, int n, const double R[9], const double o[3],
+                        ssPoly2 *out)
+{
+  /* h is the sort's scratch too (hull_chain) */
+  pt2 p[SS_HULL_POINTS_MAX], h[2 * SS_HULL_POINTS_MAX + 2];
+  out->n = 0;
+  if (n < 0 || n > SS_HULL_POINTS_MAX) return 0;
+  /* projected as a box's corners are (ss_shape_footprint) */
+  for (int k = 0; k < n; k++) {
+    const double *v = q + 3 * k;
+    p[k].x = o[0] + R[0] * v[0] + R[1] * v[1] + R[2] * v[2];
+    p[k].y = o[1] + R[3] * v[0] + R[4] * v[1] + R[5] * v[2];
+  }
+  int k = hull_chain(p, n, h, h), nh = k;
+  if (k > SS_POLY_MAX) k = hull_reduce(h, k, SS_POLY_MAX);
+  out->n = k;
+  for (int i = 0; i < k; i++) {
+    out->x[i] = h[i].x;
+    out->y[i] = h[i].y;
+  }
+  return nh;
 }
 
 /* ---------------------------------------------------------------------- */

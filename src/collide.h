@@ -37,6 +37,26 @@ typedef struct ssPoly2 {
  * spheres, cylinders and capsules the projected circles/ellipses are
  * area-matched polygons of SS_FOOTPRINT_SEGMENTS segments. */
 void ss_shape_footprint(const ssShape *s, ssPoly2 *out);
+/* Most points ss_points_footprint takes: its buffers are on the stack
+ * (about 36 KiB with those of its cut, no more than the solver's blocks
+ * take), and a mesh keeps at most SS_MESH_HULL_MAX (mesh.h).  Its cost: a
+ * sort that is nearly linear for points in rings (a 64-gon prism's 130
+ * points: 1.5 us), more for points in no order, and O(k log k) more for a
+ * hull of k > SS_POLY_MAX vertices (SS_HULL_POINTS_MAX points all on the
+ * hull, in no order: the worst, see README). */
+#define SS_HULL_POINTS_MAX 512
+/* The footprint of a point set (a mesh's footprint points, ssMesh.hull):
+ * the convex hull of the points o + R q_k (q: n x 3) projected along z,
+ * counter-clockwise from its least point, with ss_shape_footprint's
+ * tolerance for collinear points.  A hull of more than SS_POLY_MAX
+ * vertices is cut down to SS_POLY_MAX, the vertex whose triangle with its
+ * neighbours is least removed first, one at a time: the polygon shrinks
+ * into itself by the sum of those triangles (for a regular 256-gon, by
+ * 1.5e-4 of its area).  Returns the hull's vertex count before the cut
+ * (the cut's happened when it is more than out->n); n outside [0,
+ * SS_HULL_POINTS_MAX]: 0 and an empty polygon. */
+int ss_points_footprint(const double *q, int n, const double R[9], const double o[3],
+                        ssPoly2 *out);
 /* Axis-aligned bounds of the shape in the frame. */
 void ss_shape_aabb(const ssShape *s, double lo[3], double hi[3]);
 /* Bounds in x and y of the part of the shape at or below height zc: no

@@ -1,5 +1,6 @@
 /* mesh.c -- triangle meshes: import with assimp's C API, a bounding-volume
- * hierarchy, watertight ray casts and the mass properties of the solid.
+ * hierarchy, watertight ray casts, the mass properties of the solid, and
+ * the points a footprint on a soil bed is the hull of (hull_points).
  *
  * Ray casts.  The triangle test is Moller-Trumbore's determinant test
  * written in the ray's own sheared frame (Woop, Benthin and Wald, "Watertight
@@ -234,6 +235,7 @@ void ss_mesh_free(ssMesh *m)
   free(m->bvh_box);
   free(m->bvh_child);
   free(m->bvh_tri);
+  free(m->hull);
   free(m);
 }
 
@@ -266,6 +268,98 @@ static void bounds(ssMesh *m)
       if (p[a] > m->hi[a]) m->hi[a] = p[a];
     }
   }
+}
+
+/* ---------------------------------------------------------------------- */
+/* footprint points                                                        */
+
+/* vertex slots that triangles use, at most, for the footprint points to be
+ * looked for: a mesh with more has, unless its positions are split into
+ * more than 64 vertices each (per-face normals split them into 3 to 8
+ * commonly, an STL's into about 6), more than SS_MESH_HULL_MAX distinct
+ * positions anyway; it keeps the bounding box's footprint without a sort
+ * of its millions of vertices at load */
+#define HULL_SLOTS_MAX (64L * SS_MESH_HULL_MAX)
+
+typedef struct keyVert {
+  const double *p; /* position */
+  int v;           /* vertex index (breaks ties) */
+} keyVert;
+
+static int kv_same(const keyVert *a, const keyVert *b)
+{
+  return a->p[0] == b->p[0] && a->p[1] == b->p[1] && a->p[2] == b->p[2];
+}
+
+/* total order: position x, y, z, then vertex index, so that each
+ * position's first vertex leads its run (deterministic whatever qsort) */
+static int kv_cmp(const void *pa, const void *pb)
+{
+  const keyVert *a = pa, *b = pb;
+  for (int k = 0; k < 3; k++) {
+    if (a->p[k] < b->p[k]) return -1;
+    if (a->p[k] > b->p[k]) return 1;
+  }
+  return (a->v > b->v) - (a->v < b->v);
+}
+
+/* The footprint points (ssMesh.hull; after bounds): every position that
+ * triangles use, once (its first vertex), in vertex order, which keeps a
+ * ring's points in runs for the footprint's sort (ss_points_footprint).
+ * Every vertex of the 3-D convex hull is among them, hence every vertex
+ * of any projection's hull; the points strictly inside that hull are not
+ * dropped (that would take a 3-D hull here): a non-convex mesh keeps them
+ * all and may exceed the cap.  Returns 0 when out of memory. */
+static int hull_points(ssMesh *m)
+{
+  m->nhull = 0;
+  free(m->hull);
+  m->hull = NULL;
+  /* used[v]: 1 when a triangle uses v, 2 when v is also its position's
+   * first vertex */
+  unsigned char *used = calloc((size_t)m->nvert, 1);
+  if (!used) return 0;
+  for (long i = 0; i < 3L * m->ntri; i++) used[m->tri[i]] = 1;
+  long nused = 0;
+  for (int v = 0; v < m->nvert; v++) nused += used[v];
+  if (nused > HULL_SLOTS_MAX) {
+    free(used);
+    return 1;
+  }
+  keyVert *kv = malloc((size_t)nused * sizeof *kv);
+  if (!kv) {
+    free(used);
+    return 0;
+  }
+  int n = 0;
+  for (int v = 0; v < m->nvert; v++)
+    if (used[v]) kv[n++] = (keyVert){m->vert + 3 * v, v};
+  qsort(kv, (size_t)n, sizeof *kv, kv_cmp);
+  int distinct = 0;
+  for (int i = 0; i < n; i++)
+    if (i == 0 || !kv_same(&kv[i], &kv[i - 1])) {
+      used[kv[i].v] = 2;
+      distinct++;
+    }
+  free(kv);
+  if (distinct > SS_MESH_HULL_MAX) {
+    free(used);
+    return 1;
+  }
+  m->hull = malloc((size_t)distinct * 3 * sizeof *m->hull);
+  if (!m->hull) {
+    free(used);
+    return 0;
+  }
+  double c[3];
+  for (int k = 0; k < 3; k++) c[k] = 0.5 * (m->hi[k] + m->lo[k]);
+  for (int v = 0; v < m->nvert; v++)
+    if (used[v] == 2) {
+      double *h = m->hull + 3 * m->nhull++;
+      for (int k = 0; k < 3; k++) h[k] = m->vert[3 * v + k] - c[k];
+    }
+  free(used);
+  return 1;
 }
 
 static ssMesh *mesh_alloc(int nvert, int ntri)
@@ -315,6 +409,10 @@ ssStatus ss_mesh_from_arrays(const double *vert, int nvert, const int *tri,
   memcpy(m->tri, tri, (size_t)ntri * 3 * sizeof *tri);
   vertex_normals(m);
   bounds(m);
+  if (!hull_points(m)) {
+    ss_mesh_free(m);
+    return ss_error_set(err, SS_ERR_NOMEM, what, 0, "out of memory");
+  }
   ssStatus st = build_bvh(m, err, what);
   if (st) {
     ss_mesh_free(m);
@@ -433,8 +531,12 @@ ssStatus ss_mesh_load(const char *path, const double scale[3], ssMesh **out,
   aiReleaseImport(sc);
   if (!st) {
     bounds(m);
-    st = build_bvh(m, err, path);
+    if (!hull_points(m))
+      st = ss_error_set(err, SS_ERR_NOMEM, path, 0,
+                        "out of memory for the footprint points of %lld "
+                        "vertices", nv);
   }
+  if (!st) st = build_bvh(m, err, path);
   if (st) {
     ss_mesh_free(m);
     return st;

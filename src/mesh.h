@@ -5,12 +5,28 @@
 
 #include "soilsim.h"
 
+/* Most footprint points a mesh keeps (ssMesh.hull): each step a mesh near a
+ * soil bed projects them and takes their hull (O(n log n), its buffers on
+ * the stack: ss_points_footprint), so the cap bounds that cost and that
+ * room.  Convex collision meshes have fewer (PhysX allows 255 vertices,
+ * V-HACD makes 64 by default); a mesh with more keeps its bounding box's
+ * footprint. */
+#define SS_MESH_HULL_MAX 512
+
 typedef struct ssMesh {
   int nvert, ntri;
   double *vert;          /* (nvert x 3) in the mesh frame, scaled */
   double *normal;        /* (nvert x 3) per-vertex normals (for rendering) */
   int *tri;              /* (ntri x 3) vertex indices, counter-clockwise */
   double lo[3], hi[3];   /* bounding box */
+  /* footprint points (DESIGN 2.6; terrain.c): the distinct positions among
+   * the vertices that triangles use, in the order they first come, as
+   * offsets from the bounding box's centre (lo + hi) / 2.  The vertices of
+   * any projection's convex hull are among them.  nhull 0 (hull NULL):
+   * more than SS_MESH_HULL_MAX of them, and the footprint on a bed is the
+   * bounding box's */
+  int nhull;
+  double *hull;          /* (nhull x 3) */
   /* BVH: node k has bounds (bvh_box + 6k: lo xyz, hi xyz); internal nodes
    * have children bvh_child[2k], bvh_child[2k+1]; leaves have
    * bvh_child[2k] = -1 - first and bvh_child[2k+1] = count into bvh_tri */

@@ -12,7 +12,18 @@
  * on or beyond the footprint's edge, where the line meets a side face or
  * misses the collider).  The soil state stays at the vertex.
  * Only vertices inside the collider's bounding box are visited, so the cost
- * follows the contacts, not the bed size. */
+ * follows the contacts, not the bed size.
+ *
+ * A mesh's footprint is the convex hull of its vertices projected on the
+ * bed (mesh_footprint), so a convex mesh's cells get their exact covered
+ * areas as a box's do; its depths come from BVH ray casts, and a cell
+ * whose line misses the mesh gives no point.  For a non-convex mesh the
+ * hull is an outer bound: a cell partly under a concave notch gets the
+ * hull's area there, a cell whose line passes through the notch none.
+ * A mesh of more than SS_MESH_HULL_MAX distinct vertices (mesh.h) keeps
+ * its bounding box as its footprint, and a hull of more than SS_POLY_MAX
+ * vertices is cut down to that many (ss_points_footprint): both then
+ * converge with the spacing instead of being exact. */
 #include "terrain.h"
 #include "articulated.h"
 #include "collide.h"
@@ -75,8 +86,9 @@ static inline void attach_response(const Attach *a, ssContact *c)
 }
 
 /* the collider of geom g expressed in a frame (R, p); a mesh stands in as
- * its bounding box for the footprint, the width and the candidates (DESIGN
- * 2.4), its depth comes from ray casts (mesh_depth) */
+ * its bounding box for the cells visited, the width and the candidates
+ * (DESIGN 2.4), its footprint is its vertices' hull (mesh_footprint) and
+ * its depth comes from ray casts (mesh_depth) */
 static void shape_in_frame(const ssModel *m, const ssData *d, int g,
                            const double R[9], const double p[3], ssShape *s)
 {
@@ -99,6 +111,24 @@ static void shape_in_frame(const ssModel *m, const ssData *d, int g,
   double Rt[9];
   ss_m3_transpose(Rt, R);
   ss_m3_mul(s->R, Rt, d->geom_xmat + 9 * g);
+}
+
+_Static_assert(SS_MESH_HULL_MAX <= SS_HULL_POINTS_MAX,
+               "a mesh's footprint points must fit ss_points_footprint");
+
+/* the footprint of mesh geom g, s in the bed's frame (shape_in_frame: its
+ * bounding box, centred where the footprint points are): the hull of its
+ * footprint points projected, exact for a convex mesh; the box's where the
+ * mesh keeps none.  Not inlined: the hull's buffers (ss_points_footprint)
+ * are on the stack only while it runs */
+static __attribute__((noinline)) void mesh_footprint(const ssModel *m, int g,
+                                                     const ssShape *s, ssPoly2 *fp)
+{
+  const ssMesh *me = m->mesh[m->geom_mesh[g]];
+  if (me->nhull > 0)
+    ss_points_footprint(me->hull, me->nhull, s->R, s->pos, fp);
+  else
+    ss_shape_footprint(s, fp);
 }
 
 /* lowest point of a mesh geom on the bed-frame vertical line through
@@ -205,9 +235,12 @@ soil_contacts_as(const ssModel *m, ssData *d, int h, int g, int sys, const doubl
   int i0 = fi0 > 0 ? (int)fi0 : 0, i1 = fi1 < nx - 1 ? (int)fi1 : nx - 1;
   int j0 = fj0 > 0 ? (int)fj0 : 0, j1 = fj1 < ny - 1 ? (int)fj1 : ny - 1;
 
-  ssPoly2 fp;
-  ss_shape_footprint(s, &fp);
   const int mesh = type == SS_GEOM_MESH;
+  ssPoly2 fp;
+  if (mesh)
+    mesh_footprint(m, g, s, &fp);
+  else
+    ss_shape_footprint(s, &fp);
   /* formed in a copy: cast's address then reaches no call, so the calls
    * in the loop below (the band's, the reserve) cannot change it, and
    * the casts keep its fields without reloading them.  Its type is set

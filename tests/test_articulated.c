@@ -652,8 +652,8 @@ static void test_limit(void)
 }
 
 /* a link whose collider is a triangle mesh (a 0.4 x 0.6 x 0.05 box made of
- * 12 triangles): the bounding-box footprint and BVH depths give the same
- * analytic sinkage as the box */
+ * 12 triangles): the footprint (its corners' hull) and BVH depths give the
+ * same analytic sinkage as the box */
 static void test_mesh_on_soil(void)
 {
   ssUrdf *u = urdf_new();

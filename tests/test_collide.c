@@ -220,6 +220,108 @@ static void test_box_footprint(void)
   ok(inside, "random boxes: every projected corner lies in the footprint");
 }
 
+/* the regular nside-gon prism of circumradius r and height hz, centred:
+ * its corners (bottom, top alternating) into v (2 nside x 3) */
+static void prism_points(double *v, int nside, double r, double hz)
+{
+  for (int i = 0; i < nside; i++)
+    for (int t = 0; t < 2; t++) {
+      double *p = v + 3 * (2 * i + t);
+      p[0] = r * cos(2 * PI * i / nside);
+      p[1] = r * sin(2 * PI * i / nside);
+      p[2] = t ? 0.5 * hz : -0.5 * hz;
+    }
+}
+
+/* point-set footprints (a mesh's, ss_points_footprint): the hull of the
+ * projected points, exact; more than SS_POLY_MAX hull vertices cut down
+ * inside the hull */
+static void test_points_footprint(void)
+{
+  static double v[3 * (SS_HULL_POINTS_MAX + 1)];
+  double R[9], o[3] = {0.7, -1.3, 0.2};
+  ssPoly2 p, q;
+  /* its own random stream: the tests after it see the draws they saw
+   * before it came */
+  const uint64_t rng_saved = rng_state;
+  rng_state = 0x2545f4914f6cdd1dull;
+
+  /* a box's 8 corners at random orientations: the box's own footprint */
+  double worst = 0;
+  int convex = 1;
+  for (int trial = 0; trial < 200; trial++) {
+    rot_random(R);
+    double sx = urand(0.05, 1), sy = urand(0.05, 1), sz = urand(0.05, 1);
+    for (int i = 0; i < 8; i++) {
+      v[3 * i] = (i & 1) ? sx / 2 : -sx / 2;
+      v[3 * i + 1] = (i & 2) ? sy / 2 : -sy / 2;
+      v[3 * i + 2] = (i & 4) ? sz / 2 : -sz / 2;
+    }
+    ssShape s = make_shape(SS_GEOM_BOX, sx, sy, sz, o[0], o[1], o[2], R);
+    ss_shape_footprint(&s, &q);
+    int nh = ss_points_footprint(v, 8, R, o, &p);
+    worst = fmax(worst, rel(ss_poly_area(&p), ss_poly_area(&q)));
+    if (!poly_ccw_convex(&p) || p.n != q.n || nh != p.n) convex = 0;
+  }
+  ok(worst <= 1e-13, "box corners as points, random orientations: the box's footprint area "
+     "(worst rel %.3g)", worst);
+  ok(convex, "  strictly convex CCW, as many vertices as the box's footprint");
+
+  /* a 64-gon prism standing, any heading, with points inside it: the
+   * 64-gon (top and bottom project onto each other) */
+  const int ns = 64;
+  double r = 0.2, want = 0.5 * ns * r * r * sin(2 * PI / ns);
+  worst = 0;
+  int n64 = 1;
+  for (int trial = 0; trial < 50; trial++) {
+    prism_points(v, ns, r, 0.1);
+    int n = 2 * ns;
+    for (int k = 0; k < 20; k++, n++) {
+      double a = urand(-PI, PI), t = urand(0, 0.95 * r * cos(PI / ns));
+      v[3 * n] = t * cos(a);
+      v[3 * n + 1] = t * sin(a);
+      v[3 * n + 2] = urand(-0.05, 0.05);
+    }
+    rot_z(R, urand(-PI, PI));
+    int nh = ss_points_footprint(v, n, R, o, &p);
+    worst = fmax(worst, rel(ss_poly_area(&p), want));
+    if (nh != ns || p.n != ns || !poly_ccw_convex(&p)) n64 = 0;
+  }
+  ok(n64, "64-gon prism with inner points, any heading: a convex CCW 64-gon");
+  ok(worst <= 1e-13, "  its area is the 64-gon's (worst rel %.3g)", worst);
+
+  /* a 256-gon prism standing: the hull's 256 vertices cut down to
+   * SS_POLY_MAX, every one kept a hull vertex, losing a little area */
+  const int nb = 256;
+  prism_points(v, nb, r, 0.1);
+  rot_z(R, 0.3);
+  int nh = ss_points_footprint(v, 2 * nb, R, o, &p);
+  double big = 0.5 * nb * r * r * sin(2 * PI / nb);
+  int on_hull = 1;
+  for (int i = 0; i < p.n; i++)
+    if (fabs(hypot(p.x[i] - o[0], p.y[i] - o[1]) - r) > 1e-12) on_hull = 0;
+  ok(nh == nb && p.n == SS_POLY_MAX && poly_ccw_convex(&p) && on_hull,
+     "256-gon prism: a hull of %d vertices cut down to %d (SS_POLY_MAX %d), convex CCW, "
+     "its vertices the hull's", nh, p.n, SS_POLY_MAX);
+  double lost = (big - ss_poly_area(&p)) / big;
+  ok(lost > 0 && lost < 2e-4, "  it loses %.3g of the area (< 2e-4)", lost);
+
+  /* more points than the buffers take: refused, an empty polygon */
+  nh = ss_points_footprint(v, SS_HULL_POINTS_MAX + 1, R, o, &p);
+  ok(nh == 0 && p.n == 0, "more than SS_HULL_POINTS_MAX points: refused (an empty polygon)");
+  /* all on one vertical line: a single point, no area */
+  for (int i = 0; i < 5; i++) {
+    v[3 * i] = v[3 * i + 1] = 0;
+    v[3 * i + 2] = i;
+  }
+  double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  nh = ss_points_footprint(v, 5, I, o, &p);
+  ok(nh == 1 && p.n == 1 && ss_poly_area(&p) == 0 &&
+         ss_poly_rect_area(&p, -10, 10, -10, 10, NULL, NULL) == 0,
+     "points on one vertical line: one point, no area");
+  rng_state = rng_saved;
+}
+
 /* round shapes: area-matched polygons, exact tread width */
 static void test_round_footprints(void)
 {
@@ -983,6 +1085,7 @@ int main(void)
 {
   test_plate_quadrature();
   test_box_footprint();
+  test_points_footprint();
   test_round_footprints();
   test_poly_clip();
   test_poly_band();

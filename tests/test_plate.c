@@ -1,5 +1,8 @@
 /* test_plate.c -- rigid bodies on soil and rigid ground, end to end through
  * the contact solver, against the closed forms of DESIGN 2.7. */
+#include "articulated.h"
+#include "mesh.h"
+#include "model_build.h"
 #include "soilsim.h"
 #include "solver.h"
 #include "ss_math.h"
@@ -1111,6 +1114,185 @@ static void test_power_table(void)
   ss_model_free(m);
 }
 
+/* the regular nside-gon prism of circumradius r and height hz standing on
+ * its base (z from -hz/2 to hz/2) as a triangle mesh: the corners (bottom,
+ * top alternating), then the two caps' centres; each side two triangles,
+ * each cap a fan.  v: (2 nside + 2) x 3, t: 4 nside x 3 */
+static void prism_mesh(int nside, double r, double hz, double *v, int *t)
+{
+  for (int i = 0; i < nside; i++)
+    for (int k = 0; k < 2; k++) {
+      double *p = v + 3 * (2 * i + k);
+      p[0] = r * cos(2 * M_PI * i / nside);
+      p[1] = r * sin(2 * M_PI * i / nside);
+      p[2] = k ? 0.5 * hz : -0.5 * hz;
+    }
+  int cb = 2 * nside, ct = cb + 1;
+  v[3 * cb] = v[3 * cb + 1] = v[3 * ct] = v[3 * ct + 1] = 0;
+  v[3 * cb + 2] = -0.5 * hz;
+  v[3 * ct + 2] = 0.5 * hz;
+  for (int i = 0; i < nside; i++) {
+    int j = (i + 1) % nside, b0 = 2 * i, t0 = b0 + 1, b1 = 2 * j, t1 = b1 + 1;
+    int f[12] = {b0, b1, t1, b0, t1, t0, cb, b1, b0, ct, t0, t1};
+    memcpy(t + 12 * i, f, sizeof f);
+  }
+}
+
+/* a box lx x ly x lz as a flat-shaded mesh: each face its own 4 vertices
+ * (24, as a file with per-face normals gives them), 12 triangles */
+static void box_mesh_split(double lx, double ly, double lz, double *v, int *t)
+{
+  /* each face: its axis, its side, and its corners counter-clockwise seen
+   * from outside */
+  int nv = 0;
+  for (int a = 0; a < 3; a++)
+    for (int sgn = -1; sgn <= 1; sgn += 2) {
+      int b = (a + 1) % 3, c = (a + 2) % 3;
+      double h[3] = {0.5 * lx, 0.5 * ly, 0.5 * lz};
+      double uv[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+      for (int k = 0; k < 4; k++) {
+        double *p = v + 3 * (nv + k);
+        p[a] = sgn * h[a];
+        p[b] = uv[k][0] * h[b];
+        p[c] = sgn * uv[k][1] * h[c];
+      }
+      int f[6] = {nv, nv + 1, nv + 2, nv, nv + 2, nv + 3};
+      memcpy(t + 6 * (nv / 4), f, sizeof f);
+      nv += 4;
+    }
+}
+
+/* One step, without gravity, of a 20 kg link whose collider is the mesh
+ * (v, t), turned by turn about z in the link, with its flat bottom (mesh z
+ * = zb) 1 mm into a 1.2 m soil bed of spacing h, the link at (ox, oy)
+ * turned by yaw: the loaded area (-1 on failure).  *nhull: the mesh's
+ * footprint points; *all: every soil point near it was loaded. */
+static double mesh_loaded_area(const double *v, int nv, const int *t, int nt, double zb,
+                               double turn, double h, double ox, double oy, double yaw,
+                               int *nhull, int *all)
+{
+  ssError e;
+  double area = -1, zaxis[3] = {0, 0, 1}, zero[3] = {0, 0, 0};
+  ssModel *m = ss_model_new();
+  ssData *d = NULL;
+  ssMesh *me = NULL;
+  ss_v3_set(m->opt.gravity, 0, 0, 0);
+  ssUrdf *u = urdf_new();
+  add_link(u, "body", 20, NULL, 1, 1, 1);
+  ssArtDef def = ss_art_def_default();
+  def.name = "mesh";
+  def.fixed_base = 0;
+  ss_v3_set(def.pos, ox, oy, -zb - 0.001);
+  ss_quat_from_axis_angle(def.quat, zaxis, yaw);
+  int sys = ss_model_add_articulated(m, u, &def, &e);
+  ss_urdf_free(u);
+  *nhull = -1;
+  *all = 0;
+  if (add_bed(m, 1.2, h, plate_soil()) < 0 || sys < 0 ||
+      ss_mesh_from_arrays(v, nv, t, nt, &me, &e) != SS_OK) {
+    diag("mesh world: %s", e.message);
+    goto done;
+  }
+  *nhull = me->nhull;
+  double size[3], q[4];
+  for (int k = 0; k < 3; k++) size[k] = me->hi[k] - me->lo[k];
+  ss_quat_from_axis_angle(q, zaxis, turn);
+  int mi = ss_model_push_mesh(m, me, "mesh", &e);
+  if (mi < 0) {
+    ss_mesh_free(me);
+    goto done;
+  }
+  if (ss_model_push_geom(m, m->sys_bodyadr[sys], SS_GEOM_MESH, size, zero, q, 0, NULL, 1, mi,
+                         &e) < 0 ||
+      !(d = ss_data_new(m)) || ss_step(m, d, &e) != SS_OK) {
+    diag("mesh world: %s", e.message);
+    goto done;
+  }
+  area = d->stats.soil_contact_area;
+  *all = d->stats.soil_contacts > 0 && d->stats.soil_loaded == d->stats.soil_contacts;
+done:
+  ss_data_free(d);
+  ss_model_free(m);
+  return area;
+}
+
+/* DESIGN 2.6 for mesh colliders: a convex mesh's footprint is the hull of
+ * its projected vertices, so its loaded area is its true area for any
+ * placement and heading and any spacing (it was its bounding box's
+ * coverage, kept where a cell's line hit the mesh: 0.1200 and 0.1280
+ * m^2 for the 64-gon's 0.1255 at 4 cm, by placement) */
+static void test_mesh_quadrature(void)
+{
+  enum { NS = 64, NB = 600 };
+  static double v[3 * (2 * NB + 2)];
+  static int t[3 * 4 * NB];
+  const double place[5][3] = {{0, 0, 0},
+                              {0.0123, -0.0071, 0},
+                              {0.0311, 0.0173, 0.37},
+                              {-0.0417, 0.0059, 1.9},
+                              {0.0052, 0.0131, -2.6}};
+  const double spacing[2] = {0.04, 0.02};
+  double r = 0.2, poly = 0.5 * NS * r * r * sin(2 * M_PI / NS);
+
+  /* the 64-gon prism of the audit, standing */
+  prism_mesh(NS, r, 0.1, v, t);
+  double worst = 0, lo = INFINITY, hi = 0;
+  int nhull = 0, all = 1, points = 1;
+  for (int s = 0; s < 2; s++)
+    for (int k = 0; k < 5; k++) {
+      int nh, loaded;
+      double a = mesh_loaded_area(v, 2 * NS + 2, t, 4 * NS, -0.05, 0, spacing[s],
+                                  place[k][0], place[k][1], place[k][2], &nh, &loaded);
+      worst = fmax(worst, fabs(a - poly) / poly);
+      lo = fmin(lo, a);
+      hi = fmax(hi, a);
+      all &= loaded;
+      points &= nh == 2 * NS + 2;
+      nhull = nh;
+    }
+  ok(points, "64-gon prism mesh: its %d distinct vertices are its footprint points", nhull);
+  ok(worst <= 1e-9 && all,
+     "  on soil at 4 and 2 cm, 5 placements and headings: loaded area = the 64-gon's %.9g "
+     "(%.12g to %.12g, worst rel %.2g), every point loaded", poly, lo, hi, worst);
+
+  /* a 0.4 x 0.6 x 0.05 box, flat-shaded (each corner split in 3), its
+   * vertices turned by 0.6 rad about z in the mesh's frame (so that its
+   * bounding box there is larger), and the mesh turned in its link */
+  box_mesh_split(0.4, 0.6, 0.05, v, t);
+  for (int k = 0; k < 24; k++) {
+    double x = v[3 * k], y = v[3 * k + 1];
+    v[3 * k] = cos(0.6) * x - sin(0.6) * y;
+    v[3 * k + 1] = sin(0.6) * x + cos(0.6) * y;
+  }
+  worst = 0;
+  points = all = 1;
+  for (int s = 0; s < 2; s++)
+    for (int k = 0; k < 5; k++) {
+      int nh, loaded;
+      double a = mesh_loaded_area(v, 24, t, 12, -0.025, 0.5, spacing[s], place[k][0],
+                                  place[k][1], place[k][2], &nh, &loaded);
+      worst = fmax(worst, fabs(a - 0.24) / 0.24);
+      all &= loaded;
+      points &= nh == 8;
+    }
+  ok(points, "flat-shaded box mesh (24 vertices): its 8 corners are its footprint points");
+  ok(worst <= 1e-9 && all,
+     "  turned in its frame and in its link, at 4 and 2 cm, 5 placements and headings: loaded area = "
+     "0.24 m^2 (worst rel %.2g), every point loaded", worst);
+
+  /* more distinct vertices than SS_MESH_HULL_MAX: no footprint points, the
+   * bounding box's footprint (converging with the spacing, not exact) */
+  prism_mesh(NB, r, 0.1, v, t);
+  double big = 0.5 * NB * r * r * sin(2 * M_PI / NB);
+  int nh, loaded;
+  double a = mesh_loaded_area(v, 2 * NB + 2, t, 4 * NB, -0.05, 0, 0.02, place[1][0],
+                              place[1][1], place[1][2], &nh, &loaded);
+  ok(nh == 0 && fabs(a - big) / big < 0.03 && loaded,
+     "600-gon prism mesh (%d distinct vertices > SS_MESH_HULL_MAX %d): no footprint points "
+     "(%d); its bounding box's footprint, loaded area %.6g within 3%% of %.6g",
+     2 * NB + 2, SS_MESH_HULL_MAX, nh, a, big);
+}
+
 int main(void)
 {
   test_analytic_plate();
@@ -1132,5 +1314,6 @@ int main(void)
   test_resting_on_slope();
   test_creeping_plate();
   test_power_table();
+  test_mesh_quadrature();
   return done_testing();
 }
