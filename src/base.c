@@ -1,4 +1,6 @@
-/* base.c -- errors and atomic output files. */
+/* base.c -- errors, paths and atomic output files. */
+/* realpath() is XSI, beyond the _POSIX_C_SOURCE the build sets */
+#define _XOPEN_SOURCE 700
 #include "soilsim.h"
 
 #include <errno.h>
@@ -45,6 +47,74 @@ const char *ss_status_name(ssStatus code)
   case SS_ERR_NOTFOUND: return "not found";
   }
   return "unknown error";
+}
+
+/* ---------------------------------------------------------------------- */
+/* paths                                                                   */
+
+/* dir (consumed) with the path component last[0..n) appended: "." adds
+ * nothing and ".." takes dir's last component off (dir has no links to
+ * resolve first: it came from realpath, or does not exist).  NULL when
+ * out of memory. */
+static char *append_component(char *dir, const char *last, size_t n)
+{
+  if (n == 0 || (n == 1 && last[0] == '.')) return dir;
+  if (n == 2 && last[0] == '.' && last[1] == '.') {
+    char *slash = strrchr(dir, '/');
+    if (slash == dir) slash[1] = 0;
+    else if (slash) *slash = 0;
+    return dir;
+  }
+  size_t d = strlen(dir);
+  size_t sep = d > 0 && dir[d - 1] != '/';
+  char *r = malloc(d + sep + n + 1);
+  if (r) {
+    memcpy(r, dir, d);
+    if (sep) r[d] = '/';
+    memcpy(r + d + sep, last, n);
+    r[d + sep + n] = 0;
+  }
+  free(dir);
+  return r;
+}
+
+/* ss_path_absolute (soilsim.h), depth the links and folders followed so
+ * far */
+static char *path_absolute(const char *path, int depth)
+{
+  char *r = realpath(path, NULL);
+  if (r) return r;
+  if (depth > 64) return strdup(path); /* a cycle, or a folder deleted under us */
+  struct stat ls;
+  char link[PATH_MAX];
+  ssize_t nl;
+  if (lstat(path, &ls) == 0 && S_ISLNK(ls.st_mode) &&
+      (nl = readlink(path, link, sizeof link - 1)) > 0) {
+    link[nl] = 0;
+    const char *slash = strrchr(path, '/');
+    size_t keep = link[0] == '/' || !slash ? 0 : (size_t)(slash - path) + 1;
+    char *t = malloc(keep + (size_t)nl + 1);
+    if (!t) return NULL;
+    memcpy(t, path, keep);
+    memcpy(t + keep, link, (size_t)nl + 1);
+    r = path_absolute(t, depth + 1);
+    free(t);
+    return r;
+  }
+  size_t n = strlen(path);
+  while (n > 1 && path[n - 1] == '/') n--;
+  size_t b = n;
+  while (b > 0 && path[b - 1] != '/') b--;
+  char *dir = b ? strndup(path, b) : strdup(".");
+  if (!dir) return NULL;
+  char *pd = path_absolute(dir, depth + 1);
+  free(dir);
+  return pd ? append_component(pd, path + b, n - b) : NULL;
+}
+
+char *ss_path_absolute(const char *path)
+{
+  return path && *path ? path_absolute(path, 0) : NULL;
 }
 
 /* ---------------------------------------------------------------------- */

@@ -165,10 +165,8 @@ ssStatus ss_scene_c_locale_begin(ssCLocale *l, const char *path, ssError *err);
 
 /* The folder of path into dir[cap]: "." for a bare name, "/" at the root. */
 void ss_scene_path_dir(const char *path, char *dir, size_t cap);
-/* path as an absolute, normalised path into out[cap]: realpath when it
- * exists (links resolved), else relative to the working folder with ".",
- * ".." and doubled slashes taken out by hand.  Returns 0, or -1 when it
- * does not fit (or the working folder is unknown). */
+/* path as an absolute, normalised path into out[cap] (ss_path_absolute,
+ * soilsim.h).  Returns 0, or -1 when it does not fit or memory runs out. */
 int ss_scene_path_absolute(const char *path, char *out, size_t cap);
 /* The absolute path target as seen from the absolute folder dir (both
  * normalised, as ss_scene_path_absolute makes them): "../" as needed, then

@@ -5,8 +5,6 @@
  * (safely: xml_safe.h), then walks the tree once, building the model with
  * the model builder; every element is checked against a list of allowed
  * attributes and children so that typos are reported instead of ignored. */
-/* realpath (ss_scene_path_absolute) is an XSI function */
-#define _XOPEN_SOURCE 700
 #include "scene.h"
 #include "articulated.h"
 #include "urdf.h"
@@ -136,55 +134,12 @@ void ss_scene_path_dir(const char *path, char *dir, size_t cap)
     snprintf(dir, cap, "%.*s", (int)(slash - path), path);
 }
 
-/* Lexical clean-up of an absolute path: "." and empty components dropped,
- * ".." takes the previous one away (none above the root).  Only for paths
- * that do not exist, where realpath has nothing to follow. */
-static void path_clean(char *p)
-{
-  char *o = p;
-  const char *s = p;
-  while (*s) {
-    while (*s == '/') s++;
-    const char *e = s;
-    while (*e && *e != '/') e++;
-    size_t n = (size_t)(e - s);
-    if (n == 0 || (n == 1 && s[0] == '.')) {
-      /* nothing */
-    } else if (n == 2 && s[0] == '.' && s[1] == '.') {
-      while (o > p && *--o != '/') {}
-    } else {
-      *o++ = '/';
-      memmove(o, s, n);
-      o += n;
-    }
-    s = e;
-  }
-  if (o == p) *o++ = '/';
-  *o = 0;
-}
-
 int ss_scene_path_absolute(const char *path, char *out, size_t cap)
 {
-  if (!path || !*path || cap < 2) return -1;
-  char *real = realpath(path, NULL);
-  if (real) {
-    int n = snprintf(out, cap, "%s", real);
-    free(real);
-    return n >= 0 && (size_t)n < cap ? 0 : -1;
-  }
-  /* a missing file: relative to the working folder, cleaned by hand */
-  size_t k = 0;
-  if (path[0] != '/') {
-    if (!getcwd(out, cap)) return -1;
-    k = strlen(out);
-    if (k + 1 >= cap) return -1;
-    out[k++] = '/';
-  }
-  size_t n = strlen(path);
-  if (k + n + 1 > cap) return -1;
-  memcpy(out + k, path, n + 1);
-  path_clean(out);
-  return 0;
+  char *abs = ss_path_absolute(path);
+  int n = abs ? snprintf(out, cap, "%s", abs) : -1;
+  free(abs);
+  return n >= 0 && (size_t)n < cap ? 0 : -1;
 }
 
 int ss_scene_path_relative(const char *target, const char *dir, char *out,

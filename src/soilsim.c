@@ -9,8 +9,6 @@
  *
  * Exit status: 0 success; 1 bad input or a failed run (the message names
  * the file and line); 2 bad usage.  Only this file prints or exits. */
-/* realpath() is XSI, beyond the _POSIX_C_SOURCE the build sets */
-#define _XOPEN_SOURCE 700
 #include "soilsim.h"
 
 #include <errno.h>
@@ -341,69 +339,6 @@ typedef struct OutputName {
   ino_t ino;
 } OutputName;
 
-/* dir (consumed) with the path component last[0..n) appended: "." adds
- * nothing and ".." takes dir's last component off (dir has no links to
- * resolve first: it came from realpath, or does not exist).  NULL when
- * out of memory. */
-static char *append_component(char *dir, const char *last, size_t n)
-{
-  if (n == 0 || (n == 1 && last[0] == '.')) return dir;
-  if (n == 2 && last[0] == '.' && last[1] == '.') {
-    char *slash = strrchr(dir, '/');
-    if (slash == dir) slash[1] = 0;
-    else if (slash) *slash = 0;
-    return dir;
-  }
-  size_t d = strlen(dir);
-  size_t sep = d > 0 && dir[d - 1] != '/';
-  char *r = malloc(d + sep + n + 1);
-  if (r) {
-    memcpy(r, dir, d);
-    if (sep) r[d] = '/';
-    memcpy(r + d + sep, last, n);
-    r[d + sep + n] = 0;
-  }
-  free(dir);
-  return r;
-}
-
-/* The absolute form of an output path (malloc'd; NULL when out of
- * memory): realpath of the path where it exists; else its folder's,
- * found the same way (it may not exist yet either: --render creates
- * folders), with the last component appended.  A link to nothing yet
- * counts as the path it names, where the writers create the file. */
-static char *normalise_path(const char *path, int depth)
-{
-  char *r = realpath(path, NULL);
-  if (r) return r;
-  if (depth > 64) return strdup(path); /* a cycle, or a folder deleted under us */
-  struct stat ls;
-  char link[PATH_MAX];
-  ssize_t nl;
-  if (lstat(path, &ls) == 0 && S_ISLNK(ls.st_mode) &&
-      (nl = readlink(path, link, sizeof link - 1)) > 0) {
-    link[nl] = 0;
-    const char *slash = strrchr(path, '/');
-    size_t keep = link[0] == '/' || !slash ? 0 : (size_t)(slash - path) + 1;
-    char *t = malloc(keep + (size_t)nl + 1);
-    if (!t) return NULL;
-    memcpy(t, path, keep);
-    memcpy(t + keep, link, (size_t)nl + 1);
-    r = normalise_path(t, depth + 1);
-    free(t);
-    return r;
-  }
-  size_t n = strlen(path);
-  while (n > 1 && path[n - 1] == '/') n--;
-  size_t b = n;
-  while (b > 0 && path[b - 1] != '/') b--;
-  char *dir = b ? strndup(path, b) : strdup(".");
-  if (!dir) return NULL;
-  char *pd = normalise_path(dir, depth + 1);
-  free(dir);
-  return pd ? append_component(pd, path + b, n - b) : NULL;
-}
-
 static int same_output(const OutputName *a, const OutputName *b)
 {
   if (a->exists && b->exists) return a->dev == b->dev && a->ino == b->ino;
@@ -460,7 +395,7 @@ static int check_clashes(const Options *o)
     OutputName *u = &out[n++];
     u->flag = f;
     u->arg = arg;
-    u->abs = normalise_path(path, 0);
+    u->abs = ss_path_absolute(path);
     if (!u->abs) goto nomem;
     struct stat st;
     if (stat(path, &st) == 0) {

@@ -751,6 +751,14 @@ typedef struct ssAtomicFile {
  * file or link planted under that name is neither followed nor
  * overwritten. */
 ssStatus ss_atomic_open(ssAtomicFile *f, const char *path, ssError *err);
+/* The absolute, normalised form of path (malloc'd, the caller frees it;
+ * NULL for an empty path or when out of memory): realpath where it
+ * exists (links resolved); else its folder's, found the same way (that
+ * may not exist yet either), with the last component appended ("." adds
+ * nothing, ".." takes one off); a link to nothing counts as the path it
+ * names.  The CLI compares outputs by it, the scene reader keeps the
+ * files it loaded by it (so that an export can name them). */
+char *ss_path_absolute(const char *path);
 /* Whether PATH can be written, as ss_atomic_open would write it, without
  * writing it: a temporary file is created and removed; a stream is not
  * opened (a FIFO would wait for its reader, and closing it would give the
