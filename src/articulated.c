@@ -1891,7 +1891,10 @@ static int load_mesh(ssModel *m, const ssUrdfGeom *g, ssError *err)
   ssMesh *mesh = NULL;
   if (ss_mesh_load(g->mesh_path, g->mesh_scale, &mesh, err) != SS_OK) return -1;
   int k = ss_model_push_mesh(m, mesh, g->mesh_path, err);
-  if (k < 0) ss_mesh_free(mesh);
+  if (k < 0)
+    ss_mesh_free(mesh);
+  else
+    memcpy(m->mesh_scale + 3 * k, g->mesh_scale, 3 * sizeof(double));
   return k;
 }
 

@@ -760,3 +760,80 @@ void ss_mesh_mass_properties(const ssMesh *m, double *volume,
       for (int j = 0; j < 3; j++)
         inertia[3 * i + j] = (i == j ? tr : 0) - C[3 * i + j];
 }
+
+/* an edge between two positions (ids into the distinct positions), from
+ * lo to hi; dir +1 when a triangle runs it lo -> hi, -1 hi -> lo */
+typedef struct edgeKey {
+  int lo, hi, dir;
+} edgeKey;
+
+static int edge_cmp(const void *pa, const void *pb)
+{
+  const edgeKey *a = pa, *b = pb;
+  if (a->lo != b->lo) return (a->lo > b->lo) - (a->lo < b->lo);
+  if (a->hi != b->hi) return (a->hi > b->hi) - (a->hi < b->hi);
+  return (a->dir > b->dir) - (a->dir < b->dir);
+}
+
+int ss_mesh_closed(const ssMesh *m)
+{
+  if (!m || m->ntri <= 0 || m->nvert <= 0) return 0;
+  /* positions, not vertex indices: a file that splits its vertices per
+   * face (for flat shading) is closed all the same */
+  int *id = malloc((size_t)m->nvert * sizeof *id);
+  keyVert *kv = malloc((size_t)m->nvert * sizeof *kv);
+  edgeKey *ek = malloc((size_t)m->ntri * 3 * sizeof *ek);
+  int closed = -1;
+  if (!id || !kv || !ek) goto done;
+  for (int v = 0; v < m->nvert; v++) kv[v] = (keyVert){m->vert + 3 * v, v};
+  qsort(kv, (size_t)m->nvert, sizeof *kv, kv_cmp);
+  for (int i = 0, d = -1; i < m->nvert; i++) {
+    if (i == 0 || !kv_same(&kv[i], &kv[i - 1])) d++;
+    id[kv[i].v] = d;
+  }
+  long ne = 0;
+  for (int t = 0; t < m->ntri; t++)
+    for (int k = 0; k < 3; k++) {
+      int a = id[m->tri[3 * t + k]], b = id[m->tri[3 * t + (k + 1) % 3]];
+      if (a == b) continue; /* a degenerate triangle's collapsed edge */
+      ek[ne++] = a < b ? (edgeKey){a, b, 1} : (edgeKey){b, a, -1};
+    }
+  qsort(ek, (size_t)ne, sizeof *ek, edge_cmp);
+  /* closed: every edge run as often one way as the other (a consistently
+   * wound surface without border; a mesh wound inside out passes too) */
+  closed = ne > 0;
+  for (long i = 0; i < ne && closed;) {
+    long j = i;
+    int sum = 0;
+    while (j < ne && ek[j].lo == ek[i].lo && ek[j].hi == ek[i].hi) sum += ek[j++].dir;
+    if (sum != 0) closed = 0;
+    i = j;
+  }
+done:
+  free(id);
+  free(kv);
+  free(ek);
+  return closed;
+}
+
+void ss_mesh_surface_centroid(const ssMesh *m, double c[3])
+{
+  double A = 0, S[3] = {0, 0, 0}, ref[3] = {0, 0, 0};
+  if (m && m->ntri > 0)
+    for (int k = 0; k < 3; k++) ref[k] = 0.5 * (m->lo[k] + m->hi[k]);
+  for (int t = 0; m && t < m->ntri; t++) {
+    const int *f = m->tri + 3 * t;
+    double a[3], b[3], e[3], n[3];
+    ss_v3_sub(a, m->vert + 3 * f[1], m->vert + 3 * f[0]);
+    ss_v3_sub(b, m->vert + 3 * f[2], m->vert + 3 * f[0]);
+    ss_v3_cross(n, a, b);
+    double w = 0.5 * ss_v3_norm(n);
+    A += w;
+    for (int k = 0; k < 3; k++) {
+      e[k] = (m->vert[3 * f[0] + k] + m->vert[3 * f[1] + k] +
+              m->vert[3 * f[2] + k]) / 3 - ref[k];
+      S[k] += w * e[k];
+    }
+  }
+  for (int k = 0; k < 3; k++) c[k] = ref[k] + (A > 0 ? S[k] / A : 0);
+}

@@ -61,5 +61,14 @@ int ss_mesh_raycast(const ssMesh *m, const double o[3], const double d[3],
  * may be NULL.  A mesh wound inside out gives the same (positive) result. */
 void ss_mesh_mass_properties(const ssMesh *m, double *volume,
                              double centroid[3], double inertia[9]);
+/* 1 when the mesh encloses a solid: every edge (between positions, so
+ * that vertices split per face still join) is run by its triangles as
+ * often one way as the other, i.e. a consistently wound surface without
+ * border; 0 when it is open (or has no triangles), -1 out of memory.
+ * Only then are ss_mesh_mass_properties' results those of a solid. */
+int ss_mesh_closed(const ssMesh *m);
+/* The area-weighted centroid of the surface (of a shell), for a mesh that
+ * encloses no volume; the bounding box's centre when it has no area. */
+void ss_mesh_surface_centroid(const ssMesh *m, double c[3]);
 
 #endif /* SS_MESH_H */

@@ -43,6 +43,7 @@ ssBodyDef ss_body_def_default(void)
   d.size[0] = d.size[1] = d.size[2] = 0.1;
   d.mass = 1;
   d.quat[0] = 1;
+  d.mesh_scale[0] = d.mesh_scale[1] = d.mesh_scale[2] = 1;
   return d;
 }
 
@@ -103,7 +104,7 @@ void ss_model_free(ssModel *m)
   free(m->spring_body); free(m->spring_anchor); free(m->spring_param);
   free(m->pd_body); free(m->pd_gain); free(m->pd_target0);
   for (int i = 0; i < m->nmesh; i++) ss_mesh_free(m->mesh[i]);
-  free(m->mesh); free_names(m->mesh_path, m->nmesh);
+  free(m->mesh); free_names(m->mesh_path, m->nmesh); free(m->mesh_scale);
   free(m->geom_type); free(m->geom_body); free(m->geom_size); free(m->geom_pos);
   free(m->geom_quat); free(m->geom_material); free(m->geom_rgba);
   free(m->geom_group); free(m->geom_mesh);
@@ -468,13 +469,16 @@ int ss_model_push_mesh(ssModel *m, struct ssMesh *mesh, const char *path,
   int k = m->nmesh;
   if (k + 1 > m->cap_mesh) {
     int c = next_cap(m->cap_mesh, k + 1);
-    if (RE(m->mesh, c, 1) || RE(m->mesh_path, c, 1)) goto nomem;
+    if (RE(m->mesh, c, 1) || RE(m->mesh_path, c, 1) || RE(m->mesh_scale, c, 3))
+      goto nomem;
     m->cap_mesh = c;
   }
   char *p = dupstr(path ? path : "");
   if (!p) goto nomem;
   m->mesh[k] = mesh;
   m->mesh_path[k] = p;
+  /* the caller that loaded it scaled sets the scale it baked in */
+  for (int a = 0; a < 3; a++) m->mesh_scale[3 * k + a] = 1;
   return m->nmesh++;
 nomem:
   ss_error_set(err, SS_ERR_NOMEM, m->source_path, 0, "out of memory");
@@ -600,13 +604,18 @@ int ss_model_add_body(ssModel *m, const ssBodyDef *def, ssError *err)
   if (check_name(m, def->name, def->line, err) != SS_OK) return -1;
   static const char *shape_names[] = {"box", "sphere", "cylinder", "capsule",
                                       "mesh"};
-  if (def->shape < SS_GEOM_BOX || def->shape > SS_GEOM_CAPSULE) {
+  if (def->shape < SS_GEOM_BOX || def->shape > SS_GEOM_MESH) {
     ss_error_set(err, SS_ERR_UNSUPPORTED, f, def->line,
                  "body '%s': shape %d is not supported for single bodies "
-                 "(box, sphere, cylinder, capsule)", def->name, (int)def->shape);
+                 "(box, sphere, cylinder, capsule, mesh)", def->name,
+                 (int)def->shape);
     return -1;
   }
-  int nsize = def->shape == SS_GEOM_BOX ? 3 : def->shape == SS_GEOM_SPHERE ? 1 : 2;
+  const int is_mesh = def->shape == SS_GEOM_MESH;
+  /* a mesh's size is its file's: def->size is not used */
+  int nsize = is_mesh ? 0
+              : def->shape == SS_GEOM_BOX ? 3
+              : def->shape == SS_GEOM_SPHERE ? 1 : 2;
   for (int k = 0; k < nsize; k++)
     if (!isfinite(def->size[k]) || def->size[k] <= 0) {
       ss_error_set(err, SS_ERR_VALUE, f, def->line,
@@ -644,6 +653,63 @@ int ss_model_add_body(ssModel *m, const ssBodyDef *def, ssError *err)
                  "body '%s': quaternion has zero length", def->name);
     return -1;
   }
+  if (is_mesh && (!def->mesh_path || !def->mesh_path[0])) {
+    ss_error_set(err, SS_ERR_VALUE, f, def->line,
+                 "mesh '%s': no mesh file given", def->name);
+    return -1;
+  }
+  for (int k = 0; is_mesh && k < 3; k++)
+    if (!isfinite(def->mesh_scale[k]) || def->mesh_scale[k] == 0) {
+      ss_error_set(err, SS_ERR_VALUE, f, def->line,
+                   "mesh '%s': scale value %d is %g; mesh scales must be finite "
+                   "and non-zero", def->name, k + 1, def->mesh_scale[k]);
+      return -1;
+    }
+  /* a mesh: loaded first (its failures are the likeliest), its solid's
+   * mass properties at uniform density give the body frame's origin (the
+   * centroid) and, unless given, the inertia */
+  ssMesh *mesh = NULL;
+  double centroid[3] = {0, 0, 0}, Imesh[9];
+  int solid = 0;
+  if (is_mesh) {
+    ssError me;
+    if (ss_mesh_load(def->mesh_path, def->mesh_scale, &mesh, &me) != SS_OK) {
+      ss_error_set(err, me.code, f, def->line, "mesh '%s': %s: %s", def->name,
+                   def->mesh_path, me.message);
+      return -1;
+    }
+    int closed = ss_mesh_closed(mesh);
+    if (closed < 0) {
+      ss_mesh_free(mesh);
+      ss_error_set(err, SS_ERR_NOMEM, f, def->line, "out of memory");
+      return -1;
+    }
+    double V = 0, L = 0;
+    ss_mesh_mass_properties(mesh, &V, centroid, Imesh);
+    for (int k = 0; k < 3; k++)
+      if (mesh->hi[k] - mesh->lo[k] > L) L = mesh->hi[k] - mesh->lo[k];
+    /* flat: a volume that is rounding next to its extent's cube */
+    solid = closed && V > 1e-9 * L * L * L;
+    if (solid) {
+      double scl = (def->is_static ? 1 : def->mass) / V;
+      for (int k = 0; k < 9; k++) Imesh[k] *= scl;
+    } else {
+      if (!def->inertia_given && !def->is_static) {
+        ss_error_set(err, SS_ERR_VALUE, f, def->line,
+                     "mesh '%s': %s encloses no volume (it is %s), so its "
+                     "inertia cannot be computed: give it an <inertia>",
+                     def->name, def->mesh_path, closed ? "flat" : "open");
+        ss_mesh_free(mesh);
+        return -1;
+      }
+      /* a shell: its body frame at the surface's centroid (a static one's
+       * inertia is never used: its bounding box's stands in) */
+      ss_mesh_surface_centroid(mesh, centroid);
+      double box[3];
+      for (int k = 0; k < 3; k++) box[k] = mesh->hi[k] - mesh->lo[k];
+      shape_inertia(SS_GEOM_BOX, box, 1, Imesh);
+    }
+  }
   double I[9];
   if (def->inertia_given) {
     const double *v = def->inertia;
@@ -657,23 +723,31 @@ int ss_model_add_body(ssModel *m, const ssBodyDef *def, ssError *err)
       ss_error_set(err, SS_ERR_VALUE, f, def->line,
                    "body '%s': inertia must be symmetric positive definite",
                    def->name);
+      ss_mesh_free(mesh);
       return -1;
     }
+  } else if (is_mesh) {
+    memcpy(I, Imesh, sizeof I);
   } else {
     shape_inertia(def->shape, def->size, def->is_static ? 1 : def->mass, I);
   }
   int mat = ss_model_material(m, def->material);
   if (mat < 0) {
     ss_error_set(err, SS_ERR_NOMEM, f, def->line, "out of memory");
+    ss_mesh_free(mesh);
     return -1;
   }
   int nv = def->is_static ? 0 : 6;
   ssModelMark mark = ss_model_mark(m);
   int s = ss_model_push_sys(m, def->name, def->is_static ? SS_SYS_STATIC : SS_SYS_FREE,
                             7, nv, def->line, err);
-  if (s < 0) return -1;
+  if (s < 0) {
+    ss_mesh_free(mesh);
+    return -1;
+  }
   int b = ss_model_push_body(m, s, def->name, "", -1, err);
   if (b < 0) {
+    ss_mesh_free(mesh);
     ss_model_rollback(m, &mark);
     return -1;
   }
@@ -686,9 +760,26 @@ int ss_model_add_body(ssModel *m, const ssBodyDef *def, ssError *err)
   m->body_ndof[b] = nv;
   double size[3] = {def->size[0], def->shape == SS_GEOM_SPHERE ? 0 : def->size[1],
                     def->shape == SS_GEOM_BOX ? def->size[2] : 0};
-  double zero[3] = {0, 0, 0}, ident[4] = {1, 0, 0, 0};
-  if (ss_model_push_geom(m, b, def->shape, size, zero, ident, mat, def->rgba, 3,
-                         -1, err) < 0) {
+  double gpos[3] = {0, 0, 0}, ident[4] = {1, 0, 0, 0};
+  int k = -1;
+  if (is_mesh) {
+    /* the geom frame is the file's, at -centroid in the body frame, so
+     * that the body's origin (its state's pos) is the centre of mass;
+     * its size is the bounding box's, as a URDF link's mesh */
+    k = ss_model_push_mesh(m, mesh, def->mesh_path, err);
+    if (k < 0) {
+      ss_mesh_free(mesh);
+      ss_model_rollback(m, &mark);
+      return -1;
+    }
+    memcpy(m->mesh_scale + 3 * k, def->mesh_scale, 3 * sizeof(double));
+    for (int a = 0; a < 3; a++) {
+      size[a] = mesh->hi[a] - mesh->lo[a];
+      gpos[a] = -centroid[a];
+    }
+  }
+  if (ss_model_push_geom(m, b, def->shape, size, gpos, ident, mat, def->rgba, 3,
+                         k, err) < 0) {
     ss_model_rollback(m, &mark);
     return -1;
   }

@@ -63,7 +63,15 @@
  *         <pd joint=R p_gain d_gain position_target velocity_target
  *             effort_limit/>   (0..64, at most one per joint)
  *       </articulated_system>
- *       <mesh>: SS_ERR_UNSUPPORTED ("not supported yet")
+ *       <mesh name=R mass=R file_name=R scale [1] material body_type rgba>
+ *         (read_body: a rigid body of a mesh file, ss_mesh_load; no <dim>;
+ *         file_name relative or with [THIS_DIR], kept absolute; scale one
+ *         value or x y z, each non-zero; the body frame has the file's
+ *         axes, its origin at the enclosed solid's centroid, so state pos
+ *         is the centre of mass; a mesh enclosing no volume needs
+ *         <inertia>)
+ *         <state/> <inertia/> <external_force/>   as for <box>
+ *       </mesh>
  *     </objects>
  *     <material>
  *       <default friction [0.8] restitution [0] restitution_threshold [0]/>

@@ -852,20 +852,53 @@ static ssStatus read_xforce(readCtx *c, xmlNodePtr n, const char *label,
   return st;
 }
 
+/* A mesh's scale: one value for all three axes or three (as URDF's), each
+ * non-zero. */
+static ssStatus get_mesh_scale(readCtx *c, xEl *e, double s[3])
+{
+  const char *v = el_find(e, "scale");
+  if (!v) return SS_OK;
+  long n = ss_xml_vec_count(v);
+  if (n > 0 && n != 1 && n != 3)
+    return fail(c, SS_ERR_PARSE, e->line,
+                "%s: attribute 'scale' has %ld values, expected 1 (all axes) "
+                "or 3 (x y z)", e->label, n);
+  ssStatus st = parse_values(c, e, "scale", v, n == 1 ? 1 : 3, NULL, s);
+  if (!st && n == 1) s[1] = s[2] = s[0];
+  for (int k = 0; !st && k < 3; k++)
+    if (s[k] == 0)
+      st = fail(c, SS_ERR_VALUE, e->line,
+                "%s: scale value %d is 0; mesh scales must be non-zero",
+                e->label, k + 1);
+  return st;
+}
+
+/* <box|sphere|cylinder|capsule name mass material body_type rgba> with
+ * <dim>, or <mesh ... file_name scale> without; either with optional
+ * <state>, <inertia> and any number of <external_force> */
 static ssStatus read_body(readCtx *c, xmlNodePtr n, ssGeomType shape)
 {
   static const char *const allowed[] = {"name", "mass", "material",
                                         "body_type", "rgba", NULL};
+  static const char *const allowed_mesh[] = {"name", "mass", "material",
+                                             "body_type", "rgba", "file_name",
+                                             "scale", NULL};
   static const char *const kids[] = {"dim", "state", "inertia",
                                      "external_force", NULL};
+  static const char *const kids_mesh[] = {"state", "inertia", "external_force",
+                                          NULL};
+  const int is_mesh = shape == SS_GEOM_MESH;
   ssBodyDef def = ss_body_def_default();
   def.shape = shape;
   xEl e;
   xforceDef *xf = NULL;
   int nxf = 0;
   const char *type = NULL;
+  /* the mesh file as found (messages) and kept (absolute, normalised, as
+   * an articulated system's urdf_path: an export anywhere names it) */
+  char path[1024] = "", abspath[4096] = "";
   ssStatus st = el_open(c, n, NULL, &e);
-  if (!st) st = el_allow(c, &e, allowed);
+  if (!st) st = el_allow(c, &e, is_mesh ? allowed_mesh : allowed);
   if (!st) st = get_str(c, &e, "name", 1, &def.name);
   if (!st) snprintf(e.label, sizeof e.label, "%s '%s'", e.name, def.name);
   if (!st) st = get_str(c, &e, "body_type", 0, &type);
@@ -897,12 +930,22 @@ static ssStatus read_body(readCtx *c, xmlNodePtr n, ssGeomType shape)
                   "%s: rgba component %d = %g is invalid: must be in [0, 1]",
                   e.label, k + 1, def.rgba[k]);
   }
+  if (!st && is_mesh) {
+    const char *raw = NULL;
+    st = get_str(c, &e, "file_name", 1, &raw);
+    if (!st) st = resolve_path(c, &e, "file_name", raw, path, sizeof path);
+    if (!st && ss_scene_path_absolute(path, abspath, sizeof abspath))
+      st = fail(c, SS_ERR_VALUE, e.line, "%s: file_name '%s' is too long as "
+                "an absolute path", e.label, path);
+    if (!st) st = get_mesh_scale(c, &e, def.mesh_scale);
+    def.mesh_path = abspath;
+  }
   int seen_dim = 0, seen_state = 0, seen_inertia = 0;
   double quat_read[4] = {1, 0, 0, 0};
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
     char kn[NAME_CAP];
     if (!child_el(c, k, &e, kn, &st)) continue;
-    if (!strcmp(kn, "dim")) {
+    if (!strcmp(kn, "dim") && !is_mesh) {
       st = once_at(c, &seen_dim, k, kn);
       if (!st) st = read_dim(c, k, e.label, &def);
     } else if (!strcmp(kn, "state")) {
@@ -922,10 +965,10 @@ static ssStatus read_body(readCtx *c, xmlNodePtr n, ssGeomType shape)
       st = read_xforce(c, k, e.label, &xf[nxf]);
       if (!st) nxf++;
     } else {
-      st = unknown_child(c, k, &e, kids);
+      st = unknown_child(c, k, &e, is_mesh ? kids_mesh : kids);
     }
   }
-  if (!st && !seen_dim)
+  if (!st && !seen_dim && !is_mesh)
     st = fail(c, SS_ERR_PARSE, e.line, "%s: missing its <dim> element",
               e.label);
   /* a static body never moves: a velocity or a force given it would be
@@ -1477,7 +1520,7 @@ static ssStatus refuse_media(readCtx *c, xmlNodePtr k, const char *kn,
 static ssStatus read_objects(readCtx *c, xmlNodePtr n)
 {
   static const char *const kids[] = {"ground", "box", "sphere", "cylinder",
-                                     "capsule", "heightmap",
+                                     "capsule", "mesh", "heightmap",
                                      "articulated_system", NULL};
   static const char *const none[] = {NULL};
   xEl e;
@@ -1494,14 +1537,8 @@ static ssStatus read_objects(readCtx *c, xmlNodePtr n)
     else if (!strcmp(kn, "capsule")) st = read_body(c, k, SS_GEOM_CAPSULE);
     else if (!strcmp(kn, "heightmap")) st = read_heightmap(c, k);
     else if (!strcmp(kn, "articulated_system")) st = read_articulated(c, k);
-    else if (!strcmp(kn, "mesh")) {
-      xmlChar *nm = xmlGetProp(k, BAD_CAST "name");
-      st = fail(c, SS_ERR_UNSUPPORTED, ss_xml_line(k),
-                "<%s>%s%s%s is not supported yet (supported objects: ground, "
-                "box, sphere, cylinder, capsule, heightmap, articulated_system)", kn,
-                nm ? " '" : "", nm ? (const char *)nm : "", nm ? "'" : "");
-      if (nm) xmlFree(nm);
-    } else if (ss_xml_in_list(kn, media_names))
+    else if (!strcmp(kn, "mesh")) st = read_body(c, k, SS_GEOM_MESH);
+    else if (ss_xml_in_list(kn, media_names))
       st = refuse_media(c, k, kn, soil);
     else
       st = unknown_child(c, k, &e, kids);

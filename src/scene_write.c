@@ -9,9 +9,9 @@
  * through one buffer straight to the file (no per-number library calls
  * besides the formatting), and the file is replaced atomically.
  *
- * Files.  Height maps are written explicit and mesh bodies are refused, so
- * the only files an export names are an articulated system's URDF
- * (urdf_path) and resource folder (res_dir).  The reader keeps them as
+ * Files.  Height maps are written explicit, so the only files an export
+ * names are an articulated system's URDF (urdf_path) and resource folder
+ * (res_dir) and a mesh body's file (file_name).  The reader keeps them as
  * absolute, normalised paths (links resolved); they are written relative to
  * the export's own folder ("../assets/arm.urdf"), which is how the reader
  * resolves them, so an export written anywhere loads again and a folder
@@ -216,7 +216,8 @@ static const char *mat_name(const ssModel *m, int k)
 static void write_body(wBuf *w, const ssModel *m, const ssData *d, int s,
                        int g)
 {
-  static const char *const tag[] = {"box", "sphere", "cylinder", "capsule"};
+  static const char *const tag[] = {"box", "sphere", "cylinder", "capsule",
+                                    "mesh"};
   int b = m->sys_bodyadr[s];
   int is_static = m->sys_type[s] == SS_SYS_STATIC;
   const char *t = tag[m->geom_type[g]];
@@ -232,8 +233,21 @@ static void write_body(wBuf *w, const ssModel *m, const ssData *d, int s,
     a_num(w, "mass", m->body_mass[b]);
   a_str(w, "material", mat_name(m, m->geom_material[g]));
   a_vec(w, "rgba", m->geom_rgba + 4 * g, 4);
-  w_s(w, ">\n      <dim");
-  switch (m->geom_type[g]) {
+  const int is_mesh = m->geom_type[g] == SS_GEOM_MESH;
+  if (is_mesh) {
+    /* the file and the scale the model baked into its vertices: the
+     * reader loads the same vertices and finds the same centroid */
+    int k = m->geom_mesh[g];
+    const double *sc = m->mesh_scale + 3 * k;
+    a_path(w, "file_name", m->mesh_path[k]);
+    a_vec(w, "scale", sc, sc[0] == sc[1] && sc[1] == sc[2] ? 1 : 3);
+    w_s(w, ">\n      <state");
+  } else {
+    w_s(w, ">\n      <dim");
+  }
+  switch (is_mesh ? -1 : m->geom_type[g]) {
+  case -1:
+    break;
   case SS_GEOM_BOX:
     a_num(w, "x", sz[0]);
     a_num(w, "y", sz[1]);
@@ -247,7 +261,7 @@ static void write_body(wBuf *w, const ssModel *m, const ssData *d, int s,
     a_num(w, "height", sz[1]);
     break;
   }
-  w_s(w, "/>\n      <state");
+  if (!is_mesh) w_s(w, "/>\n      <state");
   a_vec(w, "pos", q, 3);
   a_vec(w, "quat", q + 3, 4);
   if (!is_static) {
@@ -256,7 +270,10 @@ static void write_body(wBuf *w, const ssModel *m, const ssData *d, int s,
     a_vec(w, "ang_vel", v + 3, 3);
   }
   w_s(w, "/>\n");
-  if (m->body_inertia_given[b]) {
+  /* a dynamic mesh's inertia is always written: the reader would
+   * integrate it again from the file (its mass over its volume), and the
+   * one held is what replays bit for bit */
+  if (m->body_inertia_given[b] || (is_mesh && !is_static)) {
     const double *I = m->body_inertia + 9 * b;
     w_s(w, "      <inertia");
     a_num(w, "xx", I[0]);
@@ -462,10 +479,14 @@ static ssStatus check_exportable(const ssModel *m, const ssData *d,
     for (int g = 0; g < m->ngeom; g++)
       if (m->geom_body[g] == b) {
         ng++;
-        if (m->geom_type[g] < SS_GEOM_BOX || m->geom_type[g] > SS_GEOM_CAPSULE)
+        if (m->geom_type[g] < SS_GEOM_BOX || m->geom_type[g] > SS_GEOM_MESH ||
+            (m->geom_type[g] == SS_GEOM_MESH &&
+             (m->geom_mesh[g] < 0 || m->geom_mesh[g] >= m->nmesh ||
+              !m->mesh_path[m->geom_mesh[g]][0])))
           return ss_error_set(err, SS_ERR_UNSUPPORTED, path, 0,
-                              "cannot export '%s': mesh bodies are not "
-                              "supported yet", m->sys_name[s]);
+                              "cannot export '%s': its collider is not a "
+                              "primitive or a mesh loaded from a file",
+                              m->sys_name[s]);
       }
     if (ng != 1)
       return ss_error_set(err, SS_ERR_UNSUPPORTED, path, 0,

@@ -118,7 +118,8 @@ typedef enum ssGeomType {
   SS_GEOM_SPHERE,   /* size[0] = radius */
   SS_GEOM_CYLINDER, /* size[0] = radius, size[1] = length along local z */
   SS_GEOM_CAPSULE,  /* size[0] = radius, size[1] = distance between centres */
-  SS_GEOM_MESH      /* triangle mesh (articulated links; later issue) */
+  SS_GEOM_MESH      /* triangle mesh (ssModel.mesh); size = its bounding
+                       box's edge lengths */
 } ssGeomType;
 
 typedef enum ssJointType {
@@ -272,6 +273,7 @@ typedef struct ssModel {
   int nmesh;
   struct ssMesh **mesh; /* (nmesh) */
   char **mesh_path;     /* (nmesh) file each mesh came from */
+  double *mesh_scale;   /* (nmesh x 3) the scale baked into its vertices */
 
   /* rigid ground planes z = height */
   int nplane;
@@ -331,12 +333,20 @@ typedef struct ssModel {
 /* model builder                                                           */
 
 /* Definition of a single rigid body (Box2D-style def with defaults). */
+/* A single rigid body.  pos is its centre of mass for every shape: a
+ * primitive's centre, or a mesh's centroid (shape SS_GEOM_MESH: the body
+ * frame has the mesh file's axes, its origin at the centroid of the solid
+ * the mesh encloses, so the mesh sits at -centroid in it). */
 typedef struct ssBodyDef {
   const char *name;
   ssGeomType shape;
-  double size[3];        /* see ssGeomType */
+  double size[3];        /* see ssGeomType (not used by a mesh) */
+  const char *mesh_path; /* SS_GEOM_MESH: the file (ss_mesh_load) */
+  double mesh_scale[3];  /* SS_GEOM_MESH: per-axis scale, each non-zero
+                            (default 1 1 1) */
   double mass;           /* (kg) > 0 for dynamic bodies */
-  int inertia_given;     /* 1: use inertia[] instead of the uniform solid */
+  int inertia_given;     /* 1: use inertia[] instead of the uniform solid
+                            (required for a mesh enclosing no volume) */
   double inertia[6];     /* xx xy xz yy yz zz about the COM, body frame */
   int is_static;         /* 1: fixed in place */
   const char *material;  /* rigid material name (NULL = "default") */

@@ -86,8 +86,9 @@ static inline void attach_response(const Attach *a, ssContact *c)
 }
 
 /* the collider of geom g expressed in a frame (R, p); a mesh stands in as
- * its bounding box for the cells visited, the width and the candidates
- * (DESIGN 2.4), its footprint is its vertices' hull (mesh_footprint) and
+ * its bounding box for the cells visited and the width (DESIGN 2.4), its
+ * rigid contacts' candidates are its lowest vertices (mesh_candidates), its
+ * footprint is its vertices' hull (mesh_footprint) and
  * its depth comes from ray casts (mesh_depth) */
 static void shape_in_frame(const ssModel *m, const ssData *d, int g,
                            const double R[9], const double p[3], ssShape *s)
@@ -461,8 +462,57 @@ static int hfield_sample(const ssModel *m, int h, double x, double y,
   return 1;
 }
 
+/* A mesh's candidate points on a rigid support, s its bounding box in the
+ * support's frame (shape_in_frame): its lowest footprint points (ssMesh.
+ * hull, its distinct vertices) along the support's normal (the frame's
+ * z), at most SS_RIGID_CANDIDATES, so that a rock rests on its vertices
+ * and not on its box's corners.  Ties go to the earlier point, and the
+ * points chosen keep the mesh's order, so that each candidate's index (the
+ * warm start's key, ss_rigid_feature) is the same vertex while the same
+ * ones are lowest: all of them for a mesh of at most SS_RIGID_CANDIDATES.
+ * The box's corners where the mesh keeps no footprint points (more than
+ * SS_MESH_HULL_MAX). */
+static int mesh_candidates(const ssModel *m, int g, const ssShape *s,
+                           double pts[][3])
+{
+  const ssMesh *me = m->mesh[m->geom_mesh[g]];
+  if (me->nhull <= 0) {
+    double up[3] = {0, 0, 1};
+    return ss_shape_candidates(s, up, pts, SS_RIGID_CANDIDATES);
+  }
+  /* the lowest so far, by height then index (insertion: n is small) */
+  int best[SS_RIGID_CANDIDATES], n = 0;
+  double bz[SS_RIGID_CANDIDATES];
+  const double *R = s->R;
+  for (int i = 0; i < me->nhull; i++) {
+    const double *h = me->hull + 3 * i;
+    double z = R[6] * h[0] + R[7] * h[1] + R[8] * h[2] + s->pos[2];
+    if (n == SS_RIGID_CANDIDATES && !(z < bz[n - 1])) continue;
+    int j = n < SS_RIGID_CANDIDATES ? n++ : n - 1;
+    for (; j > 0 && z < bz[j - 1]; j--) {
+      bz[j] = bz[j - 1];
+      best[j] = best[j - 1];
+    }
+    bz[j] = z;
+    best[j] = i;
+  }
+  /* back in the mesh's order */
+  for (int a = 1; a < n; a++)
+    for (int j = a; j > 0 && best[j] < best[j - 1]; j--) {
+      int t = best[j];
+      best[j] = best[j - 1];
+      best[j - 1] = t;
+    }
+  for (int k = 0; k < n; k++) {
+    ss_m3_mulv(pts[k], R, me->hull + 3 * best[k]);
+    ss_v3_add(pts[k], pts[k], s->pos);
+  }
+  return n;
+}
+
 /* Coulomb contacts of geom g against a rigid surface: candidate points of
- * the collider tested against the surface (plane when h < 0). */
+ * the collider (a mesh's: mesh_candidates) tested against the surface
+ * (plane when h < 0). */
 static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
                                int g, int sys, ssError *err)
 {
@@ -483,7 +533,9 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
   if (lo[2] > top + margin) return SS_OK;
 
   double up[3] = {0, 0, 1}, pts[SS_RIGID_CANDIDATES][3];
-  int npt = ss_shape_candidates(&s, up, pts, SS_RIGID_CANDIDATES);
+  int npt = m->geom_type[g] == SS_GEOM_MESH
+                ? mesh_candidates(m, g, &s, pts)
+                : ss_shape_candidates(&s, up, pts, SS_RIGID_CANDIDATES);
   const int support = h >= 0 ? h : m->nhfield + plane;
   int mat = h >= 0 ? m->hfield_material[h] : m->plane_material[plane];
   const ssMaterialPair *pair = ss_model_pair(m, m->geom_material[g], mat);

@@ -1293,6 +1293,144 @@ static void test_mesh_quadrature(void)
      2 * NB + 2, SS_MESH_HULL_MAX, nh, a, big);
 }
 
+
+/* a mesh of tests/data/urdf/meshes (from $top_srcdir) */
+static const char *mesh_file(char *buf, size_t cap, const char *name)
+{
+  const char *top = getenv("top_srcdir");
+  snprintf(buf, cap, "%s/tests/data/urdf/meshes/%s", top && *top ? top : ".", name);
+  return buf;
+}
+
+/* Stand-alone mesh bodies (ss_model_add_body, SS_GEOM_MESH).  The unit
+ * cube of cube.obj (z from 0 to 1: off-centre) scaled to the plate of
+ * DESIGN 2.7: its body frame's origin is the centroid (the geom at
+ * -centroid), its inertia the box formula's, and it settles on the plate
+ * soil to the analytic 8.175 mm as the box does (test_analytic_plate). */
+static void test_mesh_body(void)
+{
+  const double s_ref = 8.175e-3, lx = 0.4, ly = 0.6, lz = 0.05, mass = 20;
+  char path[1024];
+  ssError e;
+  World w;
+  w.m = ss_model_new();
+  w.bed = add_bed(w.m, 1.2, 0.02, plate_soil());
+  ssBodyDef bd = ss_body_def_default();
+  bd.name = "plate";
+  bd.shape = SS_GEOM_MESH;
+  bd.mesh_path = mesh_file(path, sizeof path, "cube.obj");
+  bd.mesh_scale[0] = lx;
+  bd.mesh_scale[1] = ly;
+  bd.mesh_scale[2] = lz;
+  bd.mass = mass;
+  ss_v3_set(bd.pos, 0, 0, 0.5 * lz);
+  w.plate = ss_model_add_body(w.m, &bd, &e);
+  w.d = w.plate >= 0 ? ss_data_new(w.m) : NULL;
+  if (!ok(w.plate >= 0 && w.d, "mesh body: cube.obj scaled to 0.4 x 0.6 x 0.05 m is added")) {
+    diag("%s", e.message);
+    free_world(&w);
+    return;
+  }
+  int b = w.m->sys_bodyadr[w.plate], g = w.m->ngeom - 1;
+  const double *I = w.m->body_inertia + 9 * b, *gp = w.m->geom_pos + 3 * g;
+  double want[3] = {mass * (ly * ly + lz * lz) / 12, mass * (lx * lx + lz * lz) / 12,
+                    mass * (lx * lx + ly * ly) / 12};
+  double worst = 0;
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      worst = fmax(worst, fabs(I[3 * i + j] - (i == j ? want[i] : 0)) / want[0]);
+  ok(worst < 1e-12 && w.m->body_mass[b] == mass,
+     "mesh body: mass 20 kg and the box formula's inertia (worst relative error %.2g)", worst);
+  ok(fabs(gp[0]) < 1e-15 && fabs(gp[1]) < 1e-15 && fabs(gp[2] + 0.5 * lz) < 1e-15 &&
+         w.m->geom_type[g] == SS_GEOM_MESH && w.m->geom_mesh[g] >= 0 &&
+         fabs(w.m->geom_size[3 * g + 2] - lz) < 1e-15,
+     "mesh body: the off-centre mesh (z from 0 to 0.05) sits at -centroid = (%g, %g, %g) "
+     "in the body frame: its state's pos is the centre of mass", gp[0], gp[1], gp[2]);
+  int good = run(&w, 1500);
+  if (good) close_enough(plate_sinkage(&w), s_ref, 0.005 * s_ref, "mesh body plate sinkage (8.175 mm)");
+  else ok(0, "mesh body: settle run");
+  close_enough(w.d->stats.soil_contact_area, 0.24, 1e-9, "  loaded area = the plate's");
+  free_world(&w);
+
+  /* an open mesh encloses no volume: refused without an inertia, taken
+   * with one (its frame at the surface's centroid) */
+  char open_path[1024];
+  const char *top = getenv("top_srcdir");
+  snprintf(open_path, sizeof open_path, "%s/tests/data/bad/open_box.obj", top && *top ? top : ".");
+  ssModel *m = ss_model_new();
+  ssBodyDef ob = ss_body_def_default();
+  ob.name = "bucket";
+  ob.shape = SS_GEOM_MESH;
+  ob.mesh_path = open_path;
+  ob.mass = 2;
+  int r = ss_model_add_body(m, &ob, &e);
+  ok(r < 0 && e.code == SS_ERR_VALUE && strstr(e.message, "encloses no volume") &&
+         strstr(e.message, "open_box.obj") && m->nsys == 0 && m->nmesh == 0,
+     "an open mesh without an inertia is refused, nothing added (%s)", e.message);
+  ob.inertia_given = 1;
+  ob.inertia[0] = ob.inertia[3] = ob.inertia[5] = 0.1;
+  r = ss_model_add_body(m, &ob, &e);
+  ok(r >= 0 && m->nmesh == 1 && m->body_inertia[9 * m->sys_bodyadr[r]] == 0.1,
+     "... and taken with one");
+  ob.name = "missing";
+  ob.mesh_path = "/no/such/rock.obj";
+  r = ss_model_add_body(m, &ob, &e);
+  ok(r < 0 && strstr(e.message, "/no/such/rock.obj") && m->nsys == 1,
+     "a mesh file that does not exist: the error names it (%s)", e.message);
+  ob.mesh_path = open_path;
+  ob.mesh_scale[1] = 0;
+  r = ss_model_add_body(m, &ob, &e);
+  ok(r < 0 && strstr(e.message, "scale value 2 is 0"), "scale 0 is refused (%s)", e.message);
+  ss_model_free(m);
+}
+
+/* A rock (a regular octahedron, vertices 0.1 m from its centre) set on a
+ * ground plane on one face comes to rest on that face's three vertices:
+ * its centre at 0.1 / sqrt 3 above the plane (on its bounding box's
+ * corners it would be 0.1 sqrt 3), its rigid contacts at its vertices. */
+static void test_mesh_rock(void)
+{
+  const double a = 0.1, th = acos(1 / sqrt(3.0));
+  char path[1024];
+  ssError e;
+  ssModel *m = ss_model_new();
+  ss_model_add_plane(m, "ground", 0, NULL, 0, &e);
+  ssBodyDef bd = ss_body_def_default();
+  bd.name = "rock";
+  bd.shape = SS_GEOM_MESH;
+  bd.mesh_path = mesh_file(path, sizeof path, "octa.obj");
+  bd.mesh_scale[0] = bd.mesh_scale[1] = bd.mesh_scale[2] = a;
+  bd.mass = 3;
+  double axis[3] = {sqrt(0.5), -sqrt(0.5), 0};
+  ss_quat_from_axis_angle(bd.quat, axis, th);
+  ss_v3_set(bd.pos, 0.3, -0.2, a / sqrt(3.0) + 0.01);
+  int s = ss_model_add_body(m, &bd, &e);
+  ssData *d = s >= 0 ? ss_data_new(m) : NULL;
+  if (!ok(d != NULL, "octahedron rock builds")) {
+    diag("%s", e.message);
+    ss_model_free(m);
+    return;
+  }
+  int good = 1;
+  for (int k = 0; k < 800 && good; k++) good = ss_step(m, d, &e) == SS_OK;
+  double z = d->qpos[2], worst = 0;
+  int nrigid = 0;
+  for (int i = 0; i < d->ncontact; i++) {
+    if (d->contact[i].type != SS_CONTACT_RIGID) continue;
+    nrigid++;
+    /* each contact at a vertex: |c - centre| = a */
+    double r[3];
+    ss_v3_sub(r, d->contact[i].pos, d->qpos);
+    worst = fmax(worst, fabs(ss_v3_norm(r) - a));
+  }
+  ok(good && fabs(z - a / sqrt(3.0)) < 1e-4 && nrigid == 3 && worst < 1e-4,
+     "an octahedron rock rests on a face's vertices: centre %.5f m up (want %.5f; "
+     "its box's corners would give %.5f), %d rigid contacts, each %.2g m off a vertex",
+     z, a / sqrt(3.0), a * sqrt(3.0), nrigid, worst);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 int main(void)
 {
   test_analytic_plate();
@@ -1315,5 +1453,7 @@ int main(void)
   test_creeping_plate();
   test_power_table();
   test_mesh_quadrature();
+  test_mesh_body();
+  test_mesh_rock();
   return done_testing();
 }
