@@ -658,6 +658,25 @@ static ssStatus check_output(const char *path, const char *flag, ssError *err)
 }
 
 /* mkdir -p: create dir and its missing parents. */
+/* The folders make_dirs created, so that a run that fails before its
+ * first frame takes them away again (rmdir: only while they are empty) */
+static struct {
+  char path[1024];
+  size_t from; /* the first created folder is path[0, from) */
+  int any;
+} g_made;
+
+static void unmake_dirs(void)
+{
+  if (!g_made.any) return;
+  for (size_t k = strlen(g_made.path); k >= g_made.from; k--) {
+    if (g_made.path[k] != '/' && g_made.path[k] != 0) continue;
+    g_made.path[k] = 0;
+    rmdir(g_made.path);
+  }
+  g_made.any = 0;
+}
+
 static ssStatus make_dirs(const char *dir, ssError *err)
 {
   char path[1024];
@@ -669,7 +688,13 @@ static ssStatus make_dirs(const char *dir, ssError *err)
     if (path[k] != '/' && path[k] != 0) continue;
     char c = path[k];
     path[k] = 0;
-    if (mkdir(path, 0777) != 0 && errno != EEXIST) {
+    if (mkdir(path, 0777) == 0) {
+      if (!g_made.any) {
+        g_made.any = 1;
+        g_made.from = k;
+        memcpy(g_made.path, dir, n + 1);
+      }
+    } else if (errno != EEXIST) {
       int e = errno;
       return ss_error_set(err, SS_ERR_IO, path, 0,
                           "--render: cannot create directory: %s",
@@ -996,6 +1021,16 @@ static int run(const Options *o)
    * restoring, then the command line's overrides */
   if (o->restore && restore(o, m, d, &restored, &err) != SS_OK) goto fail;
   apply_solver_overrides(o, m);
+  /* the frames' folder first: another output may lie in it (--render D
+   * --checkpoint D/k@5); made before anything is written, taken away
+   * again on any failure before the first frame (unmake_dirs) */
+  if (o->render_dir) {
+    char probe[2048];
+    snprintf(probe, sizeof probe, "%s/frame_probe.png", o->render_dir);
+    if (make_dirs(o->render_dir, &err) != SS_OK ||
+        check_output(probe, "--render", &err) != SS_OK)
+      goto fail;
+  }
   for (int i = 0; i < o->nckpt; i++)
     if (check_output(o->ckpt[i].path, "--checkpoint", &err) != SS_OK) goto fail;
   /* the step counter's limit, which ss_step refuses to pass: said before
@@ -1056,11 +1091,6 @@ static int run(const Options *o)
   }
   if (o->color) ropt.color_mode = o->color - 1;
   if (o->render_dir) {
-    char probe[2048];
-    snprintf(probe, sizeof probe, "%s/frame_probe.png", o->render_dir);
-    if (make_dirs(o->render_dir, &err) != SS_OK ||
-        check_output(probe, "--render", &err) != SS_OK)
-      goto fail;
     r = ss_render_new(m, &ropt, &err);
     if (!r) {
       if (err.code == SS_OK)
@@ -1145,6 +1175,7 @@ fail:
   progress_clear(&prog);
   report(&err);
   status = EXIT_RUN_FAILED;
+  unmake_dirs();
 cleanup:
   if (csv_open) ss_atomic_abort(&csv);
   ss_render_free(r);

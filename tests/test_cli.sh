@@ -440,6 +440,15 @@ check "an existing --export file is replaced" \
 
 run "$PLATE" --steps 10 --rut-map "$tmp/rut.png" --size 200x150 --quiet
 check "--rut-map writes a PNG" 'rc_is 0 && is_png "$tmp/rut.png"'
+# the frames' folder is made before the other outputs are checked, so an
+# output may lie in it (it failed, "No such file or directory"); a run that
+# fails before its first frame takes the folders it made away again
+run "$PLATE" --steps 5 --render "$tmp/newdir/D" --checkpoint "$tmp/newdir/D/k@3" --quiet
+check "--render D --checkpoint D/k@3 with D not there yet: both written" \
+  'rc_is 0 && [ -s "$tmp/newdir/D/k" ] && is_png "$tmp/newdir/D/frame_000005.png"'
+run "$PLATE" --steps 5 --render "$tmp/gone/a/b" --export "$tmp/no/such/x.xml" --quiet
+check "a run refused before its first frame leaves no folder it made" \
+  'rc_is 1 && err_has "--export" && no_file "$tmp/gone"'
 run "$PLATE" --steps 10 --render "$tmp/frames/sub" --render-every 4 \
   --size 160x120 --quiet
 check "--render creates the folder; frames 0, 4, 8 and the last step (10)" \
