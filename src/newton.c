@@ -2542,15 +2542,32 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
       /* stalled far from the answer (a patch near sticking, where the
        * velocity form is nearly set-valued): the sweeps do better from the
        * warm start */
-      if (f > tol2 * size && !(f <= tol * size)) {
+      int far = f > tol2 * size && !(f <= tol * size), r = 0;
+      if (far) {
         if (!w->ns || restarted) break;
-        int r = stick_try(m, d, &s, w, tol, residual_out);
+        r = stick_try(m, d, &s, w, tol, residual_out);
         if (r == 1) {
           *iterations = it;
           *sticking = w->ns;
           return 1;
         }
         if (r != 2) break;
+      } else {
+        /* the warm start may stand as it is (a settled body): then
+         * neither the apply nor check's pass is needed, and w->lam holds
+         * the laws' impulses at its velocities (ss_newton_law) */
+        if (!from_last && it == 0 && w->ns == 0 &&
+            (*residual_out = warm_check(d, &s, w)) <= tol) {
+          w->settled = 1;
+          return 2;
+        }
+        apply(m, d, &s, w);
+        *residual_out = check(m, d, &s, w);
+        if (*residual_out > tol && (stalled || it >= limit) && w->ns && !restarted)
+          r = stick_try(m, d, &s, w, tol, residual_out);
+      }
+      if (r == 2) {
+        /* Newton once more, from the stick solve's start (stick_try) */
         restarted = 1;
         if (!reevaluate(m, d, &s, w, &f, &size)) break;
         have_H = 1;
@@ -2558,28 +2575,6 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
         limit = it + 2 * MAX_ITER;
         rel_prev = 0;
         continue;
-      }
-      /* the warm start may stand as it is (a settled body): then neither
-       * the apply nor check's pass is needed, and w->lam holds the laws'
-       * impulses at its velocities (ss_newton_law) */
-      if (!from_last && it == 0 && w->ns == 0 &&
-          (*residual_out = warm_check(d, &s, w)) <= tol) {
-        w->settled = 1;
-        return 2;
-      }
-      apply(m, d, &s, w);
-      *residual_out = check(m, d, &s, w);
-      if (*residual_out > tol && (stalled || it >= limit) && w->ns && !restarted) {
-        int r = stick_try(m, d, &s, w, tol, residual_out);
-        if (r == 2) {
-          restarted = 1;
-          if (!reevaluate(m, d, &s, w, &f, &size)) break;
-          have_H = 1;
-          stalled = 0;
-          limit = it + 2 * MAX_ITER;
-          rel_prev = 0;
-          continue;
-        }
       }
       if (*residual_out <= tol || stalled || it >= limit) {
         *iterations = it;
