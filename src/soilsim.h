@@ -400,11 +400,11 @@ int ss_model_add_xforce(ssModel *m, int body, const double force[3],
 /* Look-ups by name; -1 when absent. */
 int ss_model_find_sys(const ssModel *m, const char *name);
 int ss_model_find_hfield(const ssModel *m, const char *name);
-/* Checks the whole model (options, materials, sizes); call once built. */
+/* Checks the whole model (options, materials, sizes); call once built.
+ * ss_step calls it too, since a program may edit m->opt and
+ * m->hfield_soilmat between steps. */
 ssStatus ss_model_validate(const ssModel *m, ssError *err);
-/* The part of it that checks every soil bed's material (DESIGN 2.5);
- * ss_step calls it too, since a program may edit m->hfield_soilmat
- * between steps. */
+/* The part of it that checks every soil bed's material (DESIGN 2.5). */
 ssStatus ss_model_validate_soil(const ssModel *m, ssError *err);
 /* Effective width b of a geom on a bed whose normal is n_bed (DESIGN 2.4),
  * given the geom's world rotation (row-major 3x3). */
@@ -563,9 +563,9 @@ void ss_forward(const ssModel *m, ssData *d);
  * position non-finite.  SS_ERR_VALUE, before anything is stepped, if the
  * state it starts from is already so, a bed's pose is non-finite or its
  * quaternion not unit, the clock is outside what <clock> allows (as
- * written into d between steps) or the time would not stay finite, or a
- * soil bed's material is invalid (as edited into m between steps;
- * ss_model_validate_soil).  SS_ERR_STATE, nothing stepped, when d->step
+ * written into d between steps) or the time would not stay finite, or an
+ * option or a soil bed's material is invalid (as edited into m between
+ * steps; ss_model_validate).  SS_ERR_STATE, nothing stepped, when d->step
  * is LONG_MAX: the step counter's limit.  A step
  * that fails for any reason leaves d exactly as it was (positions,
  * velocities, soil, warm-start cache, statistics). */

@@ -29,6 +29,16 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
     return ss_error_set(err, SS_ERR_STATE, NULL, 0,
                         "the step counter is at its maximum (%ld steps); "
                         "nothing was stepped", d->step);
+  /* the options and each bed's material as ss_model_validate checks them:
+   * a program may edit m->opt and m->hfield_soilmat between steps, and
+   * with an invalid one nothing is simulated (DESIGN 2.5: a time step of 0
+   * or NaN, a tolerance of 2, a material with negative damping); a few
+   * comparisons per step and bed */
+  ssError invalid;
+  ssStatus st = ss_model_validate(m, &invalid);
+  if (st)
+    return ss_error_set(err, st, NULL, 0, "step %ld (from t = %.6g s): %s; "
+                        "nothing was stepped", d->step + 1, d->time, invalid.message);
   /* the state a step starts from: a caller may have written it between
    * steps (or a checkpoint restored it), and none of it is used before
    * it has passed the test that every step's result passes */
@@ -44,15 +54,6 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
                         "step %ld: the time %.17g s plus the time step %g s is "
                         "not finite; nothing was stepped", d->step + 1, d->time,
                         m->opt.timestep);
-  /* each bed's material as ss_model_validate checks it: a program may
-   * edit m->hfield_soilmat between steps, and with an invalid one nothing
-   * is simulated (DESIGN 2.5); a few comparisons per bed */
-  ssError bad_soil;
-  ssStatus st = ss_model_validate_soil(m, &bad_soil);
-  if (st)
-    return ss_error_set(err, st, NULL, 0, "step %ld (t = %.6g s): %s; nothing "
-                        "was stepped", d->step + 1, d->time + m->opt.timestep,
-                        bad_soil.message);
   /* keep the coordinates and velocities so a failed step leaves d where it
    * was; the soil state and the warm-start cache are written only once
    * every check has passed */

@@ -1395,6 +1395,46 @@ static void test_edited_material(void)
      "%d soil materials edited between steps into invalid ones: each step "
      "refused with ss_model_validate's message, nothing changed (%d, %d, %d)",
      nedit, refused, same_msg, unchanged);
+  /* the options likewise (a time step of 0 stepped nothing forward and
+   * NaN filled the state; a tolerance of 2 passed every step unsolved) */
+  const struct {
+    const char *field;
+    double *p, v;
+  } oedit[] = {
+    {"time step", &m->opt.timestep, 0},
+    {"time step", &m->opt.timestep, NAN},
+    {"time step", &m->opt.timestep, 2},
+    {"tolerance", &m->opt.solver_tolerance, 2},
+    {"scalar_tolerance", &m->opt.scalar_tolerance, 0},
+    {"gravity", &m->opt.gravity[2], INFINITY},
+    {"contact_margin", &m->opt.contact_margin, -1},
+    {"rigid_erp", &m->opt.rigid_erp, 2},
+  };
+  const int noedit = (int)(sizeof oedit / sizeof oedit[0]);
+  ssOption okeep = m->opt;
+  refused = same_msg = unchanged = 0;
+  for (int k = 0; k < noedit; k++) {
+    *oedit[k].p = oedit[k].v;
+    ssError ev, e;
+    ss_error_clear(&e);
+    int invalid = ss_model_validate(m, &ev) == SS_ERR_VALUE;
+    size_t la = 0, lb = 0;
+    unsigned char *a = snapshot(m, d, &la), *b;
+    ssStatus st = ss_step(m, d, &e);
+    b = snapshot(m, d, &lb);
+    refused += invalid && st == SS_ERR_VALUE;
+    same_msg += invalid && strstr(e.message, ev.message) &&
+                strstr(e.message, oedit[k].field) && strstr(e.message, "nothing was stepped");
+    unchanged += a && b && la == lb && !memcmp(a, b, la);
+    diag("%s = %g: %s", oedit[k].field, oedit[k].v, e.message);
+    free(a);
+    free(b);
+    m->opt = okeep;
+  }
+  ok(refused == noedit && same_msg == noedit && unchanged == noedit,
+     "%d options edited between steps into invalid ones: each step refused "
+     "with ss_model_validate's message, nothing changed (%d, %d, %d)", noedit,
+     refused, same_msg, unchanged);
   ssModel *m2 = NULL;
   ssData *d2 = NULL;
   size_t la = 0, lb = 0;
