@@ -1349,6 +1349,33 @@ static void test_forged_clock(void)
  * power tables) into one ss_model_validate refuses: ss_step refuses it
  * with the same message, before anything is stepped (DESIGN 2.5), and
  * once mended the world steps on as if the edit had never been made. */
+/* An invalid value v written into *p between steps (a field named field):
+ * into counts, whether the step is refused (SS_ERR_VALUE, as
+ * ss_model_validate finds it invalid), says ss_model_validate's message,
+ * the field and "nothing was stepped", and leaves the world's bytes as
+ * they were; *p is put back after */
+static void edited_step(ssModel *m, ssData *d, const char *field, double *p, double v,
+                        int counts[3])
+{
+  double keep = *p;
+  *p = v;
+  ssError ev, e;
+  ss_error_clear(&e);
+  int invalid = ss_model_validate(m, &ev) == SS_ERR_VALUE;
+  size_t la = 0, lb = 0;
+  unsigned char *a = snapshot(m, d, &la), *b;
+  ssStatus st = ss_step(m, d, &e);
+  b = snapshot(m, d, &lb);
+  counts[0] += invalid && st == SS_ERR_VALUE;
+  counts[1] += invalid && strstr(e.message, ev.message) && strstr(e.message, field) &&
+               strstr(e.message, "nothing was stepped");
+  counts[2] += a && b && la == lb && !memcmp(a, b, la);
+  diag("%s = %g: %s", field, v, e.message);
+  free(a);
+  free(b);
+  *p = keep;
+}
+
 static void test_edited_material(void)
 {
   ssModel *m;
@@ -1357,44 +1384,26 @@ static void test_edited_material(void)
     ok(0, "plate.xml loads");
     return;
   }
+  ssSoilMaterial *mat = &m->hfield_soilmat[0];
   const struct {
     const char *field;
-    size_t off;
-    double v;
+    double *p, v;
   } edit[] = {
-    {"damping", offsetof(ssSoilMaterial, damping), -1e5},
-    {"bekker_kphi", offsetof(ssSoilMaterial, bekker_kphi), -1e3},
-    {"bekker_kphi", offsetof(ssSoilMaterial, bekker_kphi), 0}, /* k_c is 0 too */
-    {"elastic_stiffness", offsetof(ssSoilMaterial, elastic_stiffness), 0},
-    {"sinkage_exponent", offsetof(ssSoilMaterial, sinkage_exponent), -1},
-    {"cohesion", offsetof(ssSoilMaterial, cohesion), NAN},
-    {"friction_coefficient", offsetof(ssSoilMaterial, friction_coefficient), INFINITY},
+    {"damping", &mat->damping, -1e5},
+    {"bekker_kphi", &mat->bekker_kphi, -1e3},
+    {"bekker_kphi", &mat->bekker_kphi, 0}, /* k_c is 0 too */
+    {"elastic_stiffness", &mat->elastic_stiffness, 0},
+    {"sinkage_exponent", &mat->sinkage_exponent, -1},
+    {"cohesion", &mat->cohesion, NAN},
+    {"friction_coefficient", &mat->friction_coefficient, INFINITY},
   };
   const int nedit = (int)(sizeof edit / sizeof edit[0]);
-  int settled = run(m, d, 20), refused = 0, same_msg = 0, unchanged = 0;
-  ssSoilMaterial *mat = &m->hfield_soilmat[0], keep = *mat;
-  for (int k = 0; k < nedit; k++) {
-    *(double *)((char *)mat + edit[k].off) = edit[k].v;
-    ssError ev, e;
-    ss_error_clear(&e);
-    int invalid = ss_model_validate(m, &ev) == SS_ERR_VALUE;
-    size_t la = 0, lb = 0;
-    unsigned char *a = snapshot(m, d, &la), *b;
-    ssStatus st = ss_step(m, d, &e);
-    b = snapshot(m, d, &lb);
-    refused += invalid && st == SS_ERR_VALUE;
-    same_msg += invalid && strstr(e.message, ev.message) &&
-                strstr(e.message, edit[k].field) && strstr(e.message, "nothing was stepped");
-    unchanged += a && b && la == lb && !memcmp(a, b, la);
-    diag("%s = %g: %s", edit[k].field, edit[k].v, e.message);
-    free(a);
-    free(b);
-    *mat = keep;
-  }
-  ok(settled && refused == nedit && same_msg == nedit && unchanged == nedit,
+  int settled = run(m, d, 20), counts[3] = {0, 0, 0};
+  for (int k = 0; k < nedit; k++) edited_step(m, d, edit[k].field, edit[k].p, edit[k].v, counts);
+  ok(settled && counts[0] == nedit && counts[1] == nedit && counts[2] == nedit,
      "%d soil materials edited between steps into invalid ones: each step "
      "refused with ss_model_validate's message, nothing changed (%d, %d, %d)",
-     nedit, refused, same_msg, unchanged);
+     nedit, counts[0], counts[1], counts[2]);
   /* the options likewise (a time step of 0 stepped nothing forward and
    * NaN filled the state; a tolerance of 2 passed every step unsolved) */
   const struct {
@@ -1411,30 +1420,13 @@ static void test_edited_material(void)
     {"rigid_erp", &m->opt.rigid_erp, 2},
   };
   const int noedit = (int)(sizeof oedit / sizeof oedit[0]);
-  ssOption okeep = m->opt;
-  refused = same_msg = unchanged = 0;
-  for (int k = 0; k < noedit; k++) {
-    *oedit[k].p = oedit[k].v;
-    ssError ev, e;
-    ss_error_clear(&e);
-    int invalid = ss_model_validate(m, &ev) == SS_ERR_VALUE;
-    size_t la = 0, lb = 0;
-    unsigned char *a = snapshot(m, d, &la), *b;
-    ssStatus st = ss_step(m, d, &e);
-    b = snapshot(m, d, &lb);
-    refused += invalid && st == SS_ERR_VALUE;
-    same_msg += invalid && strstr(e.message, ev.message) &&
-                strstr(e.message, oedit[k].field) && strstr(e.message, "nothing was stepped");
-    unchanged += a && b && la == lb && !memcmp(a, b, la);
-    diag("%s = %g: %s", oedit[k].field, oedit[k].v, e.message);
-    free(a);
-    free(b);
-    m->opt = okeep;
-  }
-  ok(refused == noedit && same_msg == noedit && unchanged == noedit,
+  int ocounts[3] = {0, 0, 0};
+  for (int k = 0; k < noedit; k++)
+    edited_step(m, d, oedit[k].field, oedit[k].p, oedit[k].v, ocounts);
+  ok(ocounts[0] == noedit && ocounts[1] == noedit && ocounts[2] == noedit,
      "%d options edited between steps into invalid ones: each step refused "
      "with ss_model_validate's message, nothing changed (%d, %d, %d)", noedit,
-     refused, same_msg, unchanged);
+     ocounts[0], ocounts[1], ocounts[2]);
   ssModel *m2 = NULL;
   ssData *d2 = NULL;
   size_t la = 0, lb = 0;
