@@ -303,6 +303,32 @@ static int kv_cmp(const void *pa, const void *pb)
   return (a->v > b->v) - (a->v < b->v);
 }
 
+/* The distinct positions among the vertices v with used[v] != 0 (every
+ * vertex where used is NULL; n of them): id[v] the position's rank in
+ * kv_cmp's order (where id is not NULL) and bit 2 set in lead[v] on each
+ * position's first vertex (where lead is not NULL).  Returns the number of
+ * positions, -1 when out of memory. */
+static int distinct_positions(const ssMesh *m, const unsigned char *used, long n, int *id,
+                              unsigned char *lead)
+{
+  keyVert *kv = malloc((size_t)(n > 0 ? n : 1) * sizeof *kv);
+  if (!kv) return -1;
+  int k = 0;
+  for (int v = 0; v < m->nvert; v++)
+    if (!used || used[v]) kv[k++] = (keyVert){m->vert + 3 * v, v};
+  qsort(kv, (size_t)k, sizeof *kv, kv_cmp);
+  int d = -1;
+  for (int i = 0; i < k; i++) {
+    if (i == 0 || !kv_same(&kv[i], &kv[i - 1])) {
+      d++;
+      if (lead) lead[kv[i].v] |= 2;
+    }
+    if (id) id[kv[i].v] = d;
+  }
+  free(kv);
+  return d + 1;
+}
+
 /* The footprint points (ssMesh.hull; after bounds): every position that
  * triangles use, once (its first vertex), in vertex order, which keeps a
  * ring's points in runs for the footprint's sort (ss_points_footprint).
@@ -315,8 +341,8 @@ static int hull_points(ssMesh *m)
   m->nhull = 0;
   free(m->hull);
   m->hull = NULL;
-  /* used[v]: 1 when a triangle uses v, 2 when v is also its position's
-   * first vertex */
+  /* used[v]: bit 1 when a triangle uses v, bit 2 when v is also its
+   * position's first vertex (distinct_positions) */
   unsigned char *used = calloc((size_t)m->nvert, 1);
   if (!used) return 0;
   for (long i = 0; i < 3L * m->ntri; i++) used[m->tri[i]] = 1;
@@ -326,22 +352,11 @@ static int hull_points(ssMesh *m)
     free(used);
     return 1;
   }
-  keyVert *kv = malloc((size_t)nused * sizeof *kv);
-  if (!kv) {
+  int distinct = distinct_positions(m, used, nused, NULL, used);
+  if (distinct < 0) {
     free(used);
     return 0;
   }
-  int n = 0;
-  for (int v = 0; v < m->nvert; v++)
-    if (used[v]) kv[n++] = (keyVert){m->vert + 3 * v, v};
-  qsort(kv, (size_t)n, sizeof *kv, kv_cmp);
-  int distinct = 0;
-  for (int i = 0; i < n; i++)
-    if (i == 0 || !kv_same(&kv[i], &kv[i - 1])) {
-      used[kv[i].v] = 2;
-      distinct++;
-    }
-  free(kv);
   if (distinct > SS_MESH_HULL_MAX) {
     free(used);
     return 1;
@@ -354,7 +369,7 @@ static int hull_points(ssMesh *m)
   double c[3];
   for (int k = 0; k < 3; k++) c[k] = 0.5 * (m->hi[k] + m->lo[k]);
   for (int v = 0; v < m->nvert; v++)
-    if (used[v] == 2) {
+    if (used[v] & 2) {
       double *h = m->hull + 3 * m->nhull++;
       for (int k = 0; k < 3; k++) h[k] = m->vert[3 * v + k] - c[k];
     }
@@ -781,16 +796,9 @@ int ss_mesh_closed(const ssMesh *m)
   /* positions, not vertex indices: a file that splits its vertices per
    * face (for flat shading) is closed all the same */
   int *id = malloc((size_t)m->nvert * sizeof *id);
-  keyVert *kv = malloc((size_t)m->nvert * sizeof *kv);
   edgeKey *ek = malloc((size_t)m->ntri * 3 * sizeof *ek);
   int closed = -1;
-  if (!id || !kv || !ek) goto done;
-  for (int v = 0; v < m->nvert; v++) kv[v] = (keyVert){m->vert + 3 * v, v};
-  qsort(kv, (size_t)m->nvert, sizeof *kv, kv_cmp);
-  for (int i = 0, d = -1; i < m->nvert; i++) {
-    if (i == 0 || !kv_same(&kv[i], &kv[i - 1])) d++;
-    id[kv[i].v] = d;
-  }
+  if (!id || !ek || distinct_positions(m, NULL, m->nvert, id, NULL) < 0) goto done;
   long ne = 0;
   for (int t = 0; t < m->ntri; t++)
     for (int k = 0; k < 3; k++) {
@@ -811,7 +819,6 @@ int ss_mesh_closed(const ssMesh *m)
   }
 done:
   free(id);
-  free(kv);
   free(ek);
   return closed;
 }
