@@ -2202,7 +2202,7 @@ static int range_basis(const double S[36], double thr, double B[36])
  * E kappa) = 0 and B^T V'_g = 0 (B: an orthonormal basis of C's row
  * space, E kappa the groups' constraint wrenches), then shares each
  * wrench out over the points (share_out) and applies and checks that
- * answer, which stands only where check passes.  Measured (2026-11-28):
+ * answer, which stands only where check passes.  Measured (2026-11-27):
  * drag.xml's rocking plate is tilted on its bed, so C has rank 5, and the
  * wrench about its tangent axes needs tangential impulses 1.5 to 220
  * times their bounds (the lever arms are the tilt's): 2 of its 30 stalled
