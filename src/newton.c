@@ -2540,11 +2540,19 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
   for (;;) {
     if (f <= try2 * size || stalled || it >= limit) {
       /* stalled far from the answer (a patch near sticking, where the
-       * velocity form is nearly set-valued): the sweeps do better from the
-       * warm start */
+       * velocity form is nearly set-valued): the stick solve, else the
+       * sweeps from the warm start.  Velocity-form points alone there (a
+       * cold start on a plate that has come to rest: Newton crawls
+       * towards a stick it cannot reach in that form) go to impulse form
+       * first, as after a failed line search, so that the stick solve
+       * can take their patch */
       int far = f > tol2 * size && !(f <= tol * size), r = 0;
       if (far) {
-        if (!w->ns || restarted) break;
+        if (restarted) break;
+        if (!w->ns) {
+          if (!(switch_all(w, &s) && reevaluate(m, d, &s, w, &f, &size))) break;
+          have_H = 1;
+        }
         r = stick_try(m, d, &s, w, tol, residual_out);
         if (r == 1) {
           *iterations = it;
