@@ -1069,6 +1069,28 @@ static void test_creeping_plate(void)
   ss_model_free(m);
 }
 
+/* drag.xml run for `steps` steps, warm-started or not: how many stopped at
+ * the sweep cap, in all and from step `from` on (0: it did not load or a
+ * step failed) */
+static int drag_capped(int warm, int steps, int from, int *capped, int *late)
+{
+  ssModel *m;
+  ssData *d;
+  *capped = *late = 0;
+  if (!load_scene_file("scenes/drag.xml", &m, &d)) return 0;
+  m->opt.terrain_warm_start = warm;
+  ssError e;
+  int good = 1;
+  for (int k = 0; k < steps && good; k++) {
+    good = ss_step(m, d, &e) == SS_OK;
+    *capped += !d->stats.converged;
+    *late += k + 1 >= from && !d->stats.converged;
+  }
+  ss_data_free(d);
+  ss_model_free(m);
+  return good;
+}
+
 /* The plate of drag.xml, pulled by 60 N below its shear strength, stops
  * at t = 1.16 s and rocks; where its velocity crosses zero Newton's
  * impulse form stalls (every point sticks: the tangential impulses are
@@ -1078,24 +1100,10 @@ static void test_creeping_plate(void)
  * against 39 without it, and none of steps 1220-1250 (11 without). */
 static void test_drag_stops(void)
 {
-  ssModel *m;
-  ssData *d;
-  if (!load_scene_file("scenes/drag.xml", &m, &d)) {
-    ok(0, "drag.xml loads");
-    return;
-  }
-  ssError e;
-  int capped = 0, late = 0, good = 1;
-  for (int k = 0; k < 1250 && good; k++) {
-    good = ss_step(m, d, &e) == SS_OK;
-    capped += !d->stats.converged;
-    late += k + 1 >= 1220 && !d->stats.converged;
-  }
+  int capped, late, good = drag_capped(1, 1250, 1220, &capped, &late);
   ok(good && capped <= 30 && late == 0,
      "drag.xml, 1250 steps: %d at the sweep cap (39 without the stick solve), %d of steps "
      "1220-1250", capped, late);
-  ss_data_free(d);
-  ss_model_free(m);
 }
 
 /* The same drag started cold every step (terrain_warm_start off, which
@@ -1108,25 +1116,10 @@ static void test_drag_stops(void)
  * steps up to about 1275 still do (115 of them), and none after. */
 static void test_drag_stops_cold(void)
 {
-  ssModel *m;
-  ssData *d;
-  if (!load_scene_file("scenes/drag.xml", &m, &d)) {
-    ok(0, "drag.xml loads");
-    return;
-  }
-  m->opt.terrain_warm_start = 0;
-  ssError e;
-  int capped = 0, late = 0, good = 1;
-  for (int k = 0; k < 1400 && good; k++) {
-    good = ss_step(m, d, &e) == SS_OK;
-    capped += !d->stats.converged;
-    late += k + 1 >= 1300 && !d->stats.converged;
-  }
+  int capped, late, good = drag_capped(0, 1400, 1300, &capped, &late);
   ok(good && capped <= 130 && late == 0,
      "drag.xml cold, 1400 steps: %d at the sweep cap (241 before the stick solve took "
      "velocity-form stalls), %d of steps 1300-1400", capped, late);
-  ss_data_free(d);
-  ss_model_free(m);
 }
 
 /* The first power of each point's step comes from its bed's table of
