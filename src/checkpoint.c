@@ -32,7 +32,10 @@
  *           each: nq nv nsys nbody ngeom nhfield nhfielddata npd neq nspring
  *           nplane nxforce nmaterial npair nmesh), u32 count of hashes, the
  *           hashes (u64 FNV-1a each, one per group of model arrays, see
- *           fingerprint()), u32 length and bytes of the model's source path
+ *           fingerprint(); the rigid materials as the friction and
+ *           restitution each collider meets on each rigid support, not
+ *           by their indices, which earlier builds hashed and a restore
+ *           still accepts), u32 length and bytes of the model's source path
  *     OPTS  ssOption: timestep, gravity x y z (f64), solver_max_sweeps (i32),
  *           solver_tolerance, scalar_tolerance (f64), terrain_warm_start
  *           (i32), contact_margin, rigid_erp (f64)
@@ -179,11 +182,34 @@ typedef struct Fingerprint {
   uint64_t hash[NHASH];
 } Fingerprint;
 
+/* The contact material each collider meets on each rigid support (the
+ * rigid height maps, then the ground planes): the pair's friction and
+ * restitution, which is all a step reads of the materials (terrain.c,
+ * rigid_contacts).  Material indices are only the order in which a file
+ * named the materials, and an export names them in another order (its
+ * ground planes before its bodies), so they are not hashed. */
+static void hash_contact_materials(Hash *h, const ssModel *m)
+{
+  for (int g = 0; g < m->ngeom; g++)
+    for (int k = 0; k < m->nhfield + m->nplane; k++) {
+      if (k < m->nhfield && m->hfield_soil[k]) continue;
+      int mat = k < m->nhfield ? m->hfield_material[k] : m->plane_material[k - m->nhfield];
+      const ssMaterialPair *p = ss_model_pair(m, m->geom_material[g], mat);
+      const double v[3] = {p->friction, p->restitution, p->restitution_threshold};
+      hash_doubles(h, v, 3);
+    }
+}
+
 /* Everything in the model that changes what a step computes, grouped so
  * that a mismatch can say what differs.  Initial states (qpos0, qvel0,
  * pd_target0, bed poses) are left out: a checkpoint replaces them.  Names,
- * colours and file paths are left out: they do not change the dynamics. */
-static void fingerprint(const ssModel *m, Fingerprint *f)
+ * colours and file paths are left out: they do not change the dynamics;
+ * so is the numbering of the rigid materials (hash_contact_materials).
+ * legacy: the fingerprint of earlier builds, which hashed the material
+ * indices and the pair table as numbered (a checkpoint they wrote is
+ * still compared with it, so it restores into the world it was written
+ * for). */
+static void fingerprint(const ssModel *m, Fingerprint *f, int legacy)
 {
   const int c[NCOUNT] = {m->nq, m->nv, m->nsys, m->nbody, m->ngeom,
                          m->nhfield, m->nhfielddata, m->npd, m->neq,
@@ -240,7 +266,7 @@ static void fingerprint(const ssModel *m, Fingerprint *f)
   hash_doubles(&h, m->geom_size, 3L * m->ngeom);
   hash_doubles(&h, m->geom_pos, 3L * m->ngeom);
   hash_doubles(&h, m->geom_quat, 4L * m->ngeom);
-  hash_ints(&h, m->geom_material, m->ngeom);
+  if (legacy) hash_ints(&h, m->geom_material, m->ngeom);
   hash_ints(&h, m->geom_mesh, m->ngeom);
   for (int g = 0; g < m->ngeom; g++) hash_u64(&h, (uint64_t)(m->geom_group[g] & 1));
   for (int k = 0; k < m->nmesh; k++) {
@@ -260,7 +286,7 @@ static void fingerprint(const ssModel *m, Fingerprint *f)
   hash_doubles(&h, m->hfield_size, 2L * m->nhfield);
   hash_doubles(&h, m->hfield_center, 2L * m->nhfield);
   hash_ints(&h, m->hfield_adr, m->nhfield);
-  hash_ints(&h, m->hfield_material, m->nhfield);
+  if (legacy) hash_ints(&h, m->hfield_material, m->nhfield);
   hash_ints(&h, m->hfield_soil, m->nhfield);
   for (int k = 0; k < m->nhfield; k++) {
     const ssSoilMaterial *s = m->hfield_soilmat + k;
@@ -287,13 +313,17 @@ static void fingerprint(const ssModel *m, Fingerprint *f)
 
   hash_init(&h);
   hash_doubles(&h, m->plane_height, m->nplane);
-  hash_ints(&h, m->plane_material, m->nplane);
-  for (int k = -1; k < m->npair; k++) {
-    const ssMaterialPair *p = k < 0 ? &m->material_default : m->pair + k;
-    const int mi[2] = {p->mat1, p->mat2};
-    const double v[3] = {p->friction, p->restitution, p->restitution_threshold};
-    hash_ints(&h, mi, 2);
-    hash_doubles(&h, v, 3);
+  if (legacy) {
+    hash_ints(&h, m->plane_material, m->nplane);
+    for (int k = -1; k < m->npair; k++) {
+      const ssMaterialPair *p = k < 0 ? &m->material_default : m->pair + k;
+      const int mi[2] = {p->mat1, p->mat2};
+      const double v[3] = {p->friction, p->restitution, p->restitution_threshold};
+      hash_ints(&h, mi, 2);
+      hash_doubles(&h, v, 3);
+    }
+  } else {
+    hash_contact_materials(&h, m);
   }
   hash_ints(&h, m->xforce_body, m->nxforce);
   hash_doubles(&h, m->xforce_force, 3L * m->nxforce);
@@ -423,7 +453,7 @@ ssStatus ss_checkpoint_save_buffer(const ssModel *m, const ssData *d,
 
   Writer w = {NULL, 0, 0, 0};
   Fingerprint f;
-  fingerprint(m, &f);
+  fingerprint(m, &f, 0);
   size_t hd = 0, s;
 
   w_bytes(&w, CKPT_MAGIC, 8);
@@ -938,8 +968,9 @@ static ssStatus compare_model(const ssModel *m, const Fingerprint *fc,
                               const char *src, size_t srclen, const char *path,
                               ssError *err)
 {
-  Fingerprint fm;
-  fingerprint(m, &fm);
+  Fingerprint fm, fl;
+  fingerprint(m, &fm, 0);
+  fingerprint(m, &fl, 1);
   char from[600] = "";
   if (srclen) {
     char s[512];
@@ -955,8 +986,10 @@ static ssStatus compare_model(const ssModel *m, const Fingerprint *fc,
                           (unsigned long)fm.count[k]);
   char what[512] = "";
   size_t used = 0;
+  /* a file of an earlier build holds the legacy hashes (they differ from
+   * the current ones only in the groups with materials) */
   for (int k = 0; k < NHASH; k++)
-    if (fc->hash[k] != fm.hash[k]) {
+    if (fc->hash[k] != fm.hash[k] && fc->hash[k] != fl.hash[k]) {
       int n = snprintf(what + used, sizeof what - used, "%s%s",
                        used ? "; " : "", hash_name[k]);
       if (n > 0 && (size_t)n < sizeof what - used) used += (size_t)n;
