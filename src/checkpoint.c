@@ -44,7 +44,9 @@
  *     QPOS  nq f64          QVEL  nv f64          SYSA  nsys u8
  *     PDTG  npd x 2 f64     HPOS  nhfield x 3 f64 HQUA  nhfield x 4 f64
  *     SINK, PLAS, SHEA      nhfielddata f64 each (sinkage, plastic, shear)
- *     LOAD  nsoil_loaded i32, strictly ascending vertex indices
+ *     LOAD  nsoil_loaded i32, strictly ascending vertex indices; every
+ *           vertex with sinkage above its plastic sinkage or with shear
+ *           is among them
  *     WARM  nwarm entries of 60 bytes: vertex (i32), geom (i32), creep
  *           (i32: 0 or 1, only for soil entries), traction (3 f64), rate
  *           (3 f64), in the solver's sort order.  Soil points: geom and
@@ -1150,6 +1152,19 @@ static ssStatus parse_state(const ssModel *m, const Parsed *f, const char *path,
       return corrupt(err, path, "bad loaded-vertex list");
     s->loaded[k] = v;
   }
+  /* every vertex that holds elastic sinkage or shear is listed: the next
+   * step recovers only the listed ones (ss_terrain_update), so one left
+   * out would keep its load for ever, a state no run reaches (the list a
+   * step leaves holds every vertex it loaded; an export's reader rebuilds
+   * it from the arrays) */
+  for (size_t k = 0, at = 0; k < nhd; k++) {
+    while (at < (size_t)s->nloaded && (size_t)s->loaded[at] < k) at++;
+    if ((s->sink[k] > s->plas[k] || s->shea[k] > 0) &&
+        !(at < (size_t)s->nloaded && (size_t)s->loaded[at] == k))
+      return corrupt(err, path, "bad loaded-vertex list (a vertex with elastic "
+                     "sinkage or shear is not in it)");
+  }
+
 
   r = section(f, S_WARM);
   for (int k = 0; k < s->nwarm; k++) {

@@ -1399,6 +1399,77 @@ static void test_forged_clock(void)
   ss_model_free(m);
 }
 
+/* good (n bytes) with section tag's payload replaced by the plen bytes
+ * at pl, the sizes and checksums made right again; its length in *len
+ * (caller frees; NULL when there is no such section) */
+static unsigned char *with_section(const unsigned char *good, size_t n, const char *tag,
+                                   const void *pl, size_t plen, size_t *len)
+{
+  size_t at = find_section(good, n, tag);
+  if (!at) return NULL;
+  size_t old = (size_t)le(good + at + 8, 8), tail = n - (at + 16 + old);
+  *len = at + 16 + plen + tail;
+  unsigned char *p = malloc(*len);
+  if (!p) return NULL;
+  memcpy(p, good, at + 16);
+  put(p + at + 8, plen, 8);
+  if (plen) memcpy(p + at + 16, pl, plen);
+  memcpy(p + at + 16 + plen, good + at + 16 + old, tail);
+  put(p + 16, *len, 8);
+  reseal(p, *len);
+  return p;
+}
+
+/* A checkpoint whose list of loaded vertices leaves out vertices that
+ * hold elastic sinkage (the settled plate's 651, here all of them) is
+ * refused.  It was accepted, and once the plate was lifted those vertices
+ * kept their elastic sinkage for ever: only listed vertices recover
+ * (the plate's whole imprint 8.175 mm deep instead of its 7.766 mm rut),
+ * a state no run reaches and which the world's export, read back with
+ * the list rebuilt, does not keep. */
+static void test_forged_soil_list(void)
+{
+  ssModel *m;
+  ssData *d;
+  if (!load_scene("plate.xml", &m, &d)) {
+    ok(0, "plate.xml loads");
+    return;
+  }
+  size_t n = 0, len = 0;
+  unsigned char *good = run(m, d, 300) ? snapshot(m, d, &n) : NULL;
+  unsigned char *p = good ? with_section(good, n, "LOAD", NULL, 0, &len) : NULL;
+  ssData *d2 = ss_data_new(m), *twin = ss_data_new(m);
+  if (!p || !d2 || !twin || !run(m, d2, 5) || !run(m, twin, 5)) {
+    ok(0, "forged loaded-vertex list: a checkpoint of the settled plate");
+    goto out;
+  }
+  int elastic = 0;
+  for (int k = 0; k < m->nhfielddata; k++) elastic += d->soil_sinkage[k] > d->soil_plastic[k];
+  ssError e;
+  ss_error_clear(&e);
+  ssStatus st = ss_checkpoint_load_buffer(m, d2, p, len, &e);
+  ok(elastic > 500 && st == SS_ERR_PARSE && strstr(e.message, "loaded-vertex list") &&
+     same_state(m, d2, twin),
+     "a checkpoint whose loaded-vertex list leaves out the %d vertices with elastic "
+     "sinkage is refused, data unchanged (%s)", elastic, st ? e.message : "accepted");
+  /* the real one restores, and its vertices recover once the plate goes */
+  ssStatus st2 = ss_checkpoint_load_buffer(m, d2, good, n, &e);
+  int left = -1;
+  if (st2 == SS_OK && ss_remove(m, d2, "plate", &e) == SS_OK && run(m, d2, 1)) {
+    left = 0;
+    for (int k = 0; k < m->nhfielddata; k++) left += d2->soil_sinkage[k] > d2->soil_plastic[k];
+  }
+  ok(left == 0, "the checkpoint as written restores, and with the plate lifted every "
+     "vertex recovers to its rut (%d keep elastic sinkage)", left);
+out:
+  free(good);
+  free(p);
+  ss_data_free(twin);
+  ss_data_free(d2);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 /* A soil material edited between steps (a supported use: test_plate's
  * power tables) into one ss_model_validate refuses: ss_step refuses it
  * with the same message, before anything is stepped (DESIGN 2.5), and
@@ -1569,6 +1640,7 @@ int main(void)
   test_failed_step();
   test_step_limit();
   test_forged_clock();
+  test_forged_soil_list();
   test_edited_material();
   rmdir(tmpdir);
   return done_testing();
