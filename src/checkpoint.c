@@ -57,7 +57,7 @@
  *           2 dof + side
  *     NEWT  the Newton phase's last two answers (ssNewtonRecord, the later
  *           first), each: step (i64, -1: none), key (u64, 0 for none),
- *           n (i32, 0 for none) and n f64 (c)
+ *           n (i32, 0 for none) and n f64 (c, each within 1e100)
  *     STAT  soil_contacts, soil_loaded (i32), soil_contact_area,
  *           soil_normal_force (f64), rigid_contacts, sweeps (i32), residual
  *           (f64), converged (i32); the stage wall times are not saved, so
@@ -95,6 +95,11 @@
 #define CKPT_TRAILER 8u
 #define CKPT_WARM_BYTES 60u
 #define CKPT_SOURCE_MAX 4096u
+/* largest magnitude of a Newton record's value (NEWT): far above what a
+ * step writes, far enough below DBL_MAX that the next step's prediction
+ * (2 c_1 - c_2 added to the free velocities) and the sums of its squares
+ * stay finite */
+#define CKPT_NEWT_MAX 1e100
 
 /* ---------------------------------------------------------------------- */
 /* checksum and hashes                                                     */
@@ -1165,7 +1170,6 @@ static ssStatus parse_state(const ssModel *m, const Parsed *f, const char *path,
                      "sinkage or shear is not in it)");
   }
 
-
   r = section(f, S_WARM);
   for (int k = 0; k < s->nwarm; k++) {
     ssWarmEntry *e = s->warm + k;
@@ -1208,8 +1212,11 @@ static ssStatus parse_state(const ssModel *m, const Parsed *f, const char *path,
       return ss_error_set(err, SS_ERR_NOMEM, path, 0, "out of memory reading a checkpoint");
     q->cap = n;
     r_f64s(&r, q->c, (size_t)n);
+    /* velocity changes of one step: no step makes one anywhere near
+     * CKPT_NEWT_MAX (its velocities stay within SS_SPEED_MAX), and the
+     * Newton phase's start from such values would overflow */
     for (int a = 0; a < n; a++)
-      if (!isfinite(q->c[a])) return corrupt(err, path, "bad section 'NEWT'");
+      if (!(fabs(q->c[a]) <= CKPT_NEWT_MAX)) return corrupt(err, path, "bad section 'NEWT'");
   }
   if (r.bad || r.off != r.n) return corrupt(err, path, "bad section 'NEWT'");
 

@@ -1470,6 +1470,57 @@ out:
   ss_model_free(m);
 }
 
+/* A checkpoint whose Newton records (the next steps start from 2 c_1 -
+ * c_2) hold finite but absurd values, 1e200 and -1e200, is refused.  It
+ * was accepted, and the second step after the restore failed ("the
+ * velocity of 'plate' became non-finite or absurd"): the Newton phase's
+ * start overflowed. */
+static void test_forged_newton(void)
+{
+  ssModel *m;
+  ssData *d;
+  if (!load_scene("plate_arm.xml", &m, &d)) {
+    ok(0, "plate_arm.xml loads");
+    return;
+  }
+  size_t n = 0;
+  unsigned char *good = run(m, d, 120) ? snapshot(m, d, &n) : NULL;
+  size_t at = good ? find_section(good, n, "NEWT") : 0;
+  unsigned char *p = at ? malloc(n) : NULL;
+  ssData *d2 = ss_data_new(m), *twin = ss_data_new(m);
+  int n0 = at ? (int)le(good + at + 16 + 16, 4) : 0;
+  if (!p || !d2 || !twin || n0 <= 0 || !run(m, d2, 5) || !run(m, twin, 5)) {
+    ok(0, "forged Newton records: a checkpoint of plate_arm.xml with them");
+    goto out;
+  }
+  memcpy(p, good, n);
+  size_t r1 = at + 16 + 20 + 8 * (size_t)n0;
+  int n1 = (int)le(p + r1 + 16, 4);
+  const double big = 1e200, neg = -1e200;
+  uint64_t bb, bn;
+  memcpy(&bb, &big, 8);
+  memcpy(&bn, &neg, 8);
+  for (int a = 0; a < n0; a++) put(p + at + 16 + 20 + 8 * (size_t)a, bb, 8);
+  for (int a = 0; a < n1; a++) put(p + r1 + 20 + 8 * (size_t)a, bn, 8);
+  reseal(p, n);
+  ssError e;
+  ss_error_clear(&e);
+  ssStatus st = ss_checkpoint_load_buffer(m, d2, p, n, &e);
+  ok(st == SS_ERR_PARSE && strstr(e.message, "NEWT") && same_state(m, d2, twin),
+     "a checkpoint whose Newton records hold 1e200 and -1e200 (%d and %d values) is "
+     "refused, data unchanged (%s)", n0, n1, st ? e.message : "accepted");
+  /* the real one restores and steps */
+  st = ss_checkpoint_load_buffer(m, d2, good, n, &e);
+  ok(st == SS_OK && run(m, d2, 5), "the checkpoint as written restores and steps");
+out:
+  free(good);
+  free(p);
+  ss_data_free(twin);
+  ss_data_free(d2);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 /* A soil material edited between steps (a supported use: test_plate's
  * power tables) into one ss_model_validate refuses: ss_step refuses it
  * with the same message, before anything is stepped (DESIGN 2.5), and
@@ -1641,6 +1692,7 @@ int main(void)
   test_step_limit();
   test_forged_clock();
   test_forged_soil_list();
+  test_forged_newton();
   test_edited_material();
   rmdir(tmpdir);
   return done_testing();
