@@ -426,6 +426,23 @@ static void w_options(Writer *w, const ssOption *o)
   w_f64(w, o->rigid_erp);
 }
 
+/* The first soil vertex that holds elastic sinkage or shear but is not in
+ * the ascending list loaded (nloaded), or -1.  The next step recovers only
+ * the listed ones (ss_terrain_update), so one left out would keep its
+ * load for ever: the list a step leaves holds every vertex it loaded,
+ * ss_soil_set_state and an export's reader rebuild it from the arrays,
+ * and no checkpoint is written or read without it. */
+static long unlisted_vertex(const ssModel *m, const double *sink, const double *plas,
+                            const double *shea, const int *loaded, int nloaded)
+{
+  int at = 0;
+  for (int k = 0; k < m->nhfielddata; k++) {
+    while (at < nloaded && loaded[at] < k) at++;
+    if ((sink[k] > plas[k] || shea[k] > 0) && !(at < nloaded && loaded[at] == k)) return k;
+  }
+  return -1;
+}
+
 static ssStatus check_pair(const ssModel *m, const ssData *d, const char *what,
                            const char *path, ssError *err)
 {
@@ -457,6 +474,14 @@ ssStatus ss_checkpoint_save_buffer(const ssModel *m, const ssData *d,
   char why[300];
   if (!ss_dyn_check_state(m, d, why, sizeof why))
     return ss_error_set(err, SS_ERR_VALUE, NULL, 0, "cannot write a checkpoint: %s", why);
+  long v = unlisted_vertex(m, d->soil_sinkage, d->soil_plastic, d->soil_shear,
+                           d->soil_loaded, d->nsoil_loaded);
+  if (v >= 0)
+    return ss_error_set(err, SS_ERR_STATE, NULL, 0,
+                        "cannot write a checkpoint: soil vertex %ld holds elastic "
+                        "sinkage or shear but is not among the loaded vertices "
+                        "(soil state written into the data directly? set it with "
+                        "ss_soil_set_state)", v);
 
   Writer w = {NULL, 0, 0, 0};
   Fingerprint f;
@@ -1157,18 +1182,9 @@ static ssStatus parse_state(const ssModel *m, const Parsed *f, const char *path,
       return corrupt(err, path, "bad loaded-vertex list");
     s->loaded[k] = v;
   }
-  /* every vertex that holds elastic sinkage or shear is listed: the next
-   * step recovers only the listed ones (ss_terrain_update), so one left
-   * out would keep its load for ever, a state no run reaches (the list a
-   * step leaves holds every vertex it loaded; an export's reader rebuilds
-   * it from the arrays) */
-  for (size_t k = 0, at = 0; k < nhd; k++) {
-    while (at < (size_t)s->nloaded && (size_t)s->loaded[at] < k) at++;
-    if ((s->sink[k] > s->plas[k] || s->shea[k] > 0) &&
-        !(at < (size_t)s->nloaded && (size_t)s->loaded[at] == k))
-      return corrupt(err, path, "bad loaded-vertex list (a vertex with elastic "
-                     "sinkage or shear is not in it)");
-  }
+  if (unlisted_vertex(m, s->sink, s->plas, s->shea, s->loaded, s->nloaded) >= 0)
+    return corrupt(err, path, "bad loaded-vertex list (a vertex with elastic "
+                   "sinkage or shear is not in it)");
 
   r = section(f, S_WARM);
   for (int k = 0; k < s->nwarm; k++) {

@@ -1461,6 +1461,32 @@ static void test_forged_soil_list(void)
   }
   ok(left == 0, "the checkpoint as written restores, and with the plate lifted every "
      "vertex recovers to its rut (%d keep elastic sinkage)", left);
+  /* nor is such a state written: sinkage put into the data directly (not
+   * through ss_soil_set_state, which lists the vertex) on a vertex far
+   * from the plate */
+  {
+    int far = 0, h = ss_model_find_hfield(m, "soil");
+    double keep = d2->soil_sinkage[far];
+    d2->soil_sinkage[far] = d2->soil_plastic[far] + 1e-3;
+    unsigned char *b = NULL;
+    size_t bl = 0;
+    ss_error_clear(&e);
+    ssStatus sv = ss_checkpoint_save_buffer(m, d2, &b, &bl, &e);
+    ok(sv == SS_ERR_STATE && strstr(e.message, "ss_soil_set_state") && !b,
+       "a state with elastic sinkage on a vertex the data does not list is not "
+       "written (%s)", sv ? e.message : "written");
+    free(b);
+    double *z = calloc((size_t)m->nhfielddata, sizeof(double));
+    int set = z && h >= 0 && ss_soil_get_state(m, d2, h, z, NULL, NULL, &e) == SS_OK &&
+              ss_soil_set_state(m, d2, h, z, NULL, NULL, &e) == SS_OK;
+    b = NULL;
+    ok(set && ss_checkpoint_save_buffer(m, d2, &b, &bl, &e) == SS_OK &&
+       ss_checkpoint_load_buffer(m, twin, b, bl, &e) == SS_OK,
+       "the same sinkage set with ss_soil_set_state is written and restores");
+    free(b);
+    free(z);
+    d2->soil_sinkage[far] = keep;
+  }
 out:
   free(good);
   free(p);
