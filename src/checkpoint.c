@@ -32,7 +32,10 @@
  *           each: nq nv nsys nbody ngeom nhfield nhfielddata npd neq nspring
  *           nplane nxforce nmaterial npair nmesh), u32 count of hashes, the
  *           hashes (u64 FNV-1a each, one per group of model arrays, see
- *           fingerprint()), u32 length and bytes of the model's source path
+ *           fingerprint(); the rigid materials as the friction and
+ *           restitution each collider meets on each rigid support, not
+ *           by their indices, which earlier builds hashed and a restore
+ *           still accepts), u32 length and bytes of the model's source path
  *     OPTS  ssOption: timestep, gravity x y z (f64), solver_max_sweeps (i32),
  *           solver_tolerance, scalar_tolerance (f64), terrain_warm_start
  *           (i32), contact_margin, rigid_erp (f64)
@@ -41,7 +44,9 @@
  *     QPOS  nq f64          QVEL  nv f64          SYSA  nsys u8
  *     PDTG  npd x 2 f64     HPOS  nhfield x 3 f64 HQUA  nhfield x 4 f64
  *     SINK, PLAS, SHEA      nhfielddata f64 each (sinkage, plastic, shear)
- *     LOAD  nsoil_loaded i32, strictly ascending vertex indices
+ *     LOAD  nsoil_loaded i32, strictly ascending vertex indices; every
+ *           vertex with sinkage above its plastic sinkage or with shear
+ *           is among them
  *     WARM  nwarm entries of 60 bytes: vertex (i32), geom (i32), creep
  *           (i32: 0 or 1, only for soil entries), traction (3 f64), rate
  *           (3 f64), in the solver's sort order.  Soil points: geom and
@@ -52,7 +57,7 @@
  *           2 dof + side
  *     NEWT  the Newton phase's last two answers (ssNewtonRecord, the later
  *           first), each: step (i64, -1: none), key (u64, 0 for none),
- *           n (i32, 0 for none) and n f64 (c)
+ *           n (i32, 0 for none) and n f64 (c, each within 1e100)
  *     STAT  soil_contacts, soil_loaded (i32), soil_contact_area,
  *           soil_normal_force (f64), rigid_contacts, sweeps (i32), residual
  *           (f64), converged (i32); the stage wall times are not saved, so
@@ -90,6 +95,11 @@
 #define CKPT_TRAILER 8u
 #define CKPT_WARM_BYTES 60u
 #define CKPT_SOURCE_MAX 4096u
+/* largest magnitude of a Newton record's value (NEWT): far above what a
+ * step writes, far enough below DBL_MAX that the next step's prediction
+ * (2 c_1 - c_2 added to the free velocities) and the sums of its squares
+ * stay finite */
+#define CKPT_NEWT_MAX 1e100
 
 /* ---------------------------------------------------------------------- */
 /* checksum and hashes                                                     */
@@ -179,11 +189,34 @@ typedef struct Fingerprint {
   uint64_t hash[NHASH];
 } Fingerprint;
 
+/* The contact material each collider meets on each rigid support (the
+ * rigid height maps, then the ground planes): the pair's friction and
+ * restitution, which is all a step reads of the materials (terrain.c,
+ * rigid_contacts).  Material indices are only the order in which a file
+ * named the materials, and an export names them in another order (its
+ * ground planes before its bodies), so they are not hashed. */
+static void hash_contact_materials(Hash *h, const ssModel *m)
+{
+  for (int g = 0; g < m->ngeom; g++)
+    for (int k = 0; k < m->nhfield + m->nplane; k++) {
+      if (k < m->nhfield && m->hfield_soil[k]) continue;
+      int mat = k < m->nhfield ? m->hfield_material[k] : m->plane_material[k - m->nhfield];
+      const ssMaterialPair *p = ss_model_pair(m, m->geom_material[g], mat);
+      const double v[3] = {p->friction, p->restitution, p->restitution_threshold};
+      hash_doubles(h, v, 3);
+    }
+}
+
 /* Everything in the model that changes what a step computes, grouped so
  * that a mismatch can say what differs.  Initial states (qpos0, qvel0,
  * pd_target0, bed poses) are left out: a checkpoint replaces them.  Names,
- * colours and file paths are left out: they do not change the dynamics. */
-static void fingerprint(const ssModel *m, Fingerprint *f)
+ * colours and file paths are left out: they do not change the dynamics;
+ * so is the numbering of the rigid materials (hash_contact_materials).
+ * legacy: the fingerprint of earlier builds, which hashed the material
+ * indices and the pair table as numbered (a checkpoint they wrote is
+ * still compared with it, so it restores into the world it was written
+ * for). */
+static void fingerprint(const ssModel *m, Fingerprint *f, int legacy)
 {
   const int c[NCOUNT] = {m->nq, m->nv, m->nsys, m->nbody, m->ngeom,
                          m->nhfield, m->nhfielddata, m->npd, m->neq,
@@ -240,7 +273,7 @@ static void fingerprint(const ssModel *m, Fingerprint *f)
   hash_doubles(&h, m->geom_size, 3L * m->ngeom);
   hash_doubles(&h, m->geom_pos, 3L * m->ngeom);
   hash_doubles(&h, m->geom_quat, 4L * m->ngeom);
-  hash_ints(&h, m->geom_material, m->ngeom);
+  if (legacy) hash_ints(&h, m->geom_material, m->ngeom);
   hash_ints(&h, m->geom_mesh, m->ngeom);
   for (int g = 0; g < m->ngeom; g++) hash_u64(&h, (uint64_t)(m->geom_group[g] & 1));
   for (int k = 0; k < m->nmesh; k++) {
@@ -260,7 +293,7 @@ static void fingerprint(const ssModel *m, Fingerprint *f)
   hash_doubles(&h, m->hfield_size, 2L * m->nhfield);
   hash_doubles(&h, m->hfield_center, 2L * m->nhfield);
   hash_ints(&h, m->hfield_adr, m->nhfield);
-  hash_ints(&h, m->hfield_material, m->nhfield);
+  if (legacy) hash_ints(&h, m->hfield_material, m->nhfield);
   hash_ints(&h, m->hfield_soil, m->nhfield);
   for (int k = 0; k < m->nhfield; k++) {
     const ssSoilMaterial *s = m->hfield_soilmat + k;
@@ -287,13 +320,17 @@ static void fingerprint(const ssModel *m, Fingerprint *f)
 
   hash_init(&h);
   hash_doubles(&h, m->plane_height, m->nplane);
-  hash_ints(&h, m->plane_material, m->nplane);
-  for (int k = -1; k < m->npair; k++) {
-    const ssMaterialPair *p = k < 0 ? &m->material_default : m->pair + k;
-    const int mi[2] = {p->mat1, p->mat2};
-    const double v[3] = {p->friction, p->restitution, p->restitution_threshold};
-    hash_ints(&h, mi, 2);
-    hash_doubles(&h, v, 3);
+  if (legacy) {
+    hash_ints(&h, m->plane_material, m->nplane);
+    for (int k = -1; k < m->npair; k++) {
+      const ssMaterialPair *p = k < 0 ? &m->material_default : m->pair + k;
+      const int mi[2] = {p->mat1, p->mat2};
+      const double v[3] = {p->friction, p->restitution, p->restitution_threshold};
+      hash_ints(&h, mi, 2);
+      hash_doubles(&h, v, 3);
+    }
+  } else {
+    hash_contact_materials(&h, m);
   }
   hash_ints(&h, m->xforce_body, m->nxforce);
   hash_doubles(&h, m->xforce_force, 3L * m->nxforce);
@@ -389,6 +426,23 @@ static void w_options(Writer *w, const ssOption *o)
   w_f64(w, o->rigid_erp);
 }
 
+/* The first soil vertex that holds elastic sinkage or shear but is not in
+ * the ascending list loaded (nloaded), or -1.  The next step recovers only
+ * the listed ones (ss_terrain_update), so one left out would keep its
+ * load for ever: the list a step leaves holds every vertex it loaded,
+ * ss_soil_set_state and an export's reader rebuild it from the arrays,
+ * and no checkpoint is written or read without it. */
+static long unlisted_vertex(const ssModel *m, const double *sink, const double *plas,
+                            const double *shea, const int *loaded, int nloaded)
+{
+  int at = 0;
+  for (int k = 0; k < m->nhfielddata; k++) {
+    while (at < nloaded && loaded[at] < k) at++;
+    if ((sink[k] > plas[k] || shea[k] > 0) && !(at < nloaded && loaded[at] == k)) return k;
+  }
+  return -1;
+}
+
 static ssStatus check_pair(const ssModel *m, const ssData *d, const char *what,
                            const char *path, ssError *err)
 {
@@ -420,10 +474,18 @@ ssStatus ss_checkpoint_save_buffer(const ssModel *m, const ssData *d,
   char why[300];
   if (!ss_dyn_check_state(m, d, why, sizeof why))
     return ss_error_set(err, SS_ERR_VALUE, NULL, 0, "cannot write a checkpoint: %s", why);
+  long v = unlisted_vertex(m, d->soil_sinkage, d->soil_plastic, d->soil_shear,
+                           d->soil_loaded, d->nsoil_loaded);
+  if (v >= 0)
+    return ss_error_set(err, SS_ERR_STATE, NULL, 0,
+                        "cannot write a checkpoint: soil vertex %ld holds elastic "
+                        "sinkage or shear but is not among the loaded vertices "
+                        "(soil state written into the data directly? set it with "
+                        "ss_soil_set_state)", v);
 
   Writer w = {NULL, 0, 0, 0};
   Fingerprint f;
-  fingerprint(m, &f);
+  fingerprint(m, &f, 0);
   size_t hd = 0, s;
 
   w_bytes(&w, CKPT_MAGIC, 8);
@@ -938,8 +1000,9 @@ static ssStatus compare_model(const ssModel *m, const Fingerprint *fc,
                               const char *src, size_t srclen, const char *path,
                               ssError *err)
 {
-  Fingerprint fm;
-  fingerprint(m, &fm);
+  Fingerprint fm, fl;
+  fingerprint(m, &fm, 0);
+  fingerprint(m, &fl, 1);
   char from[600] = "";
   if (srclen) {
     char s[512];
@@ -955,8 +1018,10 @@ static ssStatus compare_model(const ssModel *m, const Fingerprint *fc,
                           (unsigned long)fm.count[k]);
   char what[512] = "";
   size_t used = 0;
+  /* a file of an earlier build holds the legacy hashes (they differ from
+   * the current ones only in the groups with materials) */
   for (int k = 0; k < NHASH; k++)
-    if (fc->hash[k] != fm.hash[k]) {
+    if (fc->hash[k] != fm.hash[k] && fc->hash[k] != fl.hash[k]) {
       int n = snprintf(what + used, sizeof what - used, "%s%s",
                        used ? "; " : "", hash_name[k]);
       if (n > 0 && (size_t)n < sizeof what - used) used += (size_t)n;
@@ -1117,6 +1182,9 @@ static ssStatus parse_state(const ssModel *m, const Parsed *f, const char *path,
       return corrupt(err, path, "bad loaded-vertex list");
     s->loaded[k] = v;
   }
+  if (unlisted_vertex(m, s->sink, s->plas, s->shea, s->loaded, s->nloaded) >= 0)
+    return corrupt(err, path, "bad loaded-vertex list (a vertex with elastic "
+                   "sinkage or shear is not in it)");
 
   r = section(f, S_WARM);
   for (int k = 0; k < s->nwarm; k++) {
@@ -1160,8 +1228,11 @@ static ssStatus parse_state(const ssModel *m, const Parsed *f, const char *path,
       return ss_error_set(err, SS_ERR_NOMEM, path, 0, "out of memory reading a checkpoint");
     q->cap = n;
     r_f64s(&r, q->c, (size_t)n);
+    /* velocity changes of one step: no step makes one anywhere near
+     * CKPT_NEWT_MAX (its velocities stay within SS_SPEED_MAX), and the
+     * Newton phase's start from such values would overflow */
     for (int a = 0; a < n; a++)
-      if (!isfinite(q->c[a])) return corrupt(err, path, "bad section 'NEWT'");
+      if (!(fabs(q->c[a]) <= CKPT_NEWT_MAX)) return corrupt(err, path, "bad section 'NEWT'");
   }
   if (r.bad || r.off != r.n) return corrupt(err, path, "bad section 'NEWT'");
 

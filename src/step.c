@@ -85,6 +85,7 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
   ss_solver_pow_tables(m, d);
   if ((st = ss_terrain_contacts(m, d, err))) goto fail;
   if ((st = ss_art_rows(m, d, err))) goto fail;
+  if ((st = ss_terrain_reserve(d, err))) goto fail;
   t1 = now(); t[2] = t1 - t0; t0 = t1;
 
   /* implicit contact impulses at the end-of-step velocity */

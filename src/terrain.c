@@ -604,6 +604,16 @@ ssStatus ss_terrain_contacts(const ssModel *m, ssData *d, ssError *err)
   return SS_OK;
 }
 
+ssStatus ss_terrain_reserve(ssData *d, ssError *err)
+{
+  if (2 * d->ncontact <= d->cap_soil_loaded) return SS_OK;
+  int *p = realloc(d->soil_loaded, (size_t)d->ncontact * 2 * sizeof(int));
+  if (!p) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
+  d->soil_loaded = p;
+  d->cap_soil_loaded = 2 * d->ncontact;
+  return SS_OK;
+}
+
 /* vertex indices, merged from their runs (one per collider) */
 static int int_less(const int *a, const int *b) { return *a < *b; }
 SS_SORT_RUNS(merge_sort_runs, int, int_less)
@@ -748,8 +758,10 @@ void ss_terrain_update(const ssModel *m, ssData *d)
     d->soil_shear[v] = 0;
   }
   /* room for the new list of loaded vertices (at most one per contact)
-   * and the scratch of its sort after it; without it the old list stays
-   * (worst case some vertices recover a step late) */
+   * and the scratch of its sort after it, which ss_terrain_reserve made
+   * before the solve (a step that cannot have it fails there); without
+   * it the old list would stay, and a vertex loaded now but not in the
+   * next step would never recover */
   const int ncontact = d->ncontact;
   if (2 * ncontact > d->cap_soil_loaded) {
     int *p = realloc(d->soil_loaded, (size_t)ncontact * 2 * sizeof(int));

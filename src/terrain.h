@@ -9,6 +9,10 @@
 
 /* Build d->contact for the current positions (d->ncontact). */
 ssStatus ss_terrain_contacts(const ssModel *m, ssData *d, ssError *err);
+/* Room in d->soil_loaded for ss_terrain_update's list of the loaded
+ * vertices and its scratch (two per contact), made before the solve so
+ * that a step without it fails (SS_ERR_NOMEM) with nothing changed. */
+ssStatus ss_terrain_reserve(ssData *d, ssError *err);
 /* After the solve: update sinkage, plastic sinkage and shear of every soil
  * vertex touched (DESIGN 3.1, last paragraph), and step statistics. */
 void ss_terrain_update(const ssModel *m, ssData *d);

@@ -1099,6 +1099,60 @@ static void test_export(void)
   }
 }
 
+/* A checkpoint restores into an export of its world, whose rigid
+ * materials the file names in another order: buggy_rigid.xml names the
+ * buggy's "rubber" before the ground's "concrete", its export the ground
+ * first, so the two models number the materials differently (the same
+ * friction on every contact).  The fingerprint once hashed the indices
+ * and refused the export ("these differ: colliders; ground planes,
+ * contact materials ...").  A friction really changed is still refused. */
+static void test_restore_into_export(void)
+{
+  ssModel *m, *m2 = NULL;
+  ssData *d, *d2 = NULL;
+  ssError e;
+  char path[600];
+  tmp_path(path, sizeof path, "rigid_export.xml");
+  if (!load_scene("buggy_rigid.xml", &m, &d)) {
+    ok(0, "buggy_rigid.xml loads");
+    return;
+  }
+  size_t len = 0;
+  unsigned char *buf = NULL;
+  int r = run(m, d, 30) && ss_scene_export(m, d, path, &e) == SS_OK &&
+          ss_scene_load(path, &m2, &d2, &e) == SS_OK && (buf = snapshot(m, d, &len));
+  if (!r) {
+    ok(0, "buggy_rigid.xml: run, export and reload (%s)", e.message);
+    goto out;
+  }
+  int renumbered = 0;
+  for (int g = 0; g < m->ngeom && g < m2->ngeom; g++)
+    renumbered |= m->geom_material[g] != m2->geom_material[g];
+  ok(renumbered && m2->npair == 1 && m->npair == 1,
+     "buggy_rigid.xml: its export numbers the rigid materials differently");
+  ssStatus st = ss_checkpoint_load_buffer(m2, d2, buf, len, &e);
+  ok(st == SS_OK, "a checkpoint of buggy_rigid.xml at step 30 restores into its export (%s)",
+     st ? e.message : "ok");
+  if (st == SS_OK) {
+    int ran = run(m, d, 40) && run(m2, d2, 40);
+    ok(ran && !memcmp(d->qpos, d2->qpos, (size_t)m->nq * sizeof(double)) &&
+       !memcmp(d->qvel, d2->qvel, (size_t)m->nv * sizeof(double)) && d->time == d2->time,
+       "... and 40 steps there give the original world's 40 steps, bit for bit");
+  }
+  m2->pair[0].friction *= 0.5;
+  st = ss_checkpoint_load_buffer(m2, d2, buf, len, &e);
+  ok(st != SS_OK && strstr(e.message, "contact materials"),
+     "a changed friction between the tyres and the ground is still refused (%s)",
+     e.message);
+out:
+  free(buf);
+  unlink(path);
+  ss_data_free(d);
+  ss_model_free(m);
+  ss_data_free(d2);
+  ss_model_free(m2);
+}
+
 /* A step that fails leaves everything as it was: the same checkpoint
  * bytes before and after, soil state and warm-start cache included.  Two
  * ways: the step itself blows up (gravity turned to 2e8 m/s^2 upward
@@ -1345,6 +1399,154 @@ static void test_forged_clock(void)
   ss_model_free(m);
 }
 
+/* good (n bytes) with section tag's payload replaced by the plen bytes
+ * at pl, the sizes and checksums made right again; its length in *len
+ * (caller frees; NULL when there is no such section) */
+static unsigned char *with_section(const unsigned char *good, size_t n, const char *tag,
+                                   const void *pl, size_t plen, size_t *len)
+{
+  size_t at = find_section(good, n, tag);
+  if (!at) return NULL;
+  size_t old = (size_t)le(good + at + 8, 8), tail = n - (at + 16 + old);
+  *len = at + 16 + plen + tail;
+  unsigned char *p = malloc(*len);
+  if (!p) return NULL;
+  memcpy(p, good, at + 16);
+  put(p + at + 8, plen, 8);
+  if (plen) memcpy(p + at + 16, pl, plen);
+  memcpy(p + at + 16 + plen, good + at + 16 + old, tail);
+  put(p + 16, *len, 8);
+  reseal(p, *len);
+  return p;
+}
+
+/* A checkpoint whose list of loaded vertices leaves out vertices that
+ * hold elastic sinkage (the settled plate's 651, here all of them) is
+ * refused.  It was accepted, and once the plate was lifted those vertices
+ * kept their elastic sinkage for ever: only listed vertices recover
+ * (the plate's whole imprint 8.175 mm deep instead of its 7.766 mm rut),
+ * a state no run reaches and which the world's export, read back with
+ * the list rebuilt, does not keep. */
+static void test_forged_soil_list(void)
+{
+  ssModel *m;
+  ssData *d;
+  if (!load_scene("plate.xml", &m, &d)) {
+    ok(0, "plate.xml loads");
+    return;
+  }
+  size_t n = 0, len = 0;
+  unsigned char *good = run(m, d, 300) ? snapshot(m, d, &n) : NULL;
+  unsigned char *p = good ? with_section(good, n, "LOAD", NULL, 0, &len) : NULL;
+  ssData *d2 = ss_data_new(m), *twin = ss_data_new(m);
+  if (!p || !d2 || !twin || !run(m, d2, 5) || !run(m, twin, 5)) {
+    ok(0, "forged loaded-vertex list: a checkpoint of the settled plate");
+    goto out;
+  }
+  int elastic = 0;
+  for (int k = 0; k < m->nhfielddata; k++) elastic += d->soil_sinkage[k] > d->soil_plastic[k];
+  ssError e;
+  ss_error_clear(&e);
+  ssStatus st = ss_checkpoint_load_buffer(m, d2, p, len, &e);
+  ok(elastic > 500 && st == SS_ERR_PARSE && strstr(e.message, "loaded-vertex list") &&
+     same_state(m, d2, twin),
+     "a checkpoint whose loaded-vertex list leaves out the %d vertices with elastic "
+     "sinkage is refused, data unchanged (%s)", elastic, st ? e.message : "accepted");
+  /* the real one restores, and its vertices recover once the plate goes */
+  ssStatus st2 = ss_checkpoint_load_buffer(m, d2, good, n, &e);
+  int left = -1;
+  if (st2 == SS_OK && ss_remove(m, d2, "plate", &e) == SS_OK && run(m, d2, 1)) {
+    left = 0;
+    for (int k = 0; k < m->nhfielddata; k++) left += d2->soil_sinkage[k] > d2->soil_plastic[k];
+  }
+  ok(left == 0, "the checkpoint as written restores, and with the plate lifted every "
+     "vertex recovers to its rut (%d keep elastic sinkage)", left);
+  /* nor is such a state written: sinkage put into the data directly (not
+   * through ss_soil_set_state, which lists the vertex) on a vertex far
+   * from the plate */
+  {
+    int far = 0, h = ss_model_find_hfield(m, "soil");
+    double keep = d2->soil_sinkage[far];
+    d2->soil_sinkage[far] = d2->soil_plastic[far] + 1e-3;
+    unsigned char *b = NULL;
+    size_t bl = 0;
+    ss_error_clear(&e);
+    ssStatus sv = ss_checkpoint_save_buffer(m, d2, &b, &bl, &e);
+    ok(sv == SS_ERR_STATE && strstr(e.message, "ss_soil_set_state") && !b,
+       "a state with elastic sinkage on a vertex the data does not list is not "
+       "written (%s)", sv ? e.message : "written");
+    free(b);
+    double *z = calloc((size_t)m->nhfielddata, sizeof(double));
+    int set = z && h >= 0 && ss_soil_get_state(m, d2, h, z, NULL, NULL, &e) == SS_OK &&
+              ss_soil_set_state(m, d2, h, z, NULL, NULL, &e) == SS_OK;
+    b = NULL;
+    ok(set && ss_checkpoint_save_buffer(m, d2, &b, &bl, &e) == SS_OK &&
+       ss_checkpoint_load_buffer(m, twin, b, bl, &e) == SS_OK,
+       "the same sinkage set with ss_soil_set_state is written and restores");
+    free(b);
+    free(z);
+    d2->soil_sinkage[far] = keep;
+  }
+out:
+  free(good);
+  free(p);
+  ss_data_free(twin);
+  ss_data_free(d2);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
+/* A checkpoint whose Newton records (the next steps start from 2 c_1 -
+ * c_2) hold finite but absurd values, 1e200 and -1e200, is refused.  It
+ * was accepted, and the second step after the restore failed ("the
+ * velocity of 'plate' became non-finite or absurd"): the Newton phase's
+ * start overflowed. */
+static void test_forged_newton(void)
+{
+  ssModel *m;
+  ssData *d;
+  if (!load_scene("plate_arm.xml", &m, &d)) {
+    ok(0, "plate_arm.xml loads");
+    return;
+  }
+  size_t n = 0;
+  unsigned char *good = run(m, d, 120) ? snapshot(m, d, &n) : NULL;
+  size_t at = good ? find_section(good, n, "NEWT") : 0;
+  unsigned char *p = at ? malloc(n) : NULL;
+  ssData *d2 = ss_data_new(m), *twin = ss_data_new(m);
+  int n0 = at ? (int)le(good + at + 16 + 16, 4) : 0;
+  if (!p || !d2 || !twin || n0 <= 0 || !run(m, d2, 5) || !run(m, twin, 5)) {
+    ok(0, "forged Newton records: a checkpoint of plate_arm.xml with them");
+    goto out;
+  }
+  memcpy(p, good, n);
+  size_t r1 = at + 16 + 20 + 8 * (size_t)n0;
+  int n1 = (int)le(p + r1 + 16, 4);
+  const double big = 1e200, neg = -1e200;
+  uint64_t bb, bn;
+  memcpy(&bb, &big, 8);
+  memcpy(&bn, &neg, 8);
+  for (int a = 0; a < n0; a++) put(p + at + 16 + 20 + 8 * (size_t)a, bb, 8);
+  for (int a = 0; a < n1; a++) put(p + r1 + 20 + 8 * (size_t)a, bn, 8);
+  reseal(p, n);
+  ssError e;
+  ss_error_clear(&e);
+  ssStatus st = ss_checkpoint_load_buffer(m, d2, p, n, &e);
+  ok(st == SS_ERR_PARSE && strstr(e.message, "NEWT") && same_state(m, d2, twin),
+     "a checkpoint whose Newton records hold 1e200 and -1e200 (%d and %d values) is "
+     "refused, data unchanged (%s)", n0, n1, st ? e.message : "accepted");
+  /* the real one restores and steps */
+  st = ss_checkpoint_load_buffer(m, d2, good, n, &e);
+  ok(st == SS_OK && run(m, d2, 5), "the checkpoint as written restores and steps");
+out:
+  free(good);
+  free(p);
+  ss_data_free(twin);
+  ss_data_free(d2);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 /* A soil material edited between steps (a supported use: test_plate's
  * power tables) into one ss_model_validate refuses: ss_step refuses it
  * with the same message, before anything is stepped (DESIGN 2.5), and
@@ -1510,10 +1712,13 @@ int main(void)
   test_rigid_cache();
   test_cache_overflow();
   test_export();
+  test_restore_into_export();
   test_mesh_bodies();
   test_failed_step();
   test_step_limit();
   test_forged_clock();
+  test_forged_soil_list();
+  test_forged_newton();
   test_edited_material();
   rmdir(tmpdir);
   return done_testing();
