@@ -516,7 +516,7 @@ static Mat mat_of(const NGroup *G, double dt)
   const ssSoilMaterial *mat = G->mat;
   Mat M = {dt, mat->sinkage_exponent,
            mat->elastic_stiffness, mat->damping, mat->friction_coefficient,
-           mat->shear_displacement > 0 ? dt / mat->shear_displacement : 0,
+           ss_soil_janosi_inverse(mat) > 0 ? dt / mat->shear_displacement : 0,
            mat->sinkage_exponent == 1.0, {0, {0}, 0, NULL}, G->gq, G->gmax};
   if (!M.linear) {
     M.pser = ss_pow_series(M.n - 1);
@@ -2455,7 +2455,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
       G->bed = c->hfield;
       G->mat = &m->hfield_soilmat[c->hfield];
       G->pt = ss_solver_pow_table(m, d, c->hfield);
-      G->ik = G->mat->shear_displacement > 0 ? 1 / G->mat->shear_displacement : 0;
+      G->ik = ss_soil_janosi_inverse(G->mat);
       G->mod.b = NAN;
       memcpy(G->R, c->frame, sizeof G->R);
       G->axes = c->bed_axes;

@@ -299,12 +299,12 @@ static inline int stick_fits(const TBlock *B, const double ct[2], double T)
  * so that the bound is T = tf m, T' = tf e r, T'' = -tf e r^2 (r = dt/K).
  * m is carried directly (no 1 - exp cancellation at small x) and moved from
  * the last point by 1 - exp(-d) = d Q(d) (ss_exp_neg_q): m' = m + e d Q.
- * r = 0: constant bound (K = 0, or a rigid Coulomb contact). */
+ * iK = 1/K (ss_soil_janosi_inverse); 0: a constant bound (K = 0, or a
+ * rigid Coulomb contact), r = 0. */
 typedef ssMobil Mobil;
 
-static void mobil_init(Mobil *J, double j, double K, double dt)
+static void mobil_init(Mobil *J, double j, double iK, double dt)
 {
-  double iK = K > 0 ? 1 / K : 0;
   J->r = dt * iK;
   J->x0 = (j > 0 ? j : 0) * iK;
   J->m0 = J->r > 0 ? (J->x0 > 0 ? -1 : 0) : 1;
@@ -783,7 +783,7 @@ void ss_point_setup(const ssSoilMaterial *mat, const ssPowTable *tab, double dt,
   }
   if (!keep_pw) L->pw = (ssPowMemo){0, 0, 0};
   Mobil J;
-  mobil_init(&J, c->j, mat->shear_displacement, dt);
+  mobil_init(&J, c->j, ss_soil_janosi_inverse(mat), dt);
   if (!(c->cache_ready && k->mob.x0 == J.x0 && k->mob.r == J.r)) k->mob = J;
   c->cache_ready = 1;
   tblock_init(&k->tb, c->G);

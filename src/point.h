@@ -10,12 +10,26 @@
 #include "soilsim.h"
 #include "ss_math.h"
 
+#include <float.h>
+
 /* The Bekker envelope's modulus k_c/b + k_phi for width b, as every user
  * of the law forms it (the sweeps' and the Newton phase's set-up, the soil
  * update, soil.c): no division where k_c = 0 (the same value) */
 static inline double ss_soil_modulus(const ssSoilMaterial *mat, double b)
 {
   return (b > 0 && mat->bekker_kc != 0 ? mat->bekker_kc / b : 0) + mat->bekker_kphi;
+}
+
+/* 1/K_j of the Janosi-Hanamoto law (DESIGN 2.3), or 0 where the bound is
+ * fully mobilized at once: K_j = 0, and a K_j so small that its reciprocal
+ * overflows (below 2^-1024, about 5.6e-309 m: a subnormal).  Such a K_j
+ * reaches tau_f within a slip of 1e-300 m, the same law as K_j = 0 to
+ * every tolerance, and 1/K_j = inf would make j/K_j NaN at j = 0.  The
+ * soil law (soil.c) and both solves (point.c, newton.c) decide by it. */
+static inline double ss_soil_janosi_inverse(const ssSoilMaterial *mat)
+{
+  double K = mat->shear_displacement, ik = K > 0 ? 1 / K : 0;
+  return ik <= DBL_MAX ? ik : 0;
 }
 
 /* ss_soil_modulus kept for the last width b (b NAN: none): the points of

@@ -93,13 +93,13 @@ double ss_soil_shear_strength(const ssSoilMaterial *mat, double p_n)
 double ss_soil_shear_limit(const ssSoilMaterial *mat, double p_n, double j)
 {
   double tf = ss_soil_shear_strength(mat, p_n);
-  if (!(mat->shear_displacement > 0)) return tf;
+  if (!(ss_soil_janosi_inverse(mat) > 0)) return tf;
   return tf * -expm1(-(j > 0 ? j : 0) / mat->shear_displacement);
 }
 
 double ss_soil_shear_limit_slope(const ssSoilMaterial *mat, double p_n, double j)
 {
-  if (!(mat->shear_displacement > 0)) return 0;
+  if (!(ss_soil_janosi_inverse(mat) > 0)) return 0;
   double tf = ss_soil_shear_strength(mat, p_n);
   return tf * exp(-(j > 0 ? j : 0) / mat->shear_displacement) /
          mat->shear_displacement;

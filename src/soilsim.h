@@ -80,7 +80,8 @@ typedef struct ssSoilMaterial {
   double damping;              /* D, loading-only viscosity (Pa s / m) */
   double cohesion;             /* c (Pa) */
   double friction_coefficient; /* mu = tan(phi) (-) */
-  double shear_displacement;   /* K_j, Janosi-Hanamoto modulus (m); 0 = full */
+  double shear_displacement;   /* K_j, Janosi-Hanamoto modulus (m); 0 = full
+                                  (and any K_j whose 1/K_j overflows) */
 } ssSoilMaterial;
 
 /* The documented defaults (illustrative, not a calibrated soil). */

@@ -263,6 +263,24 @@ static void test_coupled(void)
   z.mat.shear_displacement = 0;
   check_point(&z, "K_j = 0: full strength at once", 0);
 
+  /* a K_j whose reciprocal overflows (a subnormal) is K_j = 0's law: the
+   * bound reaches tau_f within a slip of 1e-300 m.  Taken as 1/K_j = inf,
+   * j/K_j was NaN at j = 0 and the solves stalled (drag.xml with it: 499
+   * of 1500 steps at the sweep cap, against 35 with K_j = 1e-300 or 0) */
+  Case zs = k, zf = f;
+  zs.mat.shear_displacement = zf.mat.shear_displacement = 1e-320;
+  check_point(&zs, "K_j = 1e-320: full strength at once", 0);
+  check_point(&zf, "K_j = 1e-320, fresh shear (j = 0): full strength at once", 0);
+  Case zz = zf;
+  zz.mat.shear_displacement = 0;
+  check_point(&zz, "K_j = 0, fresh shear (j = 0)", 0);
+  ok(rel3(zs.c.lambda, z.c.lambda) <= 1e-11 && rel3(zf.c.lambda, zz.c.lambda) <= 1e-11,
+     "K_j = 1e-320 gives K_j = 0's impulses (rel %.3g, %.3g at j = 0)",
+     rel3(zs.c.lambda, z.c.lambda), rel3(zf.c.lambda, zz.c.lambda));
+  ok(ss_soil_shear_limit(&zf.mat, 800, 0) == ss_soil_shear_strength(&zf.mat, 800) &&
+         ss_soil_shear_limit_slope(&zf.mat, 800, 0) == 0,
+     "the soil law: K_j = 1e-320 is fully mobilized at j = 0, with no slope");
+
   Case s = k;
   s.c.j = 0.05;
   s.v0[1] = 1e-6;
