@@ -338,6 +338,16 @@ static void write_hfield(wBuf *w, const ssModel *m, const ssData *d, int h)
   w_s(w, "/>\n    </heightmap>\n");
 }
 
+/* The material a system's element names: its (first) collider's. */
+static int sys_material(const ssModel *m, int s)
+{
+  int b0 = m->sys_bodyadr[s];
+  for (int g = 0; g < m->ngeom; g++)
+    if (m->geom_body[g] >= b0 && m->geom_body[g] < b0 + m->sys_nbody[s])
+      return m->geom_material[g];
+  return 0;
+}
+
 /* <articulated_system> with its URDF, base, full state and PD targets */
 static void write_articulated(wBuf *w, const ssModel *m, const ssData *d, int s)
 {
@@ -346,13 +356,8 @@ static void write_articulated(wBuf *w, const ssModel *m, const ssData *d, int s)
   a_path(w, "urdf_path", m->sys_source[s]);
   if (m->sys_resdir[s][0]) a_path(w, "res_dir", m->sys_resdir[s]);
   a_str(w, "base", m->sys_fixed[s] ? "fixed" : "floating");
-  int b0 = m->sys_bodyadr[s], mat = 0;
-  for (int g = 0; g < m->ngeom; g++)
-    if (m->geom_body[g] >= b0 && m->geom_body[g] < b0 + m->sys_nbody[s]) {
-      mat = m->geom_material[g];
-      break;
-    }
-  a_str(w, "material", mat_name(m, mat));
+  int b0 = m->sys_bodyadr[s];
+  a_str(w, "material", mat_name(m, sys_material(m, s)));
   w_s(w, ">\n      <state");
   if (m->sys_fixed[s]) {
     a_vec(w, "pos", m->body_jntpos + 3 * b0, 3);
@@ -382,7 +387,82 @@ static void write_articulated(wBuf *w, const ssModel *m, const ssData *d, int s)
   w_s(w, "    </articulated_system>\n");
 }
 
-static void write_world(wBuf *w, const ssModel *m, const ssData *d)
+/* The objects in the order they are written. */
+enum { OBJ_PLANE, OBJ_SYS, OBJ_HFIELD };
+typedef struct wObject {
+  int kind;  /* OBJ_* */
+  int index; /* plane, system or height map */
+} wObject;
+
+static int object_material(const ssModel *m, const wObject *o)
+{
+  return o->kind == OBJ_PLANE   ? m->plane_material[o->index]
+         : o->kind == OBJ_HFIELD ? m->hfield_material[o->index]
+                                 : sys_material(m, o->index);
+}
+
+/* The reader numbers the materials in the order it meets their names, so
+ * the objects are written in an order that names them in the order of the
+ * model's numbers: the reloaded world then has the same numbers (a
+ * checkpoint's fingerprint compares them) and its pairs keep their names'
+ * order, so export -> load -> export gives the same bytes.  Grounds,
+ * systems and height maps each keep their own order (as the reader met
+ * them, so such an order exists for a model read from a file); among the
+ * next objects of the three, the first whose material is already named or
+ * is the next number is taken, grounds before systems before height maps,
+ * which leaves the usual order wherever it already works.  renum[k] gets
+ * the number the reader will give material k (-1: not named by an
+ * object); returns the number of objects, *nnum the numbers given. */
+static int object_order(const ssModel *m, const ssData *d, wObject *order,
+                        int *renum, unsigned char *used, int *nnum)
+{
+  int count[3] = {m->nplane, m->nsys, m->nhfield}, next[3] = {0, 0, 0};
+  int nobj = 0, nused = 1;
+  for (int k = 0; k < m->nmaterial; k++) {
+    renum[k] = -1;
+    used[k] = 0;
+  }
+  if (m->nmaterial > 0) renum[0] = 0; /* "default", numbered first */
+  /* the materials the written objects name */
+  for (int kind = 0; kind < 3; kind++)
+    for (int i = 0; i < count[kind]; i++) {
+      if (kind == OBJ_SYS && !d->sys_active[i]) continue;
+      wObject o = {kind, i};
+      int mat = object_material(m, &o);
+      if (mat >= 0 && mat < m->nmaterial) used[mat] = 1;
+    }
+  int expect = 1;
+  for (;;) {
+    while (expect < m->nmaterial && (!used[expect] || renum[expect] >= 0))
+      expect++;
+    int pick = -1, fallback = -1;
+    for (int kind = 0; kind < 3 && pick < 0; kind++) {
+      while (kind == OBJ_SYS && next[kind] < count[kind] &&
+             !d->sys_active[next[kind]])
+        next[kind]++;
+      if (next[kind] >= count[kind]) continue;
+      if (fallback < 0) fallback = kind;
+      wObject o = {kind, next[kind]};
+      int mat = object_material(m, &o);
+      if (mat < 0 || mat >= m->nmaterial || renum[mat] >= 0 ||
+          mat == expect)
+        pick = kind;
+    }
+    /* no order names them in the model's order (a model built in code):
+     * the usual one */
+    if (pick < 0) pick = fallback;
+    if (pick < 0) break;
+    wObject o = {pick, next[pick]++};
+    int mat = object_material(m, &o);
+    if (mat >= 0 && mat < m->nmaterial && renum[mat] < 0) renum[mat] = nused++;
+    order[nobj++] = o;
+  }
+  *nnum = nused;
+  return nobj;
+}
+
+static void write_world(wBuf *w, const ssModel *m, const ssData *d,
+                        const wObject *order, int nobj, int *renum, int nnum)
 {
   const ssOption *o = &m->opt;
   w_s(w, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
@@ -415,27 +495,27 @@ static void write_world(wBuf *w, const ssModel *m, const ssData *d)
   }
 
   w_s(w, "  <objects>\n");
-  for (int p = 0; p < m->nplane; p++) {
-    w_s(w, "    <ground");
-    a_str(w, "name", m->plane_name[p]);
-    a_num(w, "height", m->plane_height[p]);
-    a_str(w, "material", mat_name(m, m->plane_material[p]));
-    w_s(w, "/>\n");
-  }
-  for (int s = 0; s < m->nsys; s++) {
-    if (!d->sys_active[s]) continue;
-    if (m->sys_type[s] == SS_SYS_ARTICULATED) {
-      write_articulated(w, m, d, s);
-      continue;
+  for (int k = 0; k < nobj; k++) {
+    int i = order[k].index;
+    if (order[k].kind == OBJ_PLANE) {
+      w_s(w, "    <ground");
+      a_str(w, "name", m->plane_name[i]);
+      a_num(w, "height", m->plane_height[i]);
+      a_str(w, "material", mat_name(m, m->plane_material[i]));
+      w_s(w, "/>\n");
+    } else if (order[k].kind == OBJ_HFIELD) {
+      write_hfield(w, m, d, i);
+    } else if (m->sys_type[i] == SS_SYS_ARTICULATED) {
+      write_articulated(w, m, d, i);
+    } else {
+      int b = m->sys_bodyadr[i];
+      for (int g = 0; g < m->ngeom; g++)
+        if (m->geom_body[g] == b) {
+          write_body(w, m, d, i, g);
+          break;
+        }
     }
-    int b = m->sys_bodyadr[s];
-    for (int g = 0; g < m->ngeom; g++)
-      if (m->geom_body[g] == b) {
-        write_body(w, m, d, s, g);
-        break;
-      }
   }
-  for (int h = 0; h < m->nhfield; h++) write_hfield(w, m, d, h);
   w_s(w, "  </objects>\n");
 
   w_s(w, "  <material>\n    <default");
@@ -445,9 +525,20 @@ static void write_world(wBuf *w, const ssModel *m, const ssData *d)
   w_s(w, "/>\n");
   for (int k = 0; k < m->npair; k++) {
     const ssMaterialPair *p = &m->pair[k];
+    /* the reader numbers a name it has not met yet next, and keeps a
+     * pair's lower number first: written in that order */
+    int a = p->mat1, b = p->mat2;
+    if (a >= 0 && a < m->nmaterial && renum[a] < 0) renum[a] = nnum++;
+    if (b >= 0 && b < m->nmaterial && renum[b] < 0) renum[b] = nnum++;
+    if (a >= 0 && a < m->nmaterial && b >= 0 && b < m->nmaterial &&
+        renum[b] < renum[a]) {
+      int t = a;
+      a = b;
+      b = t;
+    }
     w_s(w, "    <pair_prop");
-    a_str(w, "name1", mat_name(m, p->mat1));
-    a_str(w, "name2", mat_name(m, p->mat2));
+    a_str(w, "name1", mat_name(m, a));
+    a_str(w, "name2", mat_name(m, b));
     a_num(w, "friction", p->friction);
     a_num(w, "restitution", p->restitution);
     a_num(w, "restitution_threshold", p->restitution_threshold);
@@ -532,11 +623,25 @@ ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
   if (st != SS_OK) return st;
 
   wBuf *w = malloc(sizeof *w);
-  if (!w) return ss_error_set(err, SS_ERR_NOMEM, path, 0, "out of memory");
+  size_t nall = (size_t)m->nplane + (size_t)m->nsys + (size_t)m->nhfield;
+  wObject *order = malloc((nall + 1) * sizeof *order);
+  int *renum = malloc(((size_t)m->nmaterial + 1) * sizeof *renum);
+  unsigned char *used = malloc((size_t)m->nmaterial + 1);
+  if (!w || !order || !renum || !used) {
+    free(w);
+    free(order);
+    free(renum);
+    free(used);
+    return ss_error_set(err, SS_ERR_NOMEM, path, 0, "out of memory");
+  }
+  int nnum, nobj = object_order(m, d, order, renum, used, &nnum);
+  free(used);
   ssAtomicFile f;
   st = ss_atomic_open(&f, path, err);
   if (st != SS_OK) {
     free(w);
+    free(order);
+    free(renum);
     return st;
   }
   w->f = &f;
@@ -553,13 +658,17 @@ ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
   if (!have_loc && (!lc || !lc->decimal_point || strcmp(lc->decimal_point, "."))) {
     ss_atomic_abort(&f);
     free(w);
+    free(order);
+    free(renum);
     return ss_error_set(err, SS_ERR_STATE, path, 0,
                         "cannot switch to the C locale to write numbers");
   }
-  write_world(w, m, d);
+  write_world(w, m, d, order, nobj, renum, nnum);
   w_flush(w);
   if (have_loc) ss_scene_c_locale_pop(&loc);
   free(w);
+  free(order);
+  free(renum);
   /* a failed write is reported by the commit, with its reason */
   return ss_atomic_commit(&f, err);
 }
