@@ -784,6 +784,12 @@ ssRenderer *ss_render_new(const ssModel *m, const ssRenderOptions *opt,
                  o.color_mode);
     return NULL;
   }
+  if (!(o.camera_fov_deg > 0 && o.camera_fov_deg < 180)) {
+    ss_error_set(err, SS_ERR_VALUE, "", 0,
+                 "invalid camera field of view %g degrees: it must be "
+                 "between 0 and 180 (exclusive)", o.camera_fov_deg);
+    return NULL;
+  }
   if (!isfinite(o.sinkage_max)) {
     ss_error_set(err, SS_ERR_VALUE, "", 0,
                  "colour-bar full scale must be finite (got %g)", o.sinkage_max);
@@ -1034,7 +1040,8 @@ static void camera_for_frame(const ssRenderer *r, const ssModel *m,
   double fov_deg = r->cam_mode == 1 ? r->opt.camera_fov_deg
                    : r->cam_mode == 2 ? m->camera_fov_deg
                                       : r->opt.camera_fov_deg;
-  if (!(fov_deg > 1 && fov_deg < 179)) fov_deg = 45;
+  /* what ss_render_new and the scene reader accept, (0, 180) degrees */
+  if (!(fov_deg > 0 && fov_deg < 180)) fov_deg = 45;
   double fovy = fov_deg * SS_PI / 180;
   if (r->cam_mode == 0) {
     camera_auto(r, m, d, aspect, fovy, c);

@@ -1076,6 +1076,9 @@ static int run(const Options *o)
                    "--camera-follow needs a camera: give --camera-pos and "
                    "--camera-look-at, or a <camera> in the scene");
       goto fail;
+    } else {
+      /* the automatic overview, seen through this field of view */
+      ropt.camera_fov_deg = o->camera_fov;
     }
   }
   /* a name the scene does not hold is the option's error, said with the

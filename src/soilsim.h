@@ -317,7 +317,8 @@ typedef struct ssModel {
   int camera_given;
   double camera_pos[3];
   double camera_look_at[3];
-  double camera_fov_deg;
+  double camera_fov_deg;    /* vertical field of view, in (0, 180) degrees:
+                               the camera above's, or the automatic one's */
   char camera_follow[128];
 
   /* where the model came from (for messages and [THIS_DIR]) */
@@ -633,7 +634,8 @@ typedef struct ssRenderOptions {
                                <camera>, else an automatic overview */
   double camera_pos[3];
   double camera_look_at[3];
-  double camera_fov_deg;
+  double camera_fov_deg;    /* vertical field of view, in (0, 180) degrees:
+                               the camera above's, or the automatic one's */
   char camera_follow[128];  /* system name the camera follows ("" = none) */
 } ssRenderOptions;
 

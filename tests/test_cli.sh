@@ -631,6 +631,18 @@ run "$PLATE" --steps 0 --render "$tmp/camB" --size 160x90 --camera-pos 0,0,3 \
   --camera-look-at 0,0.001,0 --camera-fov 30 --color soil --quiet
 check "--camera-pos/--camera-look-at/--camera-fov/--color render a different view" \
   'rc_is 0 && [ -s "$tmp/camB/frame_000000.png" ] && ! cmp -s "$tmp/camA/frame_000000.png" "$tmp/camB/frame_000000.png"'
+# --camera-fov alone: the automatic overview (plate.xml has no <camera>)
+# and the scene's <camera> (buggy.xml) through another field of view; the
+# whole documented range (0, 180) counts (the automatic view ignored the
+# option, and a field of view under 1 or over 179 degrees became 45)
+run "$PLATE" --steps 0 --render "$tmp/camF" --size 160x90 --camera-fov 20 --quiet
+check "--camera-fov 20 changes the automatic view" \
+  'rc_is 0 && [ -s "$tmp/camF/frame_000000.png" ] && ! cmp -s "$tmp/camA/frame_000000.png" "$tmp/camF/frame_000000.png"'
+run "$top_srcdir/scenes/buggy.xml" --steps 0 --render "$tmp/camG" --size 160x90 --quiet
+run "$top_srcdir/scenes/buggy.xml" --steps 0 --render "$tmp/camH" --size 160x90 \
+  --camera-fov 0.5 --quiet
+check "--camera-fov 0.5 narrows the scene's camera (not taken as 45)" \
+  'rc_is 0 && [ -s "$tmp/camH/frame_000000.png" ] && ! cmp -s "$tmp/camG/frame_000000.png" "$tmp/camH/frame_000000.png"'
 run "$PLATE" --steps 0 --render "$tmp/camC" --camera-pos 0,0,3
 check "--camera-pos without --camera-look-at: exit 2" 'usage_error'
 run "$PLATE" --steps 0 --camera-fov 30

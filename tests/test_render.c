@@ -292,6 +292,17 @@ static void test_bad_sizes(void)
   ok(r == NULL && err.code == SS_ERR_NOTFOUND,
      "render_new with an unknown follow target fails: %s", err.message);
   ss_render_free(r);
+  /* a field of view outside (0, 180) degrees is refused, not drawn as 45 */
+  double fovs[] = {0, -10, 180, 200, NAN};
+  for (int k = 0; k < 5; k++) {
+    o = ss_render_options_default();
+    o.camera_fov_deg = fovs[k];
+    memset(&err, 0, sizeof err);
+    r = ss_render_new(w.m, &o, &err);
+    ok(r == NULL && err.code == SS_ERR_VALUE && strstr(err.message, "field of view"),
+       "render_new with a field of view of %g degrees fails: %s", fovs[k], err.message);
+    ss_render_free(r);
+  }
   free_world(&w);
 }
 
