@@ -248,12 +248,16 @@ static int parse_fraction(const char *s, double lo, double hi, double *out)
   return 1;
 }
 
-/* "x,y,z" or "x y z": three finite numbers */
+/* "x,y,z" or "x y z": three finite numbers, one comma or spaces between
+ * two of them (so "1,,2,3" is not read as 1,2,3) */
 static int parse_vec3(const char *s, double v[3])
 {
   const char *p = s;
   for (int k = 0; k < 3; k++) {
-    while (*p == ' ' || (k && *p == ',')) p++;
+    while (*p == ' ') p++;
+    if (k && *p == ',') p++;
+    while (*p == ' ') p++;
+    if (!*p || *p == ',') return 0;
     char *end;
     errno = 0;
     v[k] = strtod(p, &end);

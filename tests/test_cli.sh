@@ -60,6 +60,15 @@ for v in 0x10 640 x480 640x 640x480x2 -640x480 20000x100 axb; do
   run "$PLATE" --size "$v" --rut-map "$tmp/r.png"
   check "--size '$v' is rejected (exit 2)" 'usage_error && err_has "--size"'
 done
+# three numbers, one comma (or spaces) between two ("1,,2,3" was read as 1,2,3)
+i=0
+for v in "1,,2,3" "1,2" ",1,2,3" "1,2,3," "1, ,2,3" "1,2,x"; do
+  i=$((i + 1))
+  run "$PLATE" --steps 0 --render "$tmp/camv$i" --camera-pos "$v" --camera-look-at 0,0,0
+  check "--camera-pos '$v' is rejected (exit 2)" 'usage_error && err_has "--camera-pos" && no_file "$tmp/camv$i"'
+done
+run "$PLATE" --steps 0 --render "$tmp/camv" --size 32x32 --camera-pos " 1 , 2 3" --camera-look-at=-1,-2,-3 --quiet
+check "--camera-pos ' 1 , 2 3' and --camera-look-at=-1,-2,-3 are accepted" 'rc_is 0'
 run "$PLATE" --steps 5 --render "$tmp/cam0" --camera-pos 0,0,1 --camera-look-at 0,0,1
 check "--camera-pos equal to --camera-look-at: exit 2 (a camera needs a direction)" \
   'usage_error && err_has "distinct points" && no_file "$tmp/cam0"'
