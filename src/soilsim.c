@@ -1149,10 +1149,20 @@ static int run(const Options *o)
   wall = now_seconds() - t0;
   if (g_signal) {
     progress_clear(&prog);
-    if (nckpt)
+    /* what is written as the run goes stays: say what that is */
+    if (nckpt && nframes)
+      fprintf(stderr, "soilsim: interrupted after step %ld; only the %d "
+              "checkpoint%s of earlier steps and the %ld frame%s drawn so far "
+              "written\n", done, nckpt, nckpt == 1 ? "" : "s", nframes,
+              nframes == 1 ? "" : "s");
+    else if (nckpt)
       fprintf(stderr, "soilsim: interrupted after step %ld; only the %d "
               "checkpoint%s of earlier steps written\n", done, nckpt,
               nckpt == 1 ? "" : "s");
+    else if (nframes)
+      fprintf(stderr, "soilsim: interrupted after step %ld; only the %ld "
+              "frame%s drawn so far written\n", done, nframes,
+              nframes == 1 ? "" : "s");
     else
       fprintf(stderr, "soilsim: interrupted after step %ld; no output files "
               "written\n", done);

@@ -663,5 +663,26 @@ check "--camera-follow of an unknown body: exit 1 before stepping, naming the op
 run "$PLATE" --steps 0 --render "$tmp/camE" --color rainbow
 check "--color with an unknown mode: exit 2" 'usage_error && err_has "rainbow"'
 
+# SIGINT in the middle of a run: exit by the signal, no final outputs, and
+# a message that counts what stays, the frames drawn so far (it said "no
+# output files written" with the frames there)
+sig=$tmp/sig
+mkdir -p "$sig"
+last_cmd="soilsim $PLATE --steps 100000000 --render $sig/fr --render-every 1 --size 16x16 --export $sig/e.xml (SIGINT)"
+CI='' "$SOILSIM" "$PLATE" --steps 100000000 --render "$sig/fr" --render-every 1 \
+  --size 16x16 --export "$sig/e.xml" --quiet >"$tmp/out" 2>"$tmp/err" &
+pid=$!
+k=0
+while [ ! -e "$sig/fr/frame_000002.png" ] && [ $k -lt 600 ]; do
+  sleep 0.1
+  k=$((k + 1))
+done
+kill -INT "$pid" 2>"$tmp/kill_err"
+wait "$pid"
+rc=$?
+check "SIGINT: exit by the signal, no export, the message counts the frames that stay" \
+  'rc_is 130 && no_file "$sig/e.xml" && no_tmp "$sig" && err_has "interrupted after step" &&
+   err_has "frames drawn so far written" && ! err_has "no output files"'
+
 echo "1..$n"
 [ "$nfail" -eq 0 ]
