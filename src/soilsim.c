@@ -512,7 +512,7 @@ static int parse_args(int argc, char **argv, Options *o)
     case OPT_STEPS:
       if (!parse_long(value, 0, LONG_MAX - 1, &o->steps))
         return usage_error("invalid --steps value '%s': expected an integer "
-                           ">= 0", value);
+                           "from 0 to %ld", value, LONG_MAX - 1);
       steps_given = 1;
       break;
     case OPT_EXPORT: o->export_path = value; break;

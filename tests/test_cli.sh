@@ -56,6 +56,11 @@ for v in abc -1 10x 1e3 "" 99999999999999999999999; do
   run "$PLATE" --steps "$v"
   check "--steps '$v' is rejected (exit 2)" 'usage_error'
 done
+# the largest step count is one less than the largest integer (the loop
+# counts to it): the message gives the range, not ">= 0" for a number >= 0
+run "$PLATE" --steps 9223372036854775807
+check "--steps 9223372036854775807: exit 2 saying the range" \
+  'usage_error && err_has "from 0 to 9223372036854775806"'
 for v in 0x10 640 x480 640x 640x480x2 -640x480 20000x100 axb; do
   run "$PLATE" --size "$v" --rut-map "$tmp/r.png"
   check "--size '$v' is rejected (exit 2)" 'usage_error && err_has "--size"'
