@@ -600,6 +600,8 @@ static int parse_args(int argc, char **argv, Options *o)
     return usage_error("--restore needs the scene file as well: a checkpoint "
                        "holds the state of a world, not the world");
   if (!o->scene) return usage_error("no scene file given");
+  /* decidable from the command line, as --restore '' is */
+  if (!*o->scene) return usage_error("the scene file name is empty");
   if (o->render_every_given && !o->render_dir)
     return usage_error("--render-every needs --render DIR");
   if (o->camera_pos_given != o->camera_look_given)

@@ -39,6 +39,12 @@ check "--version prints 'soilsim 0.1.0' and exits 0" \
   'rc_is 0 && [ "$(cat "$tmp/out")" = "soilsim 0.1.0" ]'
 run
 check "no arguments: usage error (exit 2)" 'usage_error && err_has "no scene"'
+run ""
+check "an empty scene name: usage error (exit 2), as --restore '' is" \
+  'usage_error && err_has "scene file name is empty"'
+run "" --steps 3 --export "$tmp/empty.xml"
+check "an empty scene name with options: exit 2, nothing written" \
+  'usage_error && no_file "$tmp/empty.xml"'
 run "$PLATE" --bogus
 check "unknown option: exit 2 naming it" 'usage_error && err_has "--bogus"'
 run "$PLATE" --bogus=3
