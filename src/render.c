@@ -1842,11 +1842,20 @@ ssStatus ss_render_rut_map(const ssModel *m, const ssData *d, int hfield,
   img_frame(&im, L.map_x, L.map_y, L.map_w, L.map_h, ink_rgb);
 
   /* title, colour bar, metre scale */
-  char title[256];
-  snprintf(title, sizeof title, "%s: %s, max %.2f mm, t = %.3f s",
-           m->hfield_name[h] ? m->hfield_name[h] : "bed",
-           plastic ? "permanent sinkage" : "sinkage", vmax * 1000.0, d->time);
-  ss_font_draw(font, &im, L.title_x, L.title_y, title, ink_rgb);
+  /* the longest title that ends before the colour bar's labels, whose
+   * top one reaches up into the title's line (a long one ran over it) */
+  char title[4][256];
+  const char *what = plastic ? "permanent sinkage" : "sinkage";
+  snprintf(title[0], sizeof title[0], "%s: %s, max %.2f mm, t = %.3f s",
+           m->hfield_name[h] ? m->hfield_name[h] : "bed", what, vmax * 1000.0,
+           d->time);
+  snprintf(title[1], sizeof title[1], "%s, max %.2f mm, t = %.3f s", what,
+           vmax * 1000.0, d->time);
+  snprintf(title[2], sizeof title[2], "%s, max %.2f mm", what, vmax * 1000.0);
+  snprintf(title[3], sizeof title[3], "max %.2f mm", vmax * 1000.0);
+  int room = L.bar_x + L.bar_w + 7 - L.font_px / 2 - L.title_x, pick = 0;
+  while (pick < 3 && ss_font_width(font, title[pick]) > room) pick++;
+  ss_font_draw(font, &im, L.title_x, L.title_y, title[pick], ink_rgb);
   ss_draw_colorbar(&im, font, L.bar_x, L.bar_y, L.bar_w, L.bar_h, fs, NULL);
   int thick = L.font_px / 4 > 3 ? L.font_px / 4 : 3;
   ss_img_fill(&im, L.scale_x, L.scale_y, L.scale_len, thick, ink_rgb, 1);
