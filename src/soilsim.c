@@ -1031,8 +1031,11 @@ static int run(const Options *o)
    * --checkpoint D/k@5); made before anything is written, taken away
    * again on any failure before the first frame (unmake_dirs) */
   if (o->render_dir) {
+    /* the first frame's name, which every run writes: a made-up probe
+     * name refused a folder that held a folder of that name, and named a
+     * file the run never writes */
     char probe[2048];
-    snprintf(probe, sizeof probe, "%s/frame_probe.png", o->render_dir);
+    snprintf(probe, sizeof probe, "%s/frame_%06d.png", o->render_dir, 0);
     if (make_dirs(o->render_dir, &err) != SS_OK ||
         check_output(probe, "--render", &err) != SS_OK)
       goto fail;

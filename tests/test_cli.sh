@@ -260,6 +260,17 @@ run "$PLATE" --steps 2000000000 --render "$tmp/plainfile/frames"
 check "--render folder that cannot be created: exit 1 before stepping" \
   'rc_is 1 && err_has "plainfile" && no_tmp "$tmp"'
 
+# the --render folder is tried with the name of the first frame, which is
+# written: a folder named like a made-up probe file does not stop the run
+mkdir -p "$tmp/probe/frame_probe.png"
+run "$PLATE" --steps 2 --render "$tmp/probe" --size 16x16 --quiet
+check "--render folder holding a folder frame_probe.png: frames written" \
+  'rc_is 0 && [ -s "$tmp/probe/frame_000002.png" ] && no_tmp "$tmp/probe"'
+mkdir -p "$tmp/probe2/frame_000000.png"
+run "$PLATE" --steps 2000000000 --render "$tmp/probe2" --size 16x16
+check "--render folder whose frame_000000.png is a folder: exit 1 before stepping, naming it" \
+  'rc_is 1 && err_has "probe2/frame_000000.png" && err_has "directory"'
+
 # A failed run never touches an existing output file.
 cat >"$tmp/broken.xml" <<'EOF'
 <raisim version="1.0">
