@@ -401,6 +401,18 @@ static int object_material(const ssModel *m, const wObject *o)
                                  : sys_material(m, o->index);
 }
 
+/* The numbers the reader gives the materials of the pairs it has not met
+ * yet: a pair's two names in the order they are written (see
+ * write_materials). */
+static void number_pairs(const ssModel *m, int *renum, int *nnum)
+{
+  for (int k = 0; k < m->npair; k++) {
+    int a = m->pair[k].mat1, b = m->pair[k].mat2;
+    if (a >= 0 && a < m->nmaterial && renum[a] < 0) renum[a] = (*nnum)++;
+    if (b >= 0 && b < m->nmaterial && renum[b] < 0) renum[b] = (*nnum)++;
+  }
+}
+
 /* The reader numbers the materials in the order it meets their names, so
  * the objects are written in an order that names them in the order of the
  * model's numbers: the reloaded world then has the same numbers (a
@@ -410,11 +422,14 @@ static int object_material(const ssModel *m, const wObject *o)
  * them, so such an order exists for a model read from a file); among the
  * next objects of the three, the first whose material is already named or
  * is the next number is taken, grounds before systems before height maps,
- * which leaves the usual order wherever it already works.  renum[k] gets
- * the number the reader will give material k (-1: not named by an
- * object); returns the number of objects, *nnum the numbers given. */
-static int object_order(const ssModel *m, const ssData *d, wObject *order,
-                        int *renum, unsigned char *used, int *nnum)
+ * which leaves the usual order wherever it already works.  pairs_first:
+ * the <material> element is to be written before <objects> (a scene that
+ * has it there names its pairs' materials first).  renum[k] gets the
+ * number the reader will give material k (-1: named by nothing written);
+ * returns the number of objects, *nnum the numbers given. */
+static int object_order(const ssModel *m, const ssData *d, int pairs_first,
+                        wObject *order, int *renum, unsigned char *used,
+                        int *nnum)
 {
   int count[3] = {m->nplane, m->nsys, m->nhfield}, next[3] = {0, 0, 0};
   int nobj = 0, nused = 1;
@@ -423,6 +438,7 @@ static int object_order(const ssModel *m, const ssData *d, wObject *order,
     used[k] = 0;
   }
   if (m->nmaterial > 0) renum[0] = 0; /* "default", numbered first */
+  if (pairs_first) number_pairs(m, renum, &nused);
   /* the materials the written objects name */
   for (int kind = 0; kind < 3; kind++)
     for (int i = 0; i < count[kind]; i++) {
@@ -457,12 +473,51 @@ static int object_order(const ssModel *m, const ssData *d, wObject *order,
     if (mat >= 0 && mat < m->nmaterial && renum[mat] < 0) renum[mat] = nused++;
     order[nobj++] = o;
   }
+  if (!pairs_first) number_pairs(m, renum, &nused);
   *nnum = nused;
   return nobj;
 }
 
+/* Whether the reloaded world numbers every material written as this one. */
+static int same_numbers(const ssModel *m, const int *renum)
+{
+  for (int k = 0; k < m->nmaterial; k++)
+    if (renum[k] >= 0 && renum[k] != k) return 0;
+  return 1;
+}
+
+/* <material>: the default and the pairs, each pair's names in the order
+ * the reader numbers them (it keeps a pair's lower number first). */
+static void write_materials(wBuf *w, const ssModel *m, const int *renum)
+{
+  w_s(w, "  <material>\n    <default");
+  a_num(w, "friction", m->material_default.friction);
+  a_num(w, "restitution", m->material_default.restitution);
+  a_num(w, "restitution_threshold", m->material_default.restitution_threshold);
+  w_s(w, "/>\n");
+  for (int k = 0; k < m->npair; k++) {
+    const ssMaterialPair *p = &m->pair[k];
+    int a = p->mat1, b = p->mat2;
+    if (a >= 0 && a < m->nmaterial && b >= 0 && b < m->nmaterial &&
+        renum[b] < renum[a]) {
+      int t = a;
+      a = b;
+      b = t;
+    }
+    w_s(w, "    <pair_prop");
+    a_str(w, "name1", mat_name(m, a));
+    a_str(w, "name2", mat_name(m, b));
+    a_num(w, "friction", p->friction);
+    a_num(w, "restitution", p->restitution);
+    a_num(w, "restitution_threshold", p->restitution_threshold);
+    w_s(w, "/>\n");
+  }
+  w_s(w, "  </material>\n");
+}
+
 static void write_world(wBuf *w, const ssModel *m, const ssData *d,
-                        const wObject *order, int nobj, int *renum, int nnum)
+                        const wObject *order, int nobj, const int *renum,
+                        int pairs_first)
 {
   const ssOption *o = &m->opt;
   w_s(w, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
@@ -494,6 +549,7 @@ static void write_world(wBuf *w, const ssModel *m, const ssData *d,
     w_s(w, "/>\n");
   }
 
+  if (pairs_first) write_materials(w, m, renum);
   w_s(w, "  <objects>\n");
   for (int k = 0; k < nobj; k++) {
     int i = order[k].index;
@@ -518,33 +574,8 @@ static void write_world(wBuf *w, const ssModel *m, const ssData *d,
   }
   w_s(w, "  </objects>\n");
 
-  w_s(w, "  <material>\n    <default");
-  a_num(w, "friction", m->material_default.friction);
-  a_num(w, "restitution", m->material_default.restitution);
-  a_num(w, "restitution_threshold", m->material_default.restitution_threshold);
-  w_s(w, "/>\n");
-  for (int k = 0; k < m->npair; k++) {
-    const ssMaterialPair *p = &m->pair[k];
-    /* the reader numbers a name it has not met yet next, and keeps a
-     * pair's lower number first: written in that order */
-    int a = p->mat1, b = p->mat2;
-    if (a >= 0 && a < m->nmaterial && renum[a] < 0) renum[a] = nnum++;
-    if (b >= 0 && b < m->nmaterial && renum[b] < 0) renum[b] = nnum++;
-    if (a >= 0 && a < m->nmaterial && b >= 0 && b < m->nmaterial &&
-        renum[b] < renum[a]) {
-      int t = a;
-      a = b;
-      b = t;
-    }
-    w_s(w, "    <pair_prop");
-    a_str(w, "name1", mat_name(m, a));
-    a_str(w, "name2", mat_name(m, b));
-    a_num(w, "friction", p->friction);
-    a_num(w, "restitution", p->restitution);
-    a_num(w, "restitution_threshold", p->restitution_threshold);
-    w_s(w, "/>\n");
-  }
-  w_s(w, "  </material>\n</raisim>\n");
+  if (!pairs_first) write_materials(w, m, renum);
+  w_s(w, "</raisim>\n");
 }
 
 /* What the format cannot (yet) express. */
@@ -634,7 +665,15 @@ ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
     free(used);
     return ss_error_set(err, SS_ERR_NOMEM, path, 0, "out of memory");
   }
-  int nnum, nobj = object_order(m, d, order, renum, used, &nnum);
+  /* <material> after <objects>, as usual, unless only before them does
+   * the reloaded world number the materials as this one does */
+  int nnum, pairs_first = 0;
+  int nobj = object_order(m, d, 0, order, renum, used, &nnum);
+  if (!same_numbers(m, renum)) {
+    nobj = object_order(m, d, 1, order, renum, used, &nnum);
+    pairs_first = same_numbers(m, renum);
+    if (!pairs_first) nobj = object_order(m, d, 0, order, renum, used, &nnum);
+  }
   free(used);
   ssAtomicFile f;
   st = ss_atomic_open(&f, path, err);
@@ -663,7 +702,7 @@ ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
     return ss_error_set(err, SS_ERR_STATE, path, 0,
                         "cannot switch to the C locale to write numbers");
   }
-  write_world(w, m, d, order, nobj, renum, nnum);
+  write_world(w, m, d, order, nobj, renum, pairs_first);
   w_flush(w);
   if (have_loc) ss_scene_c_locale_pop(&loc);
   free(w);

@@ -613,6 +613,25 @@ for s in "$top_srcdir"/scenes/*.xml; do
   check "$b.xml: export, reload, export again: identical; its checkpoint restores into the export" \
     '[ "$rc1" -eq 0 ] && [ "$rc2" -eq 0 ] && rc_is 0 && cmp -s "$tmp/rt_$b.xml" "$tmp/rt2_$b.xml"'
 done
+# a <material> before <objects> (as RaiSim's examples have it) names its
+# pairs' materials first: with one naming materials no object has, the
+# export writes its <material> first too; with the bed's material before
+# the plate's, the bed is written first
+mat_first='<material><default friction="0.8"/><pair_prop name1="steel" name2="wood" friction="0.5"/></material><objects>'
+sed -e "s|<objects>|$mat_first|" -e 's|<box name="plate"|& material="rubber"|' \
+  "$PLATE" >"$tmp/mat1.xml"
+mat_pair='<material><default friction="0.8"/><pair_prop name1="wood" name2="rubber" friction="0.5"/></material><objects>'
+sed -e "s|<objects>|$mat_pair|" -e 's|<box name="plate"|& material="rubber"|' \
+  -e 's|<heightmap name="soil"|& material="wood"|' "$PLATE" >"$tmp/mat2.xml"
+for b in mat1 mat2; do
+  run "$tmp/$b.xml" --steps 5 --export "$tmp/rt_$b.xml" --checkpoint "$tmp/rt_$b.ckpt@5" --quiet
+  rc1=$rc
+  run "$tmp/rt_$b.xml" --steps 0 --export "$tmp/rt2_$b.xml" --quiet
+  rc2=$rc
+  run "$tmp/rt_$b.xml" --steps 1 --restore "$tmp/rt_$b.ckpt" --quiet
+  check "<material> before <objects> ($b): export, reload, export again: identical; its checkpoint restores into the export" \
+    '[ "$rc1" -eq 0 ] && [ "$rc2" -eq 0 ] && rc_is 0 && cmp -s "$tmp/rt_$b.xml" "$tmp/rt2_$b.xml"'
+done
 run "$PLATE" --steps 0 --checkpoint "$tmp/zero.ckpt@0" --export "$tmp/zero0.xml" --quiet
 run "$PLATE" --steps 0 --restore "$tmp/zero.ckpt" --export "$tmp/zero1.xml" --quiet
 check "--checkpoint FILE@0 holds the initial state; restoring it changes nothing" \
