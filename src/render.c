@@ -1755,9 +1755,11 @@ static void metres_label(char *buf, size_t len, double m)
   else snprintf(buf, len, "%g mm", m * 1000);
 }
 
-ssStatus ss_render_rut_map(const ssModel *m, const ssData *d, int hfield,
-                           int plastic, int width, int height,
-                           const char *png_path, ssError *err)
+/* The rut map, written to png_path or, when af is given, into it (left
+ * open for the caller to commit). */
+static ssStatus rut_map(const ssModel *m, const ssData *d, int hfield,
+                        int plastic, int width, int height,
+                        const char *png_path, ssAtomicFile *af, ssError *err)
 {
   if (!m || !d)
     return ss_error_set(err, SS_ERR_VALUE, png_path ? png_path : "", 0,
@@ -1868,7 +1870,25 @@ ssStatus ss_render_rut_map(const ssModel *m, const ssData *d, int hfield,
                L.scale_y + thick / 2 + ss_font_ascent(font) / 2 - 1, sl, ink_rgb);
   ss_font_free(font);
 
-  ssStatus st = ss_png_write_rgba(png_path, width, height, px, err);
+  ssStatus st = af ? ss_png_write_rgba_to(af, width, height, px, err)
+                   : ss_png_write_rgba(png_path, width, height, px, err);
   free(px);
   return st;
+}
+
+ssStatus ss_render_rut_map(const ssModel *m, const ssData *d, int hfield,
+                           int plastic, int width, int height,
+                           const char *png_path, ssError *err)
+{
+  return rut_map(m, d, hfield, plastic, width, height, png_path, NULL, err);
+}
+
+ssStatus ss_render_rut_map_to(const ssModel *m, const ssData *d, int hfield,
+                              int plastic, int width, int height,
+                              ssAtomicFile *af, ssError *err)
+{
+  if (!af || !af->fp)
+    return ss_error_set(err, SS_ERR_STATE, af ? af->path : "", 0,
+                        "rut map output not open");
+  return rut_map(m, d, hfield, plastic, width, height, af->path, af, err);
 }

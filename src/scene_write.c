@@ -641,18 +641,11 @@ static ssStatus check_exportable(const ssModel *m, const ssData *d,
   return SS_OK;
 }
 
-ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
-                         ssError *err)
+/* Writes the world into f (open), which the caller commits or aborts. */
+static ssStatus export_to(const ssModel *m, const ssData *d, ssAtomicFile *f,
+                          ssError *err)
 {
-  if (!m || !d || !path)
-    return ss_error_set(err, SS_ERR_VALUE, path ? path : "", 0,
-                        "ss_scene_export: NULL argument");
-  if (d->model && d->model != m)
-    return ss_error_set(err, SS_ERR_VALUE, path, 0,
-                        "ss_scene_export: the data belongs to another model");
-  ssStatus st = check_exportable(m, d, path, err);
-  if (st != SS_OK) return st;
-
+  const char *path = f->path;
   wBuf *w = malloc(sizeof *w);
   size_t nall = (size_t)m->nplane + (size_t)m->nsys + (size_t)m->nhfield;
   wObject *order = malloc((nall + 1) * sizeof *order);
@@ -675,15 +668,7 @@ ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
     if (!pairs_first) nobj = object_order(m, d, 0, order, renum, used, &nnum);
   }
   free(used);
-  ssAtomicFile f;
-  st = ss_atomic_open(&f, path, err);
-  if (st != SS_OK) {
-    free(w);
-    free(order);
-    free(renum);
-    return st;
-  }
-  w->f = &f;
+  w->f = f;
   w->n = 0;
   /* the folder exists (the temporary file is in it), so this is its real
    * path; if even so it cannot be had, paths are written absolute */
@@ -695,7 +680,6 @@ ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
   int have_loc = ss_scene_c_locale_push(&loc) == 0;
   struct lconv *lc = have_loc ? NULL : localeconv();
   if (!have_loc && (!lc || !lc->decimal_point || strcmp(lc->decimal_point, "."))) {
-    ss_atomic_abort(&f);
     free(w);
     free(order);
     free(renum);
@@ -708,6 +692,45 @@ ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
   free(w);
   free(order);
   free(renum);
+  return SS_OK;
+}
+
+ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
+                         ssError *err)
+{
+  if (!m || !d || !path)
+    return ss_error_set(err, SS_ERR_VALUE, path ? path : "", 0,
+                        "ss_scene_export: NULL argument");
+  if (d->model && d->model != m)
+    return ss_error_set(err, SS_ERR_VALUE, path, 0,
+                        "ss_scene_export: the data belongs to another model");
+  ssStatus st = check_exportable(m, d, path, err);
+  if (st != SS_OK) return st;
+  ssAtomicFile f;
+  st = ss_atomic_open(&f, path, err);
+  if (st != SS_OK) return st;
+  st = export_to(m, d, &f, err);
+  if (st != SS_OK) {
+    ss_atomic_abort(&f);
+    return st;
+  }
   /* a failed write is reported by the commit, with its reason */
   return ss_atomic_commit(&f, err);
+}
+
+ssStatus ss_scene_export_to(const ssModel *m, const ssData *d, ssAtomicFile *f,
+                            ssError *err)
+{
+  if (!f || !f->fp)
+    return ss_error_set(err, SS_ERR_STATE, f ? f->path : "", 0,
+                        "ss_scene_export_to: the output is not open");
+  if (!m || !d)
+    return ss_error_set(err, SS_ERR_VALUE, f->path, 0,
+                        "ss_scene_export_to: NULL argument");
+  if (d->model && d->model != m)
+    return ss_error_set(err, SS_ERR_VALUE, f->path, 0,
+                        "ss_scene_export_to: the data belongs to another model");
+  ssStatus st = check_exportable(m, d, f->path, err);
+  if (st != SS_OK) return st;
+  return export_to(m, d, f, err);
 }

@@ -654,6 +654,18 @@ static ssStatus open_output(ssAtomicFile *f, const char *path, const char *flag,
   return SS_OK;
 }
 
+/* An output written in full but not committed: its buffered bytes go out
+ * now, so that a write error (a full disk) is found before any output is
+ * committed.  The commit reports it, with its reason. */
+static ssStatus flush_output(ssAtomicFile *f, ssError *err)
+{
+  FILE *fp = (FILE *)f->fp;
+  errno = 0;
+  if (!f->error && fp && fflush(fp) != 0) f->error = errno ? errno : EIO;
+  if (f->error || (fp && ferror(fp))) return ss_atomic_commit(f, err);
+  return SS_OK;
+}
+
 static ssStatus check_output(const char *path, const char *flag, ssError *err)
 {
   ssError e;
@@ -1005,8 +1017,8 @@ static int run(const Options *o)
   ssModel *m = NULL;
   ssData *d = NULL;
   ssRenderer *r = NULL;
-  ssAtomicFile csv;
-  int csv_open = 0, status = EXIT_RUN_FAILED;
+  ssAtomicFile csv, rut, exp;
+  int csv_open = 0, rut_open = 0, exp_open = 0, status = EXIT_RUN_FAILED;
   long nframes = 0, unconverged = 0, done = 0;
   int nckpt = 0;
   ssCheckpointInfo restored;
@@ -1015,6 +1027,8 @@ static int run(const Options *o)
   Progress prog;
   memset(&prog, 0, sizeof prog);
   memset(&csv, 0, sizeof csv);
+  memset(&rut, 0, sizeof rut);
+  memset(&exp, 0, sizeof exp);
   ss_error_clear(&err);
 
   /* load and validate everything before the first step */
@@ -1176,13 +1190,44 @@ static int run(const Options *o)
   }
   progress_clear(&prog);
 
-  /* outputs of the final state; the CSV appears last, once all else worked */
-  if (o->rut_map &&
-      ss_render_rut_map(m, d, -1, 1, ropt.width, ropt.height, o->rut_map,
-                        &err) != SS_OK)
+  /* outputs of the final state: all of them written and flushed before
+   * any is committed, so that a failure leaves none of them (the rut map
+   * stayed when the export then failed); the CSV is committed last */
+  if (o->rut_map) {
+    if (open_output(&rut, o->rut_map, "--rut-map", &err) != SS_OK) goto fail;
+    rut_open = 1;
+    if (ss_render_rut_map_to(m, d, -1, 1, ropt.width, ropt.height, &rut,
+                             &err) != SS_OK)
+      goto fail;
+    /* a stream (a FIFO's reader waits for its end) is finished at once:
+     * it has nothing to roll back */
+    if (rut.direct) {
+      rut_open = 0;
+      if (ss_atomic_commit(&rut, &err) != SS_OK) goto fail;
+    }
+  }
+  if (o->export_path) {
+    if (open_output(&exp, o->export_path, "--export", &err) != SS_OK)
+      goto fail;
+    exp_open = 1;
+    if (ss_scene_export_to(m, d, &exp, &err) != SS_OK) goto fail;
+    if (exp.direct) {
+      exp_open = 0;
+      if (ss_atomic_commit(&exp, &err) != SS_OK) goto fail;
+    }
+  }
+  if ((rut_open && flush_output(&rut, &err) != SS_OK) ||
+      (exp_open && flush_output(&exp, &err) != SS_OK) ||
+      (csv_open && flush_output(&csv, &err) != SS_OK))
     goto fail;
-  if (o->export_path && ss_scene_export(m, d, o->export_path, &err) != SS_OK)
-    goto fail;
+  if (rut_open) {
+    rut_open = 0;
+    if (ss_atomic_commit(&rut, &err) != SS_OK) goto fail;
+  }
+  if (exp_open) {
+    exp_open = 0;
+    if (ss_atomic_commit(&exp, &err) != SS_OK) goto fail;
+  }
   if (csv_open) {
     csv_open = 0;
     if (ss_atomic_commit(&csv, &err) != SS_OK) goto fail;
@@ -1200,6 +1245,8 @@ fail:
   unmake_dirs();
 cleanup:
   if (csv_open) ss_atomic_abort(&csv);
+  if (rut_open) ss_atomic_abort(&rut);
+  if (exp_open) ss_atomic_abort(&exp);
   ss_render_free(r);
   ss_data_free(d);
   ss_model_free(m);

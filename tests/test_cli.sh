@@ -271,6 +271,26 @@ run "$PLATE" --steps 2000000000 --render "$tmp/probe2" --size 16x16
 check "--render folder whose frame_000000.png is a folder: exit 1 before stepping, naming it" \
   'rc_is 1 && err_has "probe2/frame_000000.png" && err_has "directory"'
 
+# The final outputs appear together or not at all: an export that fails
+# at the end (a copy of /dev/full: every write fails) leaves no rut map
+# and no CSV (the rut map was committed before the export was written)
+if [ "$(id -u)" -eq 0 ]; then
+  mkdir -p "$tmp/full"
+  mknod "$tmp/full/e.xml" c 1 7
+  run "$PLATE" --steps 3 --rut-map "$tmp/full/r.png" --csv "$tmp/full/c.csv" \
+    --export "$tmp/full/e.xml"
+  check "an export that fails at the end: exit 1, no rut map, no CSV, no temporary file" \
+    'rc_is 1 && err_has "e.xml" && no_file "$tmp/full/r.png" && no_file "$tmp/full/c.csv" &&
+     no_tmp "$tmp/full"'
+  echo old >"$tmp/full/r2.png"
+  run "$PLATE" --steps 3 --rut-map "$tmp/full/r2.png" --export "$tmp/full/e.xml"
+  check "an export that fails at the end: an existing rut map stays as it was" \
+    'rc_is 1 && [ "$(cat "$tmp/full/r2.png")" = old ] && no_tmp "$tmp/full"'
+else
+  skip "an export that fails at the end (mknod needs root)"
+  skip "an export that fails at the end: an existing rut map (mknod needs root)"
+fi
+
 # A failed run never touches an existing output file.
 cat >"$tmp/broken.xml" <<'EOF'
 <raisim version="1.0">
