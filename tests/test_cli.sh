@@ -721,6 +721,12 @@ run "$PLATE" --steps 5 --render "$tmp/camD" --camera-pos 0,0,3 --camera-look-at 
   --camera-follow nobody
 check "--camera-follow of an unknown body: exit 1 before stepping, naming the option and the scene" \
   'rc_is 1 && [ ! -e "$tmp/camD/frame_000005.png" ] && err_has "plate.xml: error: --camera-follow" && err_has "nobody"'
+run "$PLATE" --steps 5 --render "$tmp/camI" --camera-follow plate
+check "--camera-follow without --camera-pos or a scene <camera>: exit 1 before stepping, saying what it needs" \
+  'rc_is 1 && err_has "--camera-follow needs a camera" && no_file "$tmp/camI"'
+run --help
+check "--help gives --camera-fov's range and what --camera-follow needs" \
+  'rc_is 0 && out_has "0 < DEG < 180" && out_has "needs --camera-pos or the scene'"'"'s <camera>"'
 run "$PLATE" --steps 0 --render "$tmp/camE" --color rainbow
 check "--color with an unknown mode: exit 2" 'usage_error && err_has "rainbow"'
 
