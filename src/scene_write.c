@@ -426,10 +426,9 @@ static void number_pairs(const ssModel *m, int *renum, int *nnum)
  * the <material> element is to be written before <objects> (a scene that
  * has it there names its pairs' materials first).  renum[k] gets the
  * number the reader will give material k (-1: named by nothing written);
- * returns the number of objects, *nnum the numbers given. */
+ * returns the number of objects. */
 static int object_order(const ssModel *m, const ssData *d, int pairs_first,
-                        wObject *order, int *renum, unsigned char *used,
-                        int *nnum)
+                        wObject *order, int *renum, unsigned char *used)
 {
   int count[3] = {m->nplane, m->nsys, m->nhfield}, next[3] = {0, 0, 0};
   int nobj = 0, nused = 1;
@@ -474,7 +473,6 @@ static int object_order(const ssModel *m, const ssData *d, int pairs_first,
     order[nobj++] = o;
   }
   if (!pairs_first) number_pairs(m, renum, &nused);
-  *nnum = nused;
   return nobj;
 }
 
@@ -660,12 +658,12 @@ static ssStatus export_to(const ssModel *m, const ssData *d, ssAtomicFile *f,
   }
   /* <material> after <objects>, as usual, unless only before them does
    * the reloaded world number the materials as this one does */
-  int nnum, pairs_first = 0;
-  int nobj = object_order(m, d, 0, order, renum, used, &nnum);
+  int pairs_first = 0;
+  int nobj = object_order(m, d, 0, order, renum, used);
   if (!same_numbers(m, renum)) {
-    nobj = object_order(m, d, 1, order, renum, used, &nnum);
+    nobj = object_order(m, d, 1, order, renum, used);
     pairs_first = same_numbers(m, renum);
-    if (!pairs_first) nobj = object_order(m, d, 0, order, renum, used, &nnum);
+    if (!pairs_first) nobj = object_order(m, d, 0, order, renum, used);
   }
   free(used);
   w->f = f;
