@@ -338,6 +338,46 @@ static int encode_png(pngWriteCtx *c, FILE *fp, int w, int h,
   return 0;
 }
 
+ssStatus ss_png_write_rgba_to(ssAtomicFile *af, int w, int h,
+                              const unsigned char *rgba, ssError *err)
+{
+  const char *path = af && af->path[0] ? af->path : "";
+  if (!af || !af->fp)
+    return ss_error_set(err, SS_ERR_STATE, path, 0, "PNG output not open");
+  if (!rgba)
+    return ss_error_set(err, SS_ERR_VALUE, path, 0, "no pixels to write");
+  if (w <= 0 || h <= 0 || (double)w * (double)h > (double)SS_PNG_MAX_PIXELS)
+    return ss_error_set(err, SS_ERR_VALUE, path, 0,
+                        "invalid PNG size %d x %d (each side >= 1, at most %ld "
+                        "pixels)",
+                        w, h, (long)SS_PNG_MAX_PIXELS);
+
+  pngWriteCtx c;
+  memset(&c, 0, sizeof c);
+  c.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, c.msg, png_error_cb,
+                                  png_warning_cb);
+  if (c.png) c.info = png_create_info_struct(c.png);
+  if (!c.png || !c.info) {
+    if (c.png) png_destroy_write_struct(&c.png, c.info ? &c.info : NULL);
+    return ss_error_set(err, SS_ERR_NOMEM, path, 0,
+                        "out of memory starting the PNG encoder");
+  }
+  errno = 0;
+  int rc = encode_png(&c, (FILE *)af->fp, w, h, rgba);
+  /* libpng says only "Write Error" when fwrite fails: the system's reason
+   * (a full disk, say) is in errno */
+  int write_errno = rc != 0 && ferror((FILE *)af->fp) ? errno : 0;
+  png_destroy_write_struct(&c.png, &c.info);
+  if (rc != 0) {
+    if (write_errno)
+      return ss_error_set(err, SS_ERR_IO, path, 0, "cannot write PNG file: %s",
+                          strerror(write_errno));
+    return ss_error_set(err, SS_ERR_IO, path, 0, "cannot write PNG file: %s",
+                        c.msg[0] ? c.msg : "encoder error");
+  }
+  return SS_OK;
+}
+
 ssStatus ss_png_write_rgba(const char *path, int w, int h,
                            const unsigned char *rgba, ssError *err)
 {
@@ -355,31 +395,10 @@ ssStatus ss_png_write_rgba(const char *path, int w, int h,
   memset(&af, 0, sizeof af);
   ssStatus st = ss_atomic_open(&af, path, err);
   if (st != SS_OK) return st;
-
-  pngWriteCtx c;
-  memset(&c, 0, sizeof c);
-  c.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, c.msg, png_error_cb,
-                                  png_warning_cb);
-  if (c.png) c.info = png_create_info_struct(c.png);
-  if (!c.png || !c.info) {
-    if (c.png) png_destroy_write_struct(&c.png, c.info ? &c.info : NULL);
+  st = ss_png_write_rgba_to(&af, w, h, rgba, err);
+  if (st != SS_OK) {
     ss_atomic_abort(&af);
-    return ss_error_set(err, SS_ERR_NOMEM, path, 0,
-                        "out of memory starting the PNG encoder");
-  }
-  errno = 0;
-  int rc = encode_png(&c, (FILE *)af.fp, w, h, rgba);
-  /* libpng says only "Write Error" when fwrite fails: the system's reason
-   * (a full disk, say) is in errno */
-  int write_errno = rc != 0 && ferror((FILE *)af.fp) ? errno : 0;
-  png_destroy_write_struct(&c.png, &c.info);
-  if (rc != 0) {
-    ss_atomic_abort(&af);
-    if (write_errno)
-      return ss_error_set(err, SS_ERR_IO, path, 0, "cannot write PNG file: %s",
-                          strerror(write_errno));
-    return ss_error_set(err, SS_ERR_IO, path, 0, "cannot write PNG file: %s",
-                        c.msg[0] ? c.msg : "encoder error");
+    return st;
   }
   return ss_atomic_commit(&af, err);
 }

@@ -15,5 +15,9 @@ ssStatus ss_png_read_rgba(const char *path, int *w, int *h,
 /* Write 8-bit RGBA (w*h*4), atomically. */
 ssStatus ss_png_write_rgba(const char *path, int w, int h,
                            const unsigned char *rgba, ssError *err);
+/* The same into an output opened with ss_atomic_open, left open: the
+ * caller commits it (or aborts it on failure). */
+ssStatus ss_png_write_rgba_to(ssAtomicFile *af, int w, int h,
+                              const unsigned char *rgba, ssError *err);
 
 #endif /* SS_PNG_IO_H */

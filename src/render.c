@@ -784,6 +784,12 @@ ssRenderer *ss_render_new(const ssModel *m, const ssRenderOptions *opt,
                  o.color_mode);
     return NULL;
   }
+  if (!(o.camera_fov_deg > 0 && o.camera_fov_deg < 180)) {
+    ss_error_set(err, SS_ERR_VALUE, "", 0,
+                 "invalid camera field of view %g degrees: it must be "
+                 "between 0 and 180 (exclusive)", o.camera_fov_deg);
+    return NULL;
+  }
   if (!isfinite(o.sinkage_max)) {
     ss_error_set(err, SS_ERR_VALUE, "", 0,
                  "colour-bar full scale must be finite (got %g)", o.sinkage_max);
@@ -1034,7 +1040,8 @@ static void camera_for_frame(const ssRenderer *r, const ssModel *m,
   double fov_deg = r->cam_mode == 1 ? r->opt.camera_fov_deg
                    : r->cam_mode == 2 ? m->camera_fov_deg
                                       : r->opt.camera_fov_deg;
-  if (!(fov_deg > 1 && fov_deg < 179)) fov_deg = 45;
+  /* what ss_render_new and the scene reader accept, (0, 180) degrees */
+  if (!(fov_deg > 0 && fov_deg < 180)) fov_deg = 45;
   double fovy = fov_deg * SS_PI / 180;
   if (r->cam_mode == 0) {
     camera_auto(r, m, d, aspect, fovy, c);
@@ -1748,9 +1755,11 @@ static void metres_label(char *buf, size_t len, double m)
   else snprintf(buf, len, "%g mm", m * 1000);
 }
 
-ssStatus ss_render_rut_map(const ssModel *m, const ssData *d, int hfield,
-                           int plastic, int width, int height,
-                           const char *png_path, ssError *err)
+/* The rut map, written to png_path or, when af is given, into it (left
+ * open for the caller to commit). */
+static ssStatus rut_map(const ssModel *m, const ssData *d, int hfield,
+                        int plastic, int width, int height,
+                        const char *png_path, ssAtomicFile *af, ssError *err)
 {
   if (!m || !d)
     return ss_error_set(err, SS_ERR_VALUE, png_path ? png_path : "", 0,
@@ -1835,11 +1844,20 @@ ssStatus ss_render_rut_map(const ssModel *m, const ssData *d, int hfield,
   img_frame(&im, L.map_x, L.map_y, L.map_w, L.map_h, ink_rgb);
 
   /* title, colour bar, metre scale */
-  char title[256];
-  snprintf(title, sizeof title, "%s: %s, max %.2f mm, t = %.3f s",
-           m->hfield_name[h] ? m->hfield_name[h] : "bed",
-           plastic ? "permanent sinkage" : "sinkage", vmax * 1000.0, d->time);
-  ss_font_draw(font, &im, L.title_x, L.title_y, title, ink_rgb);
+  /* the longest title that ends before the colour bar's labels, whose
+   * top one reaches up into the title's line (a long one ran over it) */
+  char title[4][256];
+  const char *what = plastic ? "permanent sinkage" : "sinkage";
+  snprintf(title[0], sizeof title[0], "%s: %s, max %.2f mm, t = %.3f s",
+           m->hfield_name[h] ? m->hfield_name[h] : "bed", what, vmax * 1000.0,
+           d->time);
+  snprintf(title[1], sizeof title[1], "%s, max %.2f mm, t = %.3f s", what,
+           vmax * 1000.0, d->time);
+  snprintf(title[2], sizeof title[2], "%s, max %.2f mm", what, vmax * 1000.0);
+  snprintf(title[3], sizeof title[3], "max %.2f mm", vmax * 1000.0);
+  int room = L.bar_x + L.bar_w + 7 - L.font_px / 2 - L.title_x, pick = 0;
+  while (pick < 3 && ss_font_width(font, title[pick]) > room) pick++;
+  ss_font_draw(font, &im, L.title_x, L.title_y, title[pick], ink_rgb);
   ss_draw_colorbar(&im, font, L.bar_x, L.bar_y, L.bar_w, L.bar_h, fs, NULL);
   int thick = L.font_px / 4 > 3 ? L.font_px / 4 : 3;
   ss_img_fill(&im, L.scale_x, L.scale_y, L.scale_len, thick, ink_rgb, 1);
@@ -1852,7 +1870,25 @@ ssStatus ss_render_rut_map(const ssModel *m, const ssData *d, int hfield,
                L.scale_y + thick / 2 + ss_font_ascent(font) / 2 - 1, sl, ink_rgb);
   ss_font_free(font);
 
-  ssStatus st = ss_png_write_rgba(png_path, width, height, px, err);
+  ssStatus st = af ? ss_png_write_rgba_to(af, width, height, px, err)
+                   : ss_png_write_rgba(png_path, width, height, px, err);
   free(px);
   return st;
+}
+
+ssStatus ss_render_rut_map(const ssModel *m, const ssData *d, int hfield,
+                           int plastic, int width, int height,
+                           const char *png_path, ssError *err)
+{
+  return rut_map(m, d, hfield, plastic, width, height, png_path, NULL, err);
+}
+
+ssStatus ss_render_rut_map_to(const ssModel *m, const ssData *d, int hfield,
+                              int plastic, int width, int height,
+                              ssAtomicFile *af, ssError *err)
+{
+  if (!af || !af->fp)
+    return ss_error_set(err, SS_ERR_STATE, af ? af->path : "", 0,
+                        "rut map output not open");
+  return rut_map(m, d, hfield, plastic, width, height, af->path, af, err);
 }

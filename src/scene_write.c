@@ -338,6 +338,16 @@ static void write_hfield(wBuf *w, const ssModel *m, const ssData *d, int h)
   w_s(w, "/>\n    </heightmap>\n");
 }
 
+/* The material a system's element names: its (first) collider's. */
+static int sys_material(const ssModel *m, int s)
+{
+  int b0 = m->sys_bodyadr[s];
+  for (int g = 0; g < m->ngeom; g++)
+    if (m->geom_body[g] >= b0 && m->geom_body[g] < b0 + m->sys_nbody[s])
+      return m->geom_material[g];
+  return 0;
+}
+
 /* <articulated_system> with its URDF, base, full state and PD targets */
 static void write_articulated(wBuf *w, const ssModel *m, const ssData *d, int s)
 {
@@ -346,13 +356,8 @@ static void write_articulated(wBuf *w, const ssModel *m, const ssData *d, int s)
   a_path(w, "urdf_path", m->sys_source[s]);
   if (m->sys_resdir[s][0]) a_path(w, "res_dir", m->sys_resdir[s]);
   a_str(w, "base", m->sys_fixed[s] ? "fixed" : "floating");
-  int b0 = m->sys_bodyadr[s], mat = 0;
-  for (int g = 0; g < m->ngeom; g++)
-    if (m->geom_body[g] >= b0 && m->geom_body[g] < b0 + m->sys_nbody[s]) {
-      mat = m->geom_material[g];
-      break;
-    }
-  a_str(w, "material", mat_name(m, mat));
+  int b0 = m->sys_bodyadr[s];
+  a_str(w, "material", mat_name(m, sys_material(m, s)));
   w_s(w, ">\n      <state");
   if (m->sys_fixed[s]) {
     a_vec(w, "pos", m->body_jntpos + 3 * b0, 3);
@@ -382,7 +387,135 @@ static void write_articulated(wBuf *w, const ssModel *m, const ssData *d, int s)
   w_s(w, "    </articulated_system>\n");
 }
 
-static void write_world(wBuf *w, const ssModel *m, const ssData *d)
+/* The objects in the order they are written. */
+enum { OBJ_PLANE, OBJ_SYS, OBJ_HFIELD };
+typedef struct wObject {
+  int kind;  /* OBJ_* */
+  int index; /* plane, system or height map */
+} wObject;
+
+static int object_material(const ssModel *m, const wObject *o)
+{
+  return o->kind == OBJ_PLANE   ? m->plane_material[o->index]
+         : o->kind == OBJ_HFIELD ? m->hfield_material[o->index]
+                                 : sys_material(m, o->index);
+}
+
+/* The numbers the reader gives the materials of the pairs it has not met
+ * yet: a pair's two names in the order they are written (see
+ * write_materials). */
+static void number_pairs(const ssModel *m, int *renum, int *nnum)
+{
+  for (int k = 0; k < m->npair; k++) {
+    int a = m->pair[k].mat1, b = m->pair[k].mat2;
+    if (a >= 0 && a < m->nmaterial && renum[a] < 0) renum[a] = (*nnum)++;
+    if (b >= 0 && b < m->nmaterial && renum[b] < 0) renum[b] = (*nnum)++;
+  }
+}
+
+/* The reader numbers the materials in the order it meets their names, so
+ * the objects are written in an order that names them in the order of the
+ * model's numbers: the reloaded world then has the same numbers (a
+ * checkpoint's fingerprint compares them) and its pairs keep their names'
+ * order, so export -> load -> export gives the same bytes.  Grounds,
+ * systems and height maps each keep their own order (as the reader met
+ * them, so such an order exists for a model read from a file); among the
+ * next objects of the three, the first whose material is already named or
+ * is the next number is taken, grounds before systems before height maps,
+ * which leaves the usual order wherever it already works.  pairs_first:
+ * the <material> element is to be written before <objects> (a scene that
+ * has it there names its pairs' materials first).  renum[k] gets the
+ * number the reader will give material k (-1: named by nothing written);
+ * returns the number of objects. */
+static int object_order(const ssModel *m, const ssData *d, int pairs_first,
+                        wObject *order, int *renum, unsigned char *used)
+{
+  int count[3] = {m->nplane, m->nsys, m->nhfield}, next[3] = {0, 0, 0};
+  int nobj = 0, nused = 1;
+  for (int k = 0; k < m->nmaterial; k++) {
+    renum[k] = -1;
+    used[k] = 0;
+  }
+  if (m->nmaterial > 0) renum[0] = 0; /* "default", numbered first */
+  if (pairs_first) number_pairs(m, renum, &nused);
+  /* the materials the written objects name */
+  for (int kind = 0; kind < 3; kind++)
+    for (int i = 0; i < count[kind]; i++) {
+      if (kind == OBJ_SYS && !d->sys_active[i]) continue;
+      wObject o = {kind, i};
+      int mat = object_material(m, &o);
+      if (mat >= 0 && mat < m->nmaterial) used[mat] = 1;
+    }
+  int expect = 1;
+  for (;;) {
+    while (expect < m->nmaterial && (!used[expect] || renum[expect] >= 0))
+      expect++;
+    int pick = -1, fallback = -1;
+    for (int kind = 0; kind < 3 && pick < 0; kind++) {
+      while (kind == OBJ_SYS && next[kind] < count[kind] &&
+             !d->sys_active[next[kind]])
+        next[kind]++;
+      if (next[kind] >= count[kind]) continue;
+      if (fallback < 0) fallback = kind;
+      wObject o = {kind, next[kind]};
+      int mat = object_material(m, &o);
+      if (mat < 0 || mat >= m->nmaterial || renum[mat] >= 0 ||
+          mat == expect)
+        pick = kind;
+    }
+    /* no order names them in the model's order (a model built in code):
+     * the usual one */
+    if (pick < 0) pick = fallback;
+    if (pick < 0) break;
+    wObject o = {pick, next[pick]++};
+    int mat = object_material(m, &o);
+    if (mat >= 0 && mat < m->nmaterial && renum[mat] < 0) renum[mat] = nused++;
+    order[nobj++] = o;
+  }
+  if (!pairs_first) number_pairs(m, renum, &nused);
+  return nobj;
+}
+
+/* Whether the reloaded world numbers every material written as this one. */
+static int same_numbers(const ssModel *m, const int *renum)
+{
+  for (int k = 0; k < m->nmaterial; k++)
+    if (renum[k] >= 0 && renum[k] != k) return 0;
+  return 1;
+}
+
+/* <material>: the default and the pairs, each pair's names in the order
+ * the reader numbers them (it keeps a pair's lower number first). */
+static void write_materials(wBuf *w, const ssModel *m, const int *renum)
+{
+  w_s(w, "  <material>\n    <default");
+  a_num(w, "friction", m->material_default.friction);
+  a_num(w, "restitution", m->material_default.restitution);
+  a_num(w, "restitution_threshold", m->material_default.restitution_threshold);
+  w_s(w, "/>\n");
+  for (int k = 0; k < m->npair; k++) {
+    const ssMaterialPair *p = &m->pair[k];
+    int a = p->mat1, b = p->mat2;
+    if (a >= 0 && a < m->nmaterial && b >= 0 && b < m->nmaterial &&
+        renum[b] < renum[a]) {
+      int t = a;
+      a = b;
+      b = t;
+    }
+    w_s(w, "    <pair_prop");
+    a_str(w, "name1", mat_name(m, a));
+    a_str(w, "name2", mat_name(m, b));
+    a_num(w, "friction", p->friction);
+    a_num(w, "restitution", p->restitution);
+    a_num(w, "restitution_threshold", p->restitution_threshold);
+    w_s(w, "/>\n");
+  }
+  w_s(w, "  </material>\n");
+}
+
+static void write_world(wBuf *w, const ssModel *m, const ssData *d,
+                        const wObject *order, int nobj, const int *renum,
+                        int pairs_first)
 {
   const ssOption *o = &m->opt;
   w_s(w, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
@@ -414,46 +547,33 @@ static void write_world(wBuf *w, const ssModel *m, const ssData *d)
     w_s(w, "/>\n");
   }
 
+  if (pairs_first) write_materials(w, m, renum);
   w_s(w, "  <objects>\n");
-  for (int p = 0; p < m->nplane; p++) {
-    w_s(w, "    <ground");
-    a_str(w, "name", m->plane_name[p]);
-    a_num(w, "height", m->plane_height[p]);
-    a_str(w, "material", mat_name(m, m->plane_material[p]));
-    w_s(w, "/>\n");
-  }
-  for (int s = 0; s < m->nsys; s++) {
-    if (!d->sys_active[s]) continue;
-    if (m->sys_type[s] == SS_SYS_ARTICULATED) {
-      write_articulated(w, m, d, s);
-      continue;
+  for (int k = 0; k < nobj; k++) {
+    int i = order[k].index;
+    if (order[k].kind == OBJ_PLANE) {
+      w_s(w, "    <ground");
+      a_str(w, "name", m->plane_name[i]);
+      a_num(w, "height", m->plane_height[i]);
+      a_str(w, "material", mat_name(m, m->plane_material[i]));
+      w_s(w, "/>\n");
+    } else if (order[k].kind == OBJ_HFIELD) {
+      write_hfield(w, m, d, i);
+    } else if (m->sys_type[i] == SS_SYS_ARTICULATED) {
+      write_articulated(w, m, d, i);
+    } else {
+      int b = m->sys_bodyadr[i];
+      for (int g = 0; g < m->ngeom; g++)
+        if (m->geom_body[g] == b) {
+          write_body(w, m, d, i, g);
+          break;
+        }
     }
-    int b = m->sys_bodyadr[s];
-    for (int g = 0; g < m->ngeom; g++)
-      if (m->geom_body[g] == b) {
-        write_body(w, m, d, s, g);
-        break;
-      }
   }
-  for (int h = 0; h < m->nhfield; h++) write_hfield(w, m, d, h);
   w_s(w, "  </objects>\n");
 
-  w_s(w, "  <material>\n    <default");
-  a_num(w, "friction", m->material_default.friction);
-  a_num(w, "restitution", m->material_default.restitution);
-  a_num(w, "restitution_threshold", m->material_default.restitution_threshold);
-  w_s(w, "/>\n");
-  for (int k = 0; k < m->npair; k++) {
-    const ssMaterialPair *p = &m->pair[k];
-    w_s(w, "    <pair_prop");
-    a_str(w, "name1", mat_name(m, p->mat1));
-    a_str(w, "name2", mat_name(m, p->mat2));
-    a_num(w, "friction", p->friction);
-    a_num(w, "restitution", p->restitution);
-    a_num(w, "restitution_threshold", p->restitution_threshold);
-    w_s(w, "/>\n");
-  }
-  w_s(w, "  </material>\n</raisim>\n");
+  if (!pairs_first) write_materials(w, m, renum);
+  w_s(w, "</raisim>\n");
 }
 
 /* What the format cannot (yet) express. */
@@ -519,27 +639,34 @@ static ssStatus check_exportable(const ssModel *m, const ssData *d,
   return SS_OK;
 }
 
-ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
-                         ssError *err)
+/* Writes the world into f (open), which the caller commits or aborts. */
+static ssStatus export_to(const ssModel *m, const ssData *d, ssAtomicFile *f,
+                          ssError *err)
 {
-  if (!m || !d || !path)
-    return ss_error_set(err, SS_ERR_VALUE, path ? path : "", 0,
-                        "ss_scene_export: NULL argument");
-  if (d->model && d->model != m)
-    return ss_error_set(err, SS_ERR_VALUE, path, 0,
-                        "ss_scene_export: the data belongs to another model");
-  ssStatus st = check_exportable(m, d, path, err);
-  if (st != SS_OK) return st;
-
+  const char *path = f->path;
   wBuf *w = malloc(sizeof *w);
-  if (!w) return ss_error_set(err, SS_ERR_NOMEM, path, 0, "out of memory");
-  ssAtomicFile f;
-  st = ss_atomic_open(&f, path, err);
-  if (st != SS_OK) {
+  size_t nall = (size_t)m->nplane + (size_t)m->nsys + (size_t)m->nhfield;
+  wObject *order = malloc((nall + 1) * sizeof *order);
+  int *renum = malloc(((size_t)m->nmaterial + 1) * sizeof *renum);
+  unsigned char *used = malloc((size_t)m->nmaterial + 1);
+  if (!w || !order || !renum || !used) {
     free(w);
-    return st;
+    free(order);
+    free(renum);
+    free(used);
+    return ss_error_set(err, SS_ERR_NOMEM, path, 0, "out of memory");
   }
-  w->f = &f;
+  /* <material> after <objects>, as usual, unless only before them does
+   * the reloaded world number the materials as this one does */
+  int pairs_first = 0;
+  int nobj = object_order(m, d, 0, order, renum, used);
+  if (!same_numbers(m, renum)) {
+    nobj = object_order(m, d, 1, order, renum, used);
+    pairs_first = same_numbers(m, renum);
+    if (!pairs_first) nobj = object_order(m, d, 0, order, renum, used);
+  }
+  free(used);
+  w->f = f;
   w->n = 0;
   /* the folder exists (the temporary file is in it), so this is its real
    * path; if even so it cannot be had, paths are written absolute */
@@ -551,15 +678,57 @@ ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
   int have_loc = ss_scene_c_locale_push(&loc) == 0;
   struct lconv *lc = have_loc ? NULL : localeconv();
   if (!have_loc && (!lc || !lc->decimal_point || strcmp(lc->decimal_point, "."))) {
-    ss_atomic_abort(&f);
     free(w);
+    free(order);
+    free(renum);
     return ss_error_set(err, SS_ERR_STATE, path, 0,
                         "cannot switch to the C locale to write numbers");
   }
-  write_world(w, m, d);
+  write_world(w, m, d, order, nobj, renum, pairs_first);
   w_flush(w);
   if (have_loc) ss_scene_c_locale_pop(&loc);
   free(w);
+  free(order);
+  free(renum);
+  return SS_OK;
+}
+
+ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
+                         ssError *err)
+{
+  if (!m || !d || !path)
+    return ss_error_set(err, SS_ERR_VALUE, path ? path : "", 0,
+                        "ss_scene_export: NULL argument");
+  if (d->model && d->model != m)
+    return ss_error_set(err, SS_ERR_VALUE, path, 0,
+                        "ss_scene_export: the data belongs to another model");
+  ssStatus st = check_exportable(m, d, path, err);
+  if (st != SS_OK) return st;
+  ssAtomicFile f;
+  st = ss_atomic_open(&f, path, err);
+  if (st != SS_OK) return st;
+  st = export_to(m, d, &f, err);
+  if (st != SS_OK) {
+    ss_atomic_abort(&f);
+    return st;
+  }
   /* a failed write is reported by the commit, with its reason */
   return ss_atomic_commit(&f, err);
+}
+
+ssStatus ss_scene_export_to(const ssModel *m, const ssData *d, ssAtomicFile *f,
+                            ssError *err)
+{
+  if (!f || !f->fp)
+    return ss_error_set(err, SS_ERR_STATE, f ? f->path : "", 0,
+                        "ss_scene_export_to: the output is not open");
+  if (!m || !d)
+    return ss_error_set(err, SS_ERR_VALUE, f->path, 0,
+                        "ss_scene_export_to: NULL argument");
+  if (d->model && d->model != m)
+    return ss_error_set(err, SS_ERR_VALUE, f->path, 0,
+                        "ss_scene_export_to: the data belongs to another model");
+  ssStatus st = check_exportable(m, d, f->path, err);
+  if (st != SS_OK) return st;
+  return export_to(m, d, f, err);
 }

@@ -102,8 +102,9 @@ static void usage(FILE *out)
 "  --camera-pos X,Y,Z   camera position for --render (with --camera-look-at)\n"
 "  --camera-look-at X,Y,Z\n"
 "                       point the camera looks at\n"
-"  --camera-fov DEG     vertical field of view (default 45)\n"
+"  --camera-fov DEG     vertical field of view, 0 < DEG < 180 (default 45)\n"
 "  --camera-follow NAME keep the camera's offset to body or system NAME\n"
+"                       (needs --camera-pos or the scene's <camera>)\n"
 "  --color MODE         bed colour: sinkage (default), plastic or soil\n"
 "  --checkpoint FILE@STEP\n"
 "                       write a binary checkpoint after step STEP (repeatable)\n"
@@ -248,12 +249,16 @@ static int parse_fraction(const char *s, double lo, double hi, double *out)
   return 1;
 }
 
-/* "x,y,z" or "x y z": three finite numbers */
+/* "x,y,z" or "x y z": three finite numbers, one comma or spaces between
+ * two of them (so "1,,2,3" is not read as 1,2,3) */
 static int parse_vec3(const char *s, double v[3])
 {
   const char *p = s;
   for (int k = 0; k < 3; k++) {
-    while (*p == ' ' || (k && *p == ',')) p++;
+    while (*p == ' ') p++;
+    if (k && *p == ',') p++;
+    while (*p == ' ') p++;
+    if (!*p || *p == ',') return 0;
     char *end;
     errno = 0;
     v[k] = strtod(p, &end);
@@ -508,7 +513,7 @@ static int parse_args(int argc, char **argv, Options *o)
     case OPT_STEPS:
       if (!parse_long(value, 0, LONG_MAX - 1, &o->steps))
         return usage_error("invalid --steps value '%s': expected an integer "
-                           ">= 0", value);
+                           "from 0 to %ld", value, LONG_MAX - 1);
       steps_given = 1;
       break;
     case OPT_EXPORT: o->export_path = value; break;
@@ -596,6 +601,8 @@ static int parse_args(int argc, char **argv, Options *o)
     return usage_error("--restore needs the scene file as well: a checkpoint "
                        "holds the state of a world, not the world");
   if (!o->scene) return usage_error("no scene file given");
+  /* decidable from the command line, as --restore '' is */
+  if (!*o->scene) return usage_error("the scene file name is empty");
   if (o->render_every_given && !o->render_dir)
     return usage_error("--render-every needs --render DIR");
   if (o->camera_pos_given != o->camera_look_given)
@@ -645,6 +652,18 @@ static ssStatus open_output(ssAtomicFile *f, const char *path, const char *flag,
   ss_error_clear(&e);
   if (ss_atomic_open(f, path, &e) != SS_OK)
     return ss_error_set(err, SS_ERR_IO, path, 0, "%s: %s", flag, e.message);
+  return SS_OK;
+}
+
+/* An output written in full but not committed: its buffered bytes go out
+ * now, so that a write error (a full disk) is found before any output is
+ * committed.  The commit reports it, with its reason. */
+static ssStatus flush_output(ssAtomicFile *f, ssError *err)
+{
+  FILE *fp = (FILE *)f->fp;
+  errno = 0;
+  if (!f->error && fp && fflush(fp) != 0) f->error = errno ? errno : EIO;
+  if (f->error || (fp && ferror(fp))) return ss_atomic_commit(f, err);
   return SS_OK;
 }
 
@@ -999,8 +1018,8 @@ static int run(const Options *o)
   ssModel *m = NULL;
   ssData *d = NULL;
   ssRenderer *r = NULL;
-  ssAtomicFile csv;
-  int csv_open = 0, status = EXIT_RUN_FAILED;
+  ssAtomicFile csv, rut, exp;
+  int csv_open = 0, rut_open = 0, exp_open = 0, status = EXIT_RUN_FAILED;
   long nframes = 0, unconverged = 0, done = 0;
   int nckpt = 0;
   ssCheckpointInfo restored;
@@ -1009,6 +1028,8 @@ static int run(const Options *o)
   Progress prog;
   memset(&prog, 0, sizeof prog);
   memset(&csv, 0, sizeof csv);
+  memset(&rut, 0, sizeof rut);
+  memset(&exp, 0, sizeof exp);
   ss_error_clear(&err);
 
   /* load and validate everything before the first step */
@@ -1025,8 +1046,11 @@ static int run(const Options *o)
    * --checkpoint D/k@5); made before anything is written, taken away
    * again on any failure before the first frame (unmake_dirs) */
   if (o->render_dir) {
+    /* the first frame's name, which every run writes: a made-up probe
+     * name refused a folder that held a folder of that name, and named a
+     * file the run never writes */
     char probe[2048];
-    snprintf(probe, sizeof probe, "%s/frame_probe.png", o->render_dir);
+    snprintf(probe, sizeof probe, "%s/frame_%06d.png", o->render_dir, 0);
     if (make_dirs(o->render_dir, &err) != SS_OK ||
         check_output(probe, "--render", &err) != SS_OK)
       goto fail;
@@ -1076,6 +1100,9 @@ static int run(const Options *o)
                    "--camera-follow needs a camera: give --camera-pos and "
                    "--camera-look-at, or a <camera> in the scene");
       goto fail;
+    } else {
+      /* the automatic overview, seen through this field of view */
+      ropt.camera_fov_deg = o->camera_fov;
     }
   }
   /* a name the scene does not hold is the option's error, said with the
@@ -1142,10 +1169,20 @@ static int run(const Options *o)
   wall = now_seconds() - t0;
   if (g_signal) {
     progress_clear(&prog);
-    if (nckpt)
+    /* what is written as the run goes stays: say what that is */
+    if (nckpt && nframes)
+      fprintf(stderr, "soilsim: interrupted after step %ld; only the %d "
+              "checkpoint%s of earlier steps and the %ld frame%s drawn so far "
+              "written\n", done, nckpt, nckpt == 1 ? "" : "s", nframes,
+              nframes == 1 ? "" : "s");
+    else if (nckpt)
       fprintf(stderr, "soilsim: interrupted after step %ld; only the %d "
               "checkpoint%s of earlier steps written\n", done, nckpt,
               nckpt == 1 ? "" : "s");
+    else if (nframes)
+      fprintf(stderr, "soilsim: interrupted after step %ld; only the %ld "
+              "frame%s drawn so far written\n", done, nframes,
+              nframes == 1 ? "" : "s");
     else
       fprintf(stderr, "soilsim: interrupted after step %ld; no output files "
               "written\n", done);
@@ -1154,13 +1191,44 @@ static int run(const Options *o)
   }
   progress_clear(&prog);
 
-  /* outputs of the final state; the CSV appears last, once all else worked */
-  if (o->rut_map &&
-      ss_render_rut_map(m, d, -1, 1, ropt.width, ropt.height, o->rut_map,
-                        &err) != SS_OK)
+  /* outputs of the final state: all of them written and flushed before
+   * any is committed, so that a failure leaves none of them (the rut map
+   * stayed when the export then failed); the CSV is committed last */
+  if (o->rut_map) {
+    if (open_output(&rut, o->rut_map, "--rut-map", &err) != SS_OK) goto fail;
+    rut_open = 1;
+    if (ss_render_rut_map_to(m, d, -1, 1, ropt.width, ropt.height, &rut,
+                             &err) != SS_OK)
+      goto fail;
+    /* a stream (a FIFO's reader waits for its end) is finished at once:
+     * it has nothing to roll back */
+    if (rut.direct) {
+      rut_open = 0;
+      if (ss_atomic_commit(&rut, &err) != SS_OK) goto fail;
+    }
+  }
+  if (o->export_path) {
+    if (open_output(&exp, o->export_path, "--export", &err) != SS_OK)
+      goto fail;
+    exp_open = 1;
+    if (ss_scene_export_to(m, d, &exp, &err) != SS_OK) goto fail;
+    if (exp.direct) {
+      exp_open = 0;
+      if (ss_atomic_commit(&exp, &err) != SS_OK) goto fail;
+    }
+  }
+  if ((rut_open && flush_output(&rut, &err) != SS_OK) ||
+      (exp_open && flush_output(&exp, &err) != SS_OK) ||
+      (csv_open && flush_output(&csv, &err) != SS_OK))
     goto fail;
-  if (o->export_path && ss_scene_export(m, d, o->export_path, &err) != SS_OK)
-    goto fail;
+  if (rut_open) {
+    rut_open = 0;
+    if (ss_atomic_commit(&rut, &err) != SS_OK) goto fail;
+  }
+  if (exp_open) {
+    exp_open = 0;
+    if (ss_atomic_commit(&exp, &err) != SS_OK) goto fail;
+  }
   if (csv_open) {
     csv_open = 0;
     if (ss_atomic_commit(&csv, &err) != SS_OK) goto fail;
@@ -1178,6 +1246,8 @@ fail:
   unmake_dirs();
 cleanup:
   if (csv_open) ss_atomic_abort(&csv);
+  if (rut_open) ss_atomic_abort(&rut);
+  if (exp_open) ss_atomic_abort(&exp);
   ss_render_free(r);
   ss_data_free(d);
   ss_model_free(m);

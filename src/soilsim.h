@@ -318,7 +318,8 @@ typedef struct ssModel {
   int camera_given;
   double camera_pos[3];
   double camera_look_at[3];
-  double camera_fov_deg;
+  double camera_fov_deg;    /* vertical field of view, in (0, 180) degrees:
+                               the camera above's, or the automatic one's */
   char camera_follow[128];
 
   /* where the model came from (for messages and [THIS_DIR]) */
@@ -611,11 +612,17 @@ ssStatus ss_scene_load(const char *path, ssModel **mout, ssData **dout,
 ssStatus ss_scene_load_buffer(const char *buf, size_t len,
                               const char *base_path, ssModel **mout,
                               ssData **dout, ssError *err);
+struct ssAtomicFile; /* an output file, below */
 /* Write the whole world (model + current state + soil arrays) as XML,
  * atomically (temporary file, then rename; a stream such as /dev/stdout
  * is written in place, see ss_atomic_open). */
 ssStatus ss_scene_export(const ssModel *m, const ssData *d, const char *path,
                          ssError *err);
+/* The same into an output opened with ss_atomic_open, left open: the
+ * caller commits it, or aborts it on failure.  Paths in the file are
+ * written relative to the folder of the path it was opened with. */
+ssStatus ss_scene_export_to(const ssModel *m, const ssData *d,
+                            struct ssAtomicFile *f, ssError *err);
 
 /* ---------------------------------------------------------------------- */
 /* off-screen rendering (DESIGN 6)                                         */
@@ -634,7 +641,8 @@ typedef struct ssRenderOptions {
                                <camera>, else an automatic overview */
   double camera_pos[3];
   double camera_look_at[3];
-  double camera_fov_deg;
+  double camera_fov_deg;    /* vertical field of view, in (0, 180) degrees:
+                               the camera above's, or the automatic one's */
   char camera_follow[128];  /* system name the camera follows ("" = none) */
 } ssRenderOptions;
 
@@ -667,6 +675,12 @@ ssStatus ss_render_frame(ssRenderer *r, const ssModel *m, const ssData *d,
 ssStatus ss_render_rut_map(const ssModel *m, const ssData *d, int hfield,
                            int plastic, int width, int height,
                            const char *png_path, ssError *err);
+/* The same into an output opened with ss_atomic_open (see below), left
+ * open: the caller commits it, or aborts it on failure, so that a program
+ * writing several outputs can write them all before it commits any. */
+ssStatus ss_render_rut_map_to(const ssModel *m, const ssData *d, int hfield,
+                              int plastic, int width, int height,
+                              struct ssAtomicFile *af, ssError *err);
 
 /* ---------------------------------------------------------------------- */
 /* checkpoints (DESIGN 5)                                                  */

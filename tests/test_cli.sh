@@ -39,6 +39,12 @@ check "--version prints 'soilsim 0.1.0' and exits 0" \
   'rc_is 0 && [ "$(cat "$tmp/out")" = "soilsim 0.1.0" ]'
 run
 check "no arguments: usage error (exit 2)" 'usage_error && err_has "no scene"'
+run ""
+check "an empty scene name: usage error (exit 2), as --restore '' is" \
+  'usage_error && err_has "scene file name is empty"'
+run "" --steps 3 --export "$tmp/empty.xml"
+check "an empty scene name with options: exit 2, nothing written" \
+  'usage_error && no_file "$tmp/empty.xml"'
 run "$PLATE" --bogus
 check "unknown option: exit 2 naming it" 'usage_error && err_has "--bogus"'
 run "$PLATE" --bogus=3
@@ -56,10 +62,24 @@ for v in abc -1 10x 1e3 "" 99999999999999999999999; do
   run "$PLATE" --steps "$v"
   check "--steps '$v' is rejected (exit 2)" 'usage_error'
 done
+# the largest step count is one less than the largest integer (the loop
+# counts to it): the message gives the range, not ">= 0" for a number >= 0
+run "$PLATE" --steps 9223372036854775807
+check "--steps 9223372036854775807: exit 2 saying the range" \
+  'usage_error && err_has "from 0 to 9223372036854775806"'
 for v in 0x10 640 x480 640x 640x480x2 -640x480 20000x100 axb; do
   run "$PLATE" --size "$v" --rut-map "$tmp/r.png"
   check "--size '$v' is rejected (exit 2)" 'usage_error && err_has "--size"'
 done
+# three numbers, one comma (or spaces) between two ("1,,2,3" was read as 1,2,3)
+i=0
+for v in "1,,2,3" "1,2" ",1,2,3" "1,2,3," "1, ,2,3" "1,2,x"; do
+  i=$((i + 1))
+  run "$PLATE" --steps 0 --render "$tmp/camv$i" --camera-pos "$v" --camera-look-at 0,0,0
+  check "--camera-pos '$v' is rejected (exit 2)" 'usage_error && err_has "--camera-pos" && no_file "$tmp/camv$i"'
+done
+run "$PLATE" --steps 0 --render "$tmp/camv" --size 32x32 --camera-pos " 1 , 2 3" --camera-look-at=-1,-2,-3 --quiet
+check "--camera-pos ' 1 , 2 3' and --camera-look-at=-1,-2,-3 are accepted" 'rc_is 0'
 run "$PLATE" --steps 5 --render "$tmp/cam0" --camera-pos 0,0,1 --camera-look-at 0,0,1
 check "--camera-pos equal to --camera-look-at: exit 2 (a camera needs a direction)" \
   'usage_error && err_has "distinct points" && no_file "$tmp/cam0"'
@@ -239,6 +259,37 @@ check "--export naming a directory: exit 1 before stepping" \
 run "$PLATE" --steps 2000000000 --render "$tmp/plainfile/frames"
 check "--render folder that cannot be created: exit 1 before stepping" \
   'rc_is 1 && err_has "plainfile" && no_tmp "$tmp"'
+
+# the --render folder is tried with the name of the first frame, which is
+# written: a folder named like a made-up probe file does not stop the run
+mkdir -p "$tmp/probe/frame_probe.png"
+run "$PLATE" --steps 2 --render "$tmp/probe" --size 16x16 --quiet
+check "--render folder holding a folder frame_probe.png: frames written" \
+  'rc_is 0 && [ -s "$tmp/probe/frame_000002.png" ] && no_tmp "$tmp/probe"'
+mkdir -p "$tmp/probe2/frame_000000.png"
+run "$PLATE" --steps 2000000000 --render "$tmp/probe2" --size 16x16
+check "--render folder whose frame_000000.png is a folder: exit 1 before stepping, naming it" \
+  'rc_is 1 && err_has "probe2/frame_000000.png" && err_has "directory"'
+
+# The final outputs appear together or not at all: an export that fails
+# at the end (a copy of /dev/full: every write fails) leaves no rut map
+# and no CSV (the rut map was committed before the export was written)
+if [ "$(id -u)" -eq 0 ]; then
+  mkdir -p "$tmp/full"
+  mknod "$tmp/full/e.xml" c 1 7
+  run "$PLATE" --steps 3 --rut-map "$tmp/full/r.png" --csv "$tmp/full/c.csv" \
+    --export "$tmp/full/e.xml"
+  check "an export that fails at the end: exit 1, no rut map, no CSV, no temporary file" \
+    'rc_is 1 && err_has "e.xml" && no_file "$tmp/full/r.png" && no_file "$tmp/full/c.csv" &&
+     no_tmp "$tmp/full"'
+  echo old >"$tmp/full/r2.png"
+  run "$PLATE" --steps 3 --rut-map "$tmp/full/r2.png" --export "$tmp/full/e.xml"
+  check "an export that fails at the end: an existing rut map stays as it was" \
+    'rc_is 1 && [ "$(cat "$tmp/full/r2.png")" = old ] && no_tmp "$tmp/full"'
+else
+  skip "an export that fails at the end (mknod needs root)"
+  skip "an export that fails at the end: an existing rut map (mknod needs root)"
+fi
 
 # A failed run never touches an existing output file.
 cat >"$tmp/broken.xml" <<'EOF'
@@ -566,6 +617,41 @@ rc1=$rc
 run "$top_srcdir/scenes/plate_arm.xml" --steps 15 --export "$tmp/armx2.xml" --quiet
 check "a checkpoint restores into an export of its world (plate_arm): identical to 15 steps straight" \
   '[ "$rc1" -eq 0 ] && rc_is 0 && cmp -s "$tmp/armx1.xml" "$tmp/armx2.xml"'
+# every scene: export -> reload -> export gives the same bytes, and a
+# checkpoint restores into the export.  The reader numbers the contact
+# materials as it meets their names; buggy_rigid.xml names the buggy's
+# rubber before the ground's concrete, which an export listing grounds
+# first turned round (its pair_prop's names swapped, its checkpoints
+# refused as "a different world")
+for s in "$top_srcdir"/scenes/*.xml; do
+  b=$(basename "$s" .xml)
+  run "$s" --steps 20 --export "$tmp/rt_$b.xml" --checkpoint "$tmp/rt_$b.ckpt@20" --quiet
+  rc1=$rc
+  run "$tmp/rt_$b.xml" --steps 0 --export "$tmp/rt2_$b.xml" --quiet
+  rc2=$rc
+  run "$tmp/rt_$b.xml" --steps 1 --restore "$tmp/rt_$b.ckpt" --quiet
+  check "$b.xml: export, reload, export again: identical; its checkpoint restores into the export" \
+    '[ "$rc1" -eq 0 ] && [ "$rc2" -eq 0 ] && rc_is 0 && cmp -s "$tmp/rt_$b.xml" "$tmp/rt2_$b.xml"'
+done
+# a <material> before <objects> (as RaiSim's examples have it) names its
+# pairs' materials first: with one naming materials no object has, the
+# export writes its <material> first too; with the bed's material before
+# the plate's, the bed is written first
+mat_first='<material><default friction="0.8"/><pair_prop name1="steel" name2="wood" friction="0.5"/></material><objects>'
+sed -e "s|<objects>|$mat_first|" -e 's|<box name="plate"|& material="rubber"|' \
+  "$PLATE" >"$tmp/mat1.xml"
+mat_pair='<material><default friction="0.8"/><pair_prop name1="wood" name2="rubber" friction="0.5"/></material><objects>'
+sed -e "s|<objects>|$mat_pair|" -e 's|<box name="plate"|& material="rubber"|' \
+  -e 's|<heightmap name="soil"|& material="wood"|' "$PLATE" >"$tmp/mat2.xml"
+for b in mat1 mat2; do
+  run "$tmp/$b.xml" --steps 5 --export "$tmp/rt_$b.xml" --checkpoint "$tmp/rt_$b.ckpt@5" --quiet
+  rc1=$rc
+  run "$tmp/rt_$b.xml" --steps 0 --export "$tmp/rt2_$b.xml" --quiet
+  rc2=$rc
+  run "$tmp/rt_$b.xml" --steps 1 --restore "$tmp/rt_$b.ckpt" --quiet
+  check "<material> before <objects> ($b): export, reload, export again: identical; its checkpoint restores into the export" \
+    '[ "$rc1" -eq 0 ] && [ "$rc2" -eq 0 ] && rc_is 0 && cmp -s "$tmp/rt_$b.xml" "$tmp/rt2_$b.xml"'
+done
 run "$PLATE" --steps 0 --checkpoint "$tmp/zero.ckpt@0" --export "$tmp/zero0.xml" --quiet
 run "$PLATE" --steps 0 --restore "$tmp/zero.ckpt" --export "$tmp/zero1.xml" --quiet
 check "--checkpoint FILE@0 holds the initial state; restoring it changes nothing" \
@@ -615,6 +701,18 @@ run "$PLATE" --steps 0 --render "$tmp/camB" --size 160x90 --camera-pos 0,0,3 \
   --camera-look-at 0,0.001,0 --camera-fov 30 --color soil --quiet
 check "--camera-pos/--camera-look-at/--camera-fov/--color render a different view" \
   'rc_is 0 && [ -s "$tmp/camB/frame_000000.png" ] && ! cmp -s "$tmp/camA/frame_000000.png" "$tmp/camB/frame_000000.png"'
+# --camera-fov alone: the automatic overview (plate.xml has no <camera>)
+# and the scene's <camera> (buggy.xml) through another field of view; the
+# whole documented range (0, 180) counts (the automatic view ignored the
+# option, and a field of view under 1 or over 179 degrees became 45)
+run "$PLATE" --steps 0 --render "$tmp/camF" --size 160x90 --camera-fov 20 --quiet
+check "--camera-fov 20 changes the automatic view" \
+  'rc_is 0 && [ -s "$tmp/camF/frame_000000.png" ] && ! cmp -s "$tmp/camA/frame_000000.png" "$tmp/camF/frame_000000.png"'
+run "$top_srcdir/scenes/buggy.xml" --steps 0 --render "$tmp/camG" --size 160x90 --quiet
+run "$top_srcdir/scenes/buggy.xml" --steps 0 --render "$tmp/camH" --size 160x90 \
+  --camera-fov 0.5 --quiet
+check "--camera-fov 0.5 narrows the scene's camera (not taken as 45)" \
+  'rc_is 0 && [ -s "$tmp/camH/frame_000000.png" ] && ! cmp -s "$tmp/camG/frame_000000.png" "$tmp/camH/frame_000000.png"'
 run "$PLATE" --steps 0 --render "$tmp/camC" --camera-pos 0,0,3
 check "--camera-pos without --camera-look-at: exit 2" 'usage_error'
 run "$PLATE" --steps 0 --camera-fov 30
@@ -623,8 +721,35 @@ run "$PLATE" --steps 5 --render "$tmp/camD" --camera-pos 0,0,3 --camera-look-at 
   --camera-follow nobody
 check "--camera-follow of an unknown body: exit 1 before stepping, naming the option and the scene" \
   'rc_is 1 && [ ! -e "$tmp/camD/frame_000005.png" ] && err_has "plate.xml: error: --camera-follow" && err_has "nobody"'
+run "$PLATE" --steps 5 --render "$tmp/camI" --camera-follow plate
+check "--camera-follow without --camera-pos or a scene <camera>: exit 1 before stepping, saying what it needs" \
+  'rc_is 1 && err_has "--camera-follow needs a camera" && no_file "$tmp/camI"'
+run --help
+check "--help gives --camera-fov's range and what --camera-follow needs" \
+  'rc_is 0 && out_has "0 < DEG < 180" && out_has "needs --camera-pos or the scene'"'"'s <camera>"'
 run "$PLATE" --steps 0 --render "$tmp/camE" --color rainbow
 check "--color with an unknown mode: exit 2" 'usage_error && err_has "rainbow"'
+
+# SIGINT in the middle of a run: exit by the signal, no final outputs, and
+# a message that counts what stays, the frames drawn so far (it said "no
+# output files written" with the frames there)
+sig=$tmp/sig
+mkdir -p "$sig"
+last_cmd="soilsim $PLATE --steps 100000000 --render $sig/fr --render-every 1 --size 16x16 --export $sig/e.xml (SIGINT)"
+CI='' "$SOILSIM" "$PLATE" --steps 100000000 --render "$sig/fr" --render-every 1 \
+  --size 16x16 --export "$sig/e.xml" --quiet >"$tmp/out" 2>"$tmp/err" &
+pid=$!
+k=0
+while [ ! -e "$sig/fr/frame_000002.png" ] && [ $k -lt 600 ]; do
+  sleep 0.1
+  k=$((k + 1))
+done
+kill -INT "$pid" 2>"$tmp/kill_err"
+wait "$pid"
+rc=$?
+check "SIGINT: exit by the signal, no export, the message counts the frames that stay" \
+  'rc_is 130 && no_file "$sig/e.xml" && no_tmp "$sig" && err_has "interrupted after step" &&
+   err_has "frames drawn so far written" && ! err_has "no output files"'
 
 echo "1..$n"
 [ "$nfail" -eq 0 ]

@@ -292,6 +292,17 @@ static void test_bad_sizes(void)
   ok(r == NULL && err.code == SS_ERR_NOTFOUND,
      "render_new with an unknown follow target fails: %s", err.message);
   ss_render_free(r);
+  /* a field of view outside (0, 180) degrees is refused, not drawn as 45 */
+  double fovs[] = {0, -10, 180, 200, NAN};
+  for (int k = 0; k < 5; k++) {
+    o = ss_render_options_default();
+    o.camera_fov_deg = fovs[k];
+    memset(&err, 0, sizeof err);
+    r = ss_render_new(w.m, &o, &err);
+    ok(r == NULL && err.code == SS_ERR_VALUE && strstr(err.message, "field of view"),
+       "render_new with a field of view of %g degrees fails: %s", fovs[k], err.message);
+    ss_render_free(r);
+  }
   free_world(&w);
 }
 
@@ -1085,6 +1096,45 @@ static void test_plate_scene_rut_map(void)
   ss_model_free(m);
 }
 
+/* A narrow rut map: the title stops short of the colour bar's labels (a
+ * long one ran over the top label "10 mm" at 320 x 180), shortened as
+ * needed, and still says what the map shows. */
+static void test_rut_map_title(void)
+{
+  world w;
+  if (!ok(make_world(&w, 1, 0.5), "world for a narrow rut map")) return;
+  int W = 320, H = 180;
+  ssError err;
+  const char *path = out_path("ruts_narrow.png");
+  int w2 = 0, h2 = 0;
+  unsigned char *a = NULL;
+  ssRutMapLayout L;
+  if (!ok(ss_render_rut_map(w.m, w.d, -1, 1, W, H, path, &err) == SS_OK &&
+              ss_png_read_rgba(path, &w2, &h2, &a, &err) == SS_OK && w2 == W &&
+              h2 == H && ss_rut_map_layout(W, H, 2.0, 2.0, &L) == 0,
+          "narrow rut map written and decoded")) {
+    free(a);
+    free_world(&w);
+    return;
+  }
+  /* the rows above the top label's glyphs, right of where the labels
+   * begin: only paper there */
+  int label_x = L.bar_x + L.bar_w + 7 - L.font_px / 2, ink = 0, title = 0;
+  for (int row = 0; row < L.bar_y - L.font_px; row++)
+    for (int col = 0; col < W; col++) {
+      const unsigned char *p = pix(a, W, col, row);
+      int paper = p[0] == SS_PAPER_R && p[1] == SS_PAPER_G && p[2] == SS_PAPER_B;
+      if (!paper && col >= label_x) ink++;
+      if (!paper && col < label_x) title++;
+    }
+  ok(title > 0 && ink == 0,
+     "narrow rut map: the title (%d pixels) ends before the colour bar's labels "
+     "(%d pixels beyond)", title, ink);
+  free(a);
+  unlink(path);
+  free_world(&w);
+}
+
 static void test_rut_map(void)
 {
   world w;
@@ -1325,6 +1375,7 @@ int main(void)
   test_buggy_visuals();
   test_gl_backends();
   test_rut_map();
+  test_rut_map_title();
   test_plate_scene_rut_map();
   test_timing();
   if (!(keep && *keep)) {
