@@ -1,6 +1,7 @@
 /* articulated.c -- reduced-coordinate articulated systems (see
  * articulated.h for the formulation). */
 #include "articulated.h"
+#include "dynamics.h"
 #include "mesh.h"
 #include "model_build.h"
 #include "solver.h"
@@ -1159,7 +1160,7 @@ ssStatus ss_art_free_velocity(const ssModel *m, ssData *d, int s, ssError *err)
     /* external loads at the centre of mass */
     for (int k = 0; k < m->nxforce; k++) {
       if (m->xforce_body[k] != b) continue;
-      if (d->time < m->xforce_time[2 * k] || d->time >= m->xforce_time[2 * k + 1]) continue;
+      if (!ss_dyn_xforce_active(m, d, k)) continue;
       const double *F = m->xforce_force + 3 * k, *Tq = m->xforce_torque + 3 * k;
       double cxf[3];
       ss_v3_cross(cxf, cr, F);

@@ -50,8 +50,7 @@ ssStatus ss_dyn_free_velocity(const ssModel *m, ssData *d, ssError *err)
     ss_v3_set(tau, 0, 0, 0);
     for (int k = 0; k < m->nxforce; k++) {
       if (m->xforce_body[k] != b) continue;
-      if (d->time < m->xforce_time[2 * k] || d->time >= m->xforce_time[2 * k + 1])
-        continue;
+      if (!ss_dyn_xforce_active(m, d, k)) continue;
       ss_v3_add(f, f, m->xforce_force + 3 * k);
       ss_v3_add(tau, tau, m->xforce_torque + 3 * k);
     }

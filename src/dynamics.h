@@ -10,6 +10,17 @@
  * the end of the last step, or the loop-closure projection's last pass)
  * is not formed again; the same bits as ss_forward. */
 void ss_forward_step(const ssModel *m, ssData *d);
+/* 1 when external load k acts over the step that starts now: the step
+ * [t, t + dt] counts when its midpoint t + dt/2 lies in [start, end).
+ * The clock is a running sum of dt, off a multiple of dt by round-off
+ * (after 1000 steps of 1 ms, 0.99999999999990 s), so testing t itself
+ * against a start or end on the step grid took a step too many or too
+ * few by chance: the midpoint lies dt/2 from either side of it. */
+static inline int ss_dyn_xforce_active(const ssModel *m, const ssData *d, int k)
+{
+  double mid = d->time + 0.5 * m->opt.timestep;
+  return mid >= m->xforce_time[2 * k] && mid < m->xforce_time[2 * k + 1];
+}
 /* qvel <- qvel + dt M^-1 (gravity + external forces - gyroscopic terms),
  * for articulated systems with their force elements and loop closures. */
 ssStatus ss_dyn_free_velocity(const ssModel *m, ssData *d, ssError *err);

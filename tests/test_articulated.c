@@ -425,6 +425,56 @@ static void test_free_both_ways(void)
   ss_urdf_free(u);
 }
 
+/* an external load over [start, end) on the step grid gives the impulse
+ * F (end - start) exactly, on a free body and on an articulated link:
+ * the clock is a running sum of dt (after 100 steps of 10 ms it reads
+ * 0.99999999999999989 s), and testing it against the window's ends took
+ * a step too few or too many (0.19 N s for 0.2 at 10 ms, 1.001 N s for
+ * 1 at 1 ms) */
+static void test_xforce_window(void)
+{
+  static const double win[][3] = {{0.01, 0.1, 0.3}, {0.001, 1, 2}, {0.002, 0.5, 1.7}};
+  double F[3] = {1, 0, 0}, T[3] = {0, 0, 1};
+  for (int c = 0; c < 3; c++) {
+    double dt = win[c][0], t0 = win[c][1], t1 = win[c][2];
+    int n = (int)lround((t1 + 0.5) / dt);
+    ssError e;
+    ssModel *m = ss_model_new();
+    m->opt.timestep = dt;
+    ss_v3_set(m->opt.gravity, 0, 0, 0);
+    ssBodyDef bd = ss_body_def_default();
+    bd.name = "box";
+    bd.size[0] = bd.size[1] = 0.2;
+    bd.size[2] = 0.1;
+    bd.mass = 1;
+    ss_model_add_body(m, &bd, &e);
+    ss_model_add_xforce(m, 0, F, T, t0, t1, &e);
+    ssData *d = ss_data_new(m);
+
+    ssUrdf *u = urdf_new();
+    int l = add_link(u, "box", 1, NULL, 0.1, 0.1, 0.1);
+    add_box(u, l, 0.2, 0.2, 0.1, NULL);
+    World w = build(u, 0, NULL);
+    w.m->opt.timestep = dt;
+    ss_v3_set(w.m->opt.gravity, 0, 0, 0);
+    ss_model_add_xforce(w.m, 0, F, T, t0, t1, &e);
+    finish(&w);
+    int good = 1;
+    for (int k = 0; k < n; k++) good = good && ss_step(m, d, &e) == SS_OK && steps(&w, 1);
+    double want = t1 - t0;
+    ok(good && fabs(d->qvel[0] - want) < 1e-12 &&
+           fabs(d->qvel[5] * m->body_inertia[8] - want) < 1e-12,
+       "free body: load over [%g, %g) s at dt = %g s gives its impulse (%.12g, %.12g N s; "
+       "want %g)", t0, t1, dt, d->qvel[0], d->qvel[5] * m->body_inertia[8], want);
+    ok(good && fabs(w.d->qvel[0] - want) < 1e-12 && fabs(w.d->qvel[5] * 0.1 - want) < 1e-12,
+       "articulated link: the same (%.12g, %.12g N s)", w.d->qvel[0], w.d->qvel[5] * 0.1);
+    ss_data_free(d);
+    ss_model_free(m);
+    drop(&w);
+    ss_urdf_free(u);
+  }
+}
+
 /* ---------------------------------------------------------------------- */
 /* articulated bodies on soil (DESIGN 8's benchmark bodies)                */
 
@@ -928,6 +978,7 @@ int main(void)
   test_fourbar();
   test_pd_and_springs();
   test_free_both_ways();
+  test_xforce_window();
   test_on_soil();
   test_packed_groups();
   test_mesh_on_soil();
