@@ -270,6 +270,19 @@ int ss_dyn_check_state(const ssModel *m, const ssData *d, char *msg, size_t cap)
              m->sys_name[s], vel ? "non-finite or above 1e5 (m/s or rad/s)" : "non-finite");
     return 0;
   }
+  /* PD targets finite, as the scene and checkpoint readers take them: a
+   * program writes d->pd_target between steps, and a NaN there made the
+   * step fail as if it were too stiff, an export write position_target
+   * "nan" and a checkpoint one its reader refuses as corrupted */
+  for (int k = 0; k < m->npd; k++) {
+    const double *t = d->pd_target + 2 * k;
+    if (!isfinite(t[0]) || !isfinite(t[1])) {
+      int b = m->pd_body[k];
+      snprintf(msg, cap, "the PD target of joint '%s' of '%s' (position %g, velocity %g) "
+               "is non-finite", m->body_jntname[b], m->sys_name[m->body_sys[b]], t[0], t[1]);
+      return 0;
+    }
+  }
   /* a bed's quaternion unit as ss_hfield_set_pose leaves it and the
    * checkpoint reader asks */
   for (int h = 0; h < m->nhfield; h++) {

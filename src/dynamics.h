@@ -62,7 +62,8 @@ void ss_dyn_integrate(const ssModel *m, ssData *d);
 int ss_dyn_check_finite(const ssModel *m, const ssData *d, int *velocity);
 /* The state a step starts from and an export or checkpoint writes: the
  * clock as <clock> allows it (time finite and >= 0, step >= 0), that
- * of ss_dyn_check_finite, and every bed's pose finite with a unit
+ * of ss_dyn_check_finite, every PD target finite, and every bed's
+ * pose finite with a unit
  * quaternion (to 1e-6, as a checkpoint must hold it).  1 when it holds;
  * else 0 with what is wrong in msg ("the velocity of 'ball' is non-finite
  * or above 1e5 (m/s or rad/s)"). */

@@ -475,6 +475,45 @@ static void test_xforce_window(void)
   }
 }
 
+/* a PD target written non-finite between steps is refused by name, the
+ * state left as it was, and no checkpoint is written of it: it made the
+ * step fail as "too stiff", and a checkpoint its own reader refused as
+ * corrupted */
+static void test_pd_target_finite(void)
+{
+  ssUrdf *u = urdf_new();
+  int base = add_link(u, "base", 1, NULL, 0.01, 0.01, 0.01);
+  double com[3] = {0.5, 0, 0};
+  int bob = add_link(u, "bob", 2, com, 0.001, 0.001, 0.001);
+  add_joint(u, "hinge", SS_JOINT_REVOLUTE, base, bob, NULL, ny_axis());
+  ssError e;
+  World w = build(u, 1, NULL);
+  ss_model_add_pd(w.m, 0, "hinge", 100, 10, 0, 0, 0, 0, &e);
+  finish(&w);
+  steps(&w, 10);
+  double q = w.d->qpos[0], v = w.d->qvel[0];
+  const double bad[2] = {NAN, INFINITY};
+  for (int k = 0; k < 4; k++) {
+    w.d->pd_target[0] = w.d->pd_target[1] = 0;
+    w.d->pd_target[k / 2] = bad[k % 2];
+    ssStatus st = ss_step(w.m, w.d, &e);
+    ok(st == SS_ERR_VALUE && strstr(e.message, "PD target of joint 'hinge'") &&
+           w.d->qpos[0] == q && w.d->qvel[0] == v && w.d->step == 10,
+       "%s PD %s target is refused before the step (%s)", k % 2 ? "an infinite" : "a NaN",
+       k / 2 ? "velocity" : "position", st ? e.message : "stepped");
+    unsigned char *buf = NULL;
+    size_t len = 0;
+    st = ss_checkpoint_save_buffer(w.m, w.d, &buf, &len, &e);
+    ok(st != SS_OK && strstr(e.message, "PD target"), "  and not checkpointed (%s)",
+       st ? e.message : "written");
+    free(buf);
+  }
+  w.d->pd_target[0] = w.d->pd_target[1] = 0;
+  ok(steps(&w, 1), "  a finite target steps again");
+  drop(&w);
+  ss_urdf_free(u);
+}
+
 /* ---------------------------------------------------------------------- */
 /* articulated bodies on soil (DESIGN 8's benchmark bodies)                */
 
@@ -979,6 +1018,7 @@ int main(void)
   test_pd_and_springs();
   test_free_both_ways();
   test_xforce_window();
+  test_pd_target_finite();
   test_on_soil();
   test_packed_groups();
   test_mesh_on_soil();
