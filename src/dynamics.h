@@ -21,6 +21,20 @@ static inline int ss_dyn_xforce_active(const ssModel *m, const ssData *d, int k)
   double mid = d->time + 0.5 * m->opt.timestep;
   return mid >= m->xforce_time[2 * k] && mid < m->xforce_time[2 * k + 1];
 }
+/* The gyroscopic torque w x (I w) of a rigid body (world inertia about
+ * its centre of mass I, angular velocity w) as one step of dt takes it:
+ * g = I (w - w') / dt, w' one Newton step of the implicit midpoint rule
+ * on I dw/dt = -w x I w from w, scaled to w's kinetic energy (a
+ * gyroscopic torque does no work).  The explicit term made a spin about
+ * a body's major axis, stable in nature, grow without bound (a 0.1 x
+ * 0.4 x 0.8 m box at 10 rad/s blew up after 68 s at dt = 2 ms); this
+ * one keeps a torque-free body's energy to round-off and its angular
+ * momentum to the step's order, and equals the explicit term to first
+ * order in dt (both are 0 where w is along a principal axis).
+ * Where the Newton matrix is not positive definite, the explicit step
+ * scaled alike; where I is singular (a massless link), the explicit
+ * term. */
+void ss_dyn_gyro(const double I[9], const double w[3], double dt, double g[3]);
 /* qvel <- qvel + dt M^-1 (gravity + external forces - gyroscopic terms),
  * for articulated systems with their force elements and loop closures. */
 ssStatus ss_dyn_free_velocity(const ssModel *m, ssData *d, ssError *err);
