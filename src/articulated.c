@@ -1997,7 +1997,19 @@ int ss_model_add_articulated(ssModel *m, const ssUrdf *u, const ssArtDef *def,
     switch (u->joint[j].type) {
     case SS_JOINT_REVOLUTE:
     case SS_JOINT_PRISMATIC: nq += 1; nv += 1; break;
-    case SS_JOINT_SPHERICAL: nq += 4; nv += 3; break;
+    case SS_JOINT_SPHERICAL:
+      /* a joint spring is tau = -stiffness (q - spring_mount), one
+       * coordinate; on a ball joint it was dropped without a word */
+      if (u->joint[j].stiffness > 0) {
+        ss_error_set(err, SS_ERR_UNSUPPORTED, u->path, u->joint[j].line,
+                     "joint '%s': stiffness %g on a spherical joint is not supported "
+                     "(a joint spring acts on a revolute, continuous or prismatic "
+                     "joint)", u->joint[j].name, u->joint[j].stiffness);
+        return -1;
+      }
+      nq += 4;
+      nv += 3;
+      break;
     case SS_JOINT_FIXED: break;
     default:
       ss_error_set(err, SS_ERR_UNSUPPORTED, u->path, u->joint[j].line,

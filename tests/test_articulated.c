@@ -678,6 +678,35 @@ static void test_gyro_energy(void)
      "largest change %.3g)", bad, worst);
 }
 
+/* stiffness on a ball joint is refused at its line: joint springs act on
+ * one coordinate, and the spring was dropped without a word (a ball
+ * pendulum with stiffness 50 swung as if it had none) */
+static void test_spherical_stiffness(void)
+{
+  ssUrdf *u = urdf_new();
+  int base = add_link(u, "base", 1, NULL, 0.01, 0.01, 0.01);
+  double com[3] = {0, 0, -0.5};
+  int bob = add_link(u, "bob", 2, com, 0.01, 0.01, 0.01);
+  int j = add_joint(u, "ball", SS_JOINT_SPHERICAL, base, bob, NULL, NULL);
+  u->joint[j].line = 17;
+  u->joint[j].damping = 0.5;
+  World w = build(u, 1, NULL);
+  ok(w.sys >= 0, "a damped ball joint builds");
+  drop(&w);
+  u->joint[j].stiffness = 50;
+  ssError e;
+  ssModel *m = ss_model_new();
+  ssArtDef def = ss_art_def_default();
+  def.name = "robot";
+  def.fixed_base = 1;
+  int s = ss_model_add_articulated(m, u, &def, &e);
+  ok(s < 0 && e.code == SS_ERR_UNSUPPORTED && e.line == 17 && strstr(e.message, "'ball'") &&
+         strstr(e.message, "spherical") && m->nsys == 0,
+     "stiffness on a ball joint is refused at its line (%s)", s < 0 ? e.message : "built");
+  ss_model_free(m);
+  ss_urdf_free(u);
+}
+
 /* ---------------------------------------------------------------------- */
 /* articulated bodies on soil (DESIGN 8's benchmark bodies)                */
 
@@ -1185,6 +1214,7 @@ int main(void)
   test_pd_target_finite();
   test_major_axis_spin();
   test_gyro_energy();
+  test_spherical_stiffness();
   test_on_soil();
   test_packed_groups();
   test_mesh_on_soil();
