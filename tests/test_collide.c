@@ -3,6 +3,8 @@
  * (DESIGN 2.4, 2.6), checked against closed forms. */
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "collide.h"
@@ -894,6 +896,38 @@ static void test_width(void)
     if (ss_shape_width(&s, nt) != 0.4) same = 0;
   }
   ok(same, "plate on a tilted bed: b = 0.4 at every heading");
+
+  /* the public ss_geom_width: a mesh takes its bounding box's rule
+   * (DESIGN 2.4), as the box it is shaped like; it gave 0 */
+  const char *top = getenv("top_srcdir");
+  char xml[1024];
+  snprintf(xml, sizeof xml,
+           "<raisim version=\"1.0\"><objects>"
+           "<mesh name=\"slab\" mass=\"20\" file_name=\"%s/tests/data/urdf/meshes/cube.obj\" "
+           "scale=\"0.4 0.6 0.05\"><state pos=\"0 0 0.025\"/></mesh>"
+           "<box name=\"plate\" mass=\"20\"><dim x=\"0.4\" y=\"0.6\" z=\"0.05\"/>"
+           "<state pos=\"1 0 0.025\"/></box></objects></raisim>", top ? top : ".");
+  ssModel *m = NULL;
+  ssData *d = NULL;
+  ssError e;
+  if (ss_scene_load_buffer(xml, strlen(xml), "widths.xml", &m, &d, &e) != SS_OK) {
+    ok(0, "mesh and box scene loads (%s)", e.message);
+    return;
+  }
+  same = 1;
+  double up[3] = {0, 0, 1};
+  for (int t = 0; t < 20; t++) {
+    rot_z(B, urand(-PI, PI));
+    for (int g = 0; g < 2; g++) {
+      double b = ss_geom_width(m, g, B, up);
+      if (b != 0.4) same = 0;
+    }
+  }
+  ok(m->geom_type[0] == SS_GEOM_MESH && same,
+     "ss_geom_width: a box-shaped mesh and the box both 0.4 at every heading (mesh %g)",
+     ss_geom_width(m, 0, B, up));
+  ss_data_free(d);
+  ss_model_free(m);
 }
 
 /* tight bounds */
