@@ -244,9 +244,11 @@ static inline int ss_shape_cast_lowest_z(const ssShapeCast *c, const ssCastRow *
 /* Rigid contact candidates against a surface with unit normal n: points of
  * the shape that can be lowest along n -- box: its 8 corners; sphere: the
  * point c - r n; capsule: c_i - r n for both end spheres; cylinder: for each
- * cap the rim point lowest along n, plus 8 evenly spaced rim points of each
- * cap (so a cylinder standing on its end rests on its rim).  Returns the
- * count (<= max). */
+ * cap the rim point lowest along n, then 7 more rim points of each cap at
+ * 45-degree steps from it (so a cylinder standing on its end rests on its
+ * rim; the ring is placed from the lowest direction, not fixed on the
+ * body, so that a rolling wheel's rim points do not strike the support
+ * in turn).  Returns the count (<= max). */
 int ss_shape_candidates(const ssShape *s, const double n[3], double pts[][3],
                         int max);
 /* Effective width b (DESIGN 2.4), measured in the shape's own frame so that

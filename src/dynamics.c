@@ -15,6 +15,52 @@
 #include <stdio.h>
 #include <string.h>
 
+void ss_dyn_gyro(const double I[9], const double w[3], double dt, double g[3])
+{
+  double Iw[3], f[3];
+  ss_m3_mulv(Iw, I, w);
+  ss_v3_cross(f, w, Iw);
+  /* the implicit midpoint rule I (w' - w) = -dt h((w + w') / 2), h(y) =
+   * y x I y, by one Newton step from w: J (w - w') = dt h(w) with J = I +
+   * dt/2 (skew(w) I - skew(I w)), the derivative of h at w (column k of
+   * skew(a) B is a x B_k) */
+  double J[9], Ji[9];
+  for (int k = 0; k < 3; k++) {
+    double col[3] = {I[k], I[3 + k], I[6 + k]}, wc[3], e[3] = {0, 0, 0}, iwe[3];
+    e[k] = 1;
+    ss_v3_cross(wc, w, col);
+    ss_v3_cross(iwe, Iw, e);
+    for (int i = 0; i < 3; i++) J[3 * i + k] = I[3 * i + k] + 0.5 * dt * (wc[i] - iwe[i]);
+  }
+  /* dw = (w - w') / dt = J^-1 f; where J is not positive definite (dt |w|
+   * far beyond a small inertia), the explicit step's I^-1 f; where I is
+   * singular too (a massless link), the explicit torque as it stands */
+  double dw[3];
+  double det = ss_m3_inv(Ji, J);
+  if (!(det > 0) || !isfinite(det)) {
+    det = ss_m3_inv(Ji, I);
+    if (!(det > 0) || !isfinite(det)) {
+      ss_v3_copy(g, f);
+      return;
+    }
+  }
+  ss_m3_mulv(dw, Ji, f);
+  /* a gyroscopic torque does no work: w' is scaled to w's kinetic
+   * energy, which the midpoint rule keeps and one Newton step of it
+   * keeps to O(dt^3) (near a singular J it may not: an inertia of 1e-4
+   * of the others' at 100 rad/s) */
+  double w1[3], Iw1[3];
+  for (int i = 0; i < 3; i++) w1[i] = w[i] - dt * dw[i];
+  ss_m3_mulv(Iw1, I, w1);
+  double e0 = ss_v3_dot(w, Iw), e1 = ss_v3_dot(w1, Iw1);
+  if (e1 != e0) {
+    double k = e1 > 0 && e0 >= 0 ? sqrt(e0 / e1) : 0;
+    for (int i = 0; i < 3; i++) dw[i] = (w[i] - k * w1[i]) / dt;
+  }
+  /* g = I (w - w') / dt */
+  ss_m3_mulv(g, I, dw);
+}
+
 static int sys_dynamic(const ssModel *m, const ssData *d, int s)
 {
   return m->sys_type[s] == SS_SYS_FREE && d->sys_active[s];
@@ -50,15 +96,13 @@ ssStatus ss_dyn_free_velocity(const ssModel *m, ssData *d, ssError *err)
     ss_v3_set(tau, 0, 0, 0);
     for (int k = 0; k < m->nxforce; k++) {
       if (m->xforce_body[k] != b) continue;
-      if (d->time < m->xforce_time[2 * k] || d->time >= m->xforce_time[2 * k + 1])
-        continue;
+      if (!ss_dyn_xforce_active(m, d, k)) continue;
       ss_v3_add(f, f, m->xforce_force + 3 * k);
       ss_v3_add(tau, tau, m->xforce_torque + 3 * k);
     }
-    /* gyroscopic torque -w x (I w), explicit */
-    double Iw_w[3], gyro[3];
-    ss_m3_mulv(Iw_w, Iw, w);
-    ss_v3_cross(gyro, w, Iw_w);
+    /* gyroscopic torque -w x (I w), implicit (ss_dyn_gyro) */
+    double gyro[3];
+    ss_dyn_gyro(Iw, w, dt, gyro);
     ss_v3_sub(tau, tau, gyro);
 
     double dw[3];
@@ -270,6 +314,19 @@ int ss_dyn_check_state(const ssModel *m, const ssData *d, char *msg, size_t cap)
     snprintf(msg, cap, "the %s of '%s' is %s", vel ? "velocity" : "position",
              m->sys_name[s], vel ? "non-finite or above 1e5 (m/s or rad/s)" : "non-finite");
     return 0;
+  }
+  /* PD targets finite, as the scene and checkpoint readers take them: a
+   * program writes d->pd_target between steps, and a NaN there made the
+   * step fail as if it were too stiff, an export write position_target
+   * "nan" and a checkpoint one its reader refuses as corrupted */
+  for (int k = 0; k < m->npd; k++) {
+    const double *t = d->pd_target + 2 * k;
+    if (!isfinite(t[0]) || !isfinite(t[1])) {
+      int b = m->pd_body[k];
+      snprintf(msg, cap, "the PD target of joint '%s' of '%s' (position %g, velocity %g) "
+               "is non-finite", m->body_jntname[b], m->sys_name[m->body_sys[b]], t[0], t[1]);
+      return 0;
+    }
   }
   /* a bed's quaternion unit as ss_hfield_set_pose leaves it and the
    * checkpoint reader asks */

@@ -1014,7 +1014,10 @@ double ss_geom_width(const ssModel *m, int geom, const double xmat[9],
 {
   ssShape s;
   memset(&s, 0, sizeof s);
-  s.type = m->geom_type[geom];
+  /* a mesh: its bounding box's rule (DESIGN 2.4), as the soil contacts
+   * take it; its size is that box's edge lengths (ss_shape_width knows
+   * no mesh and gave 0) */
+  s.type = m->geom_type[geom] == SS_GEOM_MESH ? SS_GEOM_BOX : m->geom_type[geom];
   memcpy(s.size, m->geom_size + 3 * geom, 3 * sizeof(double));
   memcpy(s.R, xmat, 9 * sizeof(double));
   return ss_shape_width(&s, n_bed);
