@@ -1099,13 +1099,38 @@ static void test_export(void)
   }
 }
 
-/* A checkpoint restores into an export of its world, whose rigid
- * materials the file names in another order: buggy_rigid.xml names the
- * buggy's "rubber" before the ground's "concrete", its export the ground
- * first, so the two models number the materials differently (the same
- * friction on every contact).  The fingerprint once hashed the indices
- * and refused the export ("these differ: colliders; ground planes,
- * contact materials ...").  A friction really changed is still refused. */
+/* The ground of an export of buggy_rigid.xml moved before the buggy, as
+ * a hand-edited or another tool's file may have it (and as exports were
+ * written before they kept the scene's order: scene_write.c): the rigid
+ * materials are then named in another order ("concrete" before "rubber")
+ * and the two models number them differently, with the same friction on
+ * every contact.  A checkpoint of one restores into the other: the
+ * fingerprint once hashed the indices and refused it ("these differ:
+ * colliders; ground planes, contact materials ...").  A friction really
+ * changed is still refused. */
+static int ground_first(const char *path)
+{
+  FILE *fp = fopen(path, "rb");
+  if (!fp) return 0;
+  char buf[1 << 16];
+  size_t n = fread(buf, 1, sizeof buf - 1, fp);
+  fclose(fp);
+  buf[n] = 0;
+  char *g = strstr(buf, "    <ground "), *o = strstr(buf, "<objects>\n");
+  char *ge = g ? strchr(g, '\n') : NULL;
+  if (!g || !o || !ge || o > g || n == sizeof buf - 1) return 0;
+  o += strlen("<objects>\n");
+  ge++;
+  /* objects start, the ground line, the objects before it, the rest */
+  char out[1 << 16];
+  size_t a = (size_t)(o - buf), gl = (size_t)(ge - g), mid = (size_t)(g - o);
+  memcpy(out, buf, a);
+  memcpy(out + a, g, gl);
+  memcpy(out + a + gl, o, mid);
+  memcpy(out + a + gl + mid, ge, n - (size_t)(ge - buf));
+  return write_file(path, out, n);
+}
+
 static void test_restore_into_export(void)
 {
   ssModel *m, *m2 = NULL;
@@ -1119,7 +1144,7 @@ static void test_restore_into_export(void)
   }
   size_t len = 0;
   unsigned char *buf = NULL;
-  int r = run(m, d, 30) && ss_scene_export(m, d, path, &e) == SS_OK &&
+  int r = run(m, d, 30) && ss_scene_export(m, d, path, &e) == SS_OK && ground_first(path) &&
           ss_scene_load(path, &m2, &d2, &e) == SS_OK && (buf = snapshot(m, d, &len));
   if (!r) {
     ok(0, "buggy_rigid.xml: run, export and reload (%s)", e.message);
@@ -1129,9 +1154,10 @@ static void test_restore_into_export(void)
   for (int g = 0; g < m->ngeom && g < m2->ngeom; g++)
     renumbered |= m->geom_material[g] != m2->geom_material[g];
   ok(renumbered && m2->npair == 1 && m->npair == 1,
-     "buggy_rigid.xml: its export numbers the rigid materials differently");
+     "buggy_rigid.xml: its export with the ground first numbers the rigid materials "
+     "differently");
   ssStatus st = ss_checkpoint_load_buffer(m2, d2, buf, len, &e);
-  ok(st == SS_OK, "a checkpoint of buggy_rigid.xml at step 30 restores into its export (%s)",
+  ok(st == SS_OK, "a checkpoint of buggy_rigid.xml at step 30 restores into that world (%s)",
      st ? e.message : "ok");
   if (st == SS_OK) {
     int ran = run(m, d, 40) && run(m2, d2, 40);
