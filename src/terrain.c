@@ -510,6 +510,51 @@ static int mesh_candidates(const ssModel *m, int g, const ssShape *s,
   return n;
 }
 
+/* A round collider's candidate points on rigid height map h (its frame):
+ * the points lowest along the map's normal under them, not along the
+ * map's up.  ss_shape_candidates takes them lowest along up; on a slope a
+ * sphere's lowest point is then not where it touches (directly below its
+ * centre instead of along the normal), so the sphere sank r (1/cos(a) - 1)
+ * into a slope of angle a (3 mm for r = 0.1 m at 14 degrees) and, pushed
+ * at that point, did not roll.  Each point is moved to the support point
+ * along the normal sampled under it, twice (the second sees the normal
+ * where the first put it: exact on a plane, second order on a curved
+ * map): per end of a capsule, and for a cylinder's whole ring from the
+ * normal under its lowest rim point.  Where the map is level under the
+ * points the candidates stay as they are.  Boxes (corners) and meshes
+ * (their lowest vertices) are points of the body whatever the normal. */
+static void round_on_slope(const ssModel *m, int h, const ssShape *s,
+                           double pts[][3], int npt)
+{
+  int type = s->type;
+  if (type != SS_GEOM_SPHERE && type != SS_GEOM_CAPSULE && type != SS_GEOM_CYLINDER) return;
+  double r = s->size[0];
+  for (int pass = 0; pass < 2; pass++) {
+    if (type == SS_GEOM_CYLINDER) {
+      double zs, nl[3];
+      if (!hfield_sample(m, h, pts[0][0], pts[0][1], &zs, nl) || (nl[0] == 0 && nl[1] == 0))
+        return;
+      ss_shape_candidates(s, nl, pts, npt);
+      continue;
+    }
+    for (int k = 0; k < npt; k++) {
+      double zs, nl[3], c[3];
+      if (!hfield_sample(m, h, pts[k][0], pts[k][1], &zs, nl) || (nl[0] == 0 && nl[1] == 0))
+        continue;
+      /* the centre of the sphere, or of the capsule's end k */
+      ss_v3_copy(c, s->pos);
+      if (type == SS_GEOM_CAPSULE) {
+        double e = k ? 0.5 : -0.5;
+        c[0] += e * s->size[1] * s->R[2];
+        c[1] += e * s->size[1] * s->R[5];
+        c[2] += e * s->size[1] * s->R[8];
+      }
+      ss_v3_copy(pts[k], c);
+      ss_v3_addscl(pts[k], nl, -r);
+    }
+  }
+}
+
 /* Coulomb contacts of geom g against a rigid surface: candidate points of
  * the collider (a mesh's: mesh_candidates) tested against the surface
  * (plane when h < 0). */
@@ -536,6 +581,7 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
   int npt = m->geom_type[g] == SS_GEOM_MESH
                 ? mesh_candidates(m, g, &s, pts)
                 : ss_shape_candidates(&s, up, pts, SS_RIGID_CANDIDATES);
+  if (h >= 0) round_on_slope(m, h, &s, pts, npt);
   const int support = h >= 0 ? h : m->nhfield + plane;
   int mat = h >= 0 ? m->hfield_material[h] : m->plane_material[plane];
   const ssMaterialPair *pair = ss_model_pair(m, m->geom_material[g], mat);

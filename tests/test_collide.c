@@ -875,6 +875,47 @@ static void test_candidates(void)
   ss_model_free(m);
 }
 
+/* A ball on a rigid height map that rises 0.25 m a metre along x (14
+ * degrees) rolls down it without slipping: its centre stays r from the
+ * slope and accelerates at 5/7 g sin(a) along it (the horizontal part
+ * 5/7 g sin(a) cos(a) = 1.6487 m/s^2).  Its candidate point was the
+ * lowest along the map's up, directly below the centre: the ball sank
+ * r (1/cos(a) - 1) = 3.1 mm into the slope and, pushed there, did not
+ * roll (x stayed at 0.30002 m). */
+static void test_ball_on_slope(void)
+{
+  char xml[4096], *q = xml;
+  q += sprintf(q, "<raisim version=\"1.0\"><timeStep value=\"0.001\"/><objects>"
+                  "<heightmap name=\"h\" x_size=\"4\" y_size=\"4\" x_sample=\"11\" "
+                  "y_sample=\"11\" center_x=\"0\" center_y=\"0\" height=\"");
+  for (int j = 0; j < 11; j++)
+    for (int i = 0; i < 11; i++) q += sprintf(q, "%s%.1f", i || j ? " " : "", 0.1 * (i - 5));
+  sprintf(q, "\"/><sphere name=\"ball\" mass=\"2\"><dim radius=\"0.1\"/>"
+             "<state pos=\"0.3 0.2 0.3\"/></sphere></objects><material><default "
+             "friction=\"0.8\" restitution=\"0\" restitution_threshold=\"0\"/></material>"
+             "</raisim>");
+  ssModel *m = NULL;
+  ssData *d = NULL;
+  ssError e;
+  int good = ss_scene_load_buffer(xml, strlen(xml), "slope.xml", &m, &d, &e) == SS_OK;
+  /* landed and rolling by 0.3 s; then v_x at two times */
+  double gap = 0, v1 = 0, v2 = 0, t1 = 0, t2 = 0;
+  const double c = sqrt(1.0625);
+  for (int t = 0; good && t < 900; t++) {
+    good = ss_step(m, d, &e) == SS_OK;
+    if (t + 1 >= 300) gap = fmax(gap, fabs((d->qpos[2] - 0.25 * d->qpos[0]) / c - 0.1));
+    if (t + 1 == 400) v1 = d->qvel[0], t1 = d->time;
+    if (t + 1 == 900) v2 = d->qvel[0], t2 = d->time;
+  }
+  double a = good ? (v2 - v1) / (t2 - t1) : 0, want = -5.0 / 7 * 9.81 * 0.25 / 1.0625;
+  ok(good && gap <= 1e-9 && fabs(a - want) <= 1e-9 * fabs(want),
+     "ball on a 14-degree rigid slope: centre r from it (worst %.3g m), rolls at %.10f m/s^2 "
+     "horizontally (5/7 g sin cos: %.10f)%s%s", gap, a, want, good ? "" : ": ",
+     good ? "" : e.message);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 /* effective width b: DESIGN 2.4, invariant under yaw */
 static void test_width(void)
 {
@@ -1167,6 +1208,7 @@ int main(void)
   test_poly_band();
   test_lowest_z();
   test_candidates();
+  test_ball_on_slope();
   test_width();
   test_aabb();
   test_low_bounds();
