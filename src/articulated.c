@@ -1769,8 +1769,14 @@ void ss_art_link_motion_cols(const ssModel *m, const ssData *d, int b, const dou
 void ss_art_point_velocity(const ssModel *m, const ssData *d, int b,
                            const double pw[3], double v[3])
 {
+  ss_art_point_velocity_of(m, d, d->qvel, b, pw, v);
+}
+
+void ss_art_point_velocity_of(const ssModel *m, const ssData *d, const double *qvel, int b,
+                              const double pw[3], double v[3])
+{
   double sv[6], wp[3], p[3];
-  ss_art_link_velocity(m, d, b, sv);
+  ss_art_link_motion(m, d, b, qvel + d->art[m->body_sys[b]]->v0, sv);
   ss_v3_sub(p, pw, d->art[m->body_sys[b]]->org);
   ss_v3_cross(wp, sv, p);
   ss_v3_add(v, sv + 3, wp);

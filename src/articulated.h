@@ -144,6 +144,9 @@ void ss_art_dof_force_add(ssData *d, int sys, int dof, double f);
 /* Velocity of a world point on body b. */
 void ss_art_point_velocity(const ssModel *m, const ssData *d, int b,
                            const double p[3], double v[3]);
+/* the same with the velocities qvel (laid out as d->qvel) at d's poses */
+void ss_art_point_velocity_of(const ssModel *m, const ssData *d, const double *qvel, int b,
+                              const double pw[3], double v[3]);
 /* Positions from velocities, then loop-closure drift removed by projection
  * (Newton in the M' metric); sets d->closure_error. */
 void ss_art_integrate(const ssModel *m, ssData *d, int sys);

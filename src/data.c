@@ -21,6 +21,7 @@ ssData *ss_data_new(const ssModel *m)
   d->qpos = calloc(nq, sizeof(double));
   d->qvel = calloc(nv, sizeof(double));
   d->qvel_free = calloc(nv, sizeof(double));
+  d->qvel_start = calloc(nv, sizeof(double));
   d->sys_active = calloc(ns, 1);
   d->body_xpos = calloc(nb * 3, sizeof(double));
   d->body_xquat = calloc(nb * 4, sizeof(double));
@@ -38,7 +39,7 @@ ssData *ss_data_new(const ssModel *m)
   d->soil_sinkage = calloc(nhd, sizeof(double));
   d->soil_plastic = calloc(nhd, sizeof(double));
   d->soil_shear = calloc(nhd, sizeof(double));
-  if (!d->qpos || !d->qvel || !d->qvel_free || !d->sys_active ||
+  if (!d->qpos || !d->qvel || !d->qvel_free || !d->qvel_start || !d->sys_active ||
       !d->body_xpos || !d->body_xquat || !d->body_xmat || !d->geom_xpos ||
       !d->geom_xmat || !d->geom_patch || !d->hfield_pow || !d->body_iinv ||
       !d->body_xipos || !d->pd_target ||
@@ -59,7 +60,8 @@ ssData *ss_data_new(const ssModel *m)
 void ss_data_free(ssData *d)
 {
   if (!d) return;
-  free(d->qpos); free(d->qvel); free(d->qvel_free); free(d->sys_active);
+  free(d->qpos); free(d->qvel); free(d->qvel_free); free(d->qvel_start);
+  free(d->sys_active);
   free(d->body_xpos); free(d->body_xquat); free(d->body_xmat);
   free(d->geom_xpos); free(d->geom_xmat); free(d->geom_patch); free(d->body_iinv);
   free(d->hfield_pow);

@@ -158,16 +158,22 @@ void ss_dyn_body_impulse(const ssModel *m, ssData *d, int b, const double F[6])
 void ss_dyn_point_velocity(const ssModel *m, const ssData *d, int b,
                            const double p[3], double v[3])
 {
+  ss_dyn_point_velocity_of(m, d, d->qvel, b, p, v);
+}
+
+void ss_dyn_point_velocity_of(const ssModel *m, const ssData *d, const double *qvel,
+                              int b, const double p[3], double v[3])
+{
   int s = m->body_sys[b];
   if (m->sys_nv[s] == 0 || !d->sys_active[s]) {
     ss_v3_set(v, 0, 0, 0);
     return;
   }
   if (m->sys_type[s] == SS_SYS_ARTICULATED) {
-    ss_art_point_velocity(m, d, b, p, v);
+    ss_art_point_velocity_of(m, d, qvel, b, p, v);
     return;
   }
-  const double *u = d->qvel + m->sys_vadr[s];
+  const double *u = qvel + m->sys_vadr[s];
   double r[3], wr[3];
   ss_v3_sub(r, p, d->body_xipos + 3 * b);
   ss_v3_cross(wr, u + 3, r);

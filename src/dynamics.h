@@ -56,6 +56,10 @@ void ss_dyn_body_impulse(const ssModel *m, ssData *d, int body,
 /* Velocity of a world point on body b. */
 void ss_dyn_point_velocity(const ssModel *m, const ssData *d, int body,
                            const double point[3], double v[3]);
+/* The same with the system velocities qvel (nv, laid out as d->qvel) in
+ * place of d->qvel, at the poses of d */
+void ss_dyn_point_velocity_of(const ssModel *m, const ssData *d, const double *qvel,
+                              int body, const double point[3], double v[3]);
 /* Radius of a sphere about geom g's origin that holds the whole geom (a
  * mesh: its farthest bounding-box corner). */
 double ss_dyn_geom_radius(const ssModel *m, int g);

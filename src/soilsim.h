@@ -506,6 +506,9 @@ typedef struct ssData {
   double *jac;            /* contact Jacobians and responses (internal) */
   size_t cap_jac;
   double *qvel_free;      /* (nv) velocity before contact impulses */
+  double *qvel_start;     /* (nv) velocity at the step's start, before its
+                             loads: a rigid contact's approach speed for
+                             restitution (ss_step sets it) */
   int nwarm, cap_warm;
   ssWarmEntry *warm;      /* (nwarm) warm-start cache */
   int cap_warm_next;

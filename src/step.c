@@ -76,7 +76,8 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
   t1 = now(); t[0] = t1 - t0; t0 = t1;
 
   /* velocities under gravity, external loads, force elements and loop
-   * closures */
+   * closures (the velocities before them kept for restitution) */
+  if (m->nv) memcpy(d->qvel_start, d->qvel, (size_t)m->nv * sizeof(double));
   if ((st = ss_dyn_free_velocity(m, d, err))) goto fail;
   t1 = now(); t[1] = t1 - t0; t0 = t1;
 

@@ -610,8 +610,13 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
     double dt = m->opt.timestep;
     c->vn_target = gap >= 0 ? -gap / dt : -m->opt.rigid_erp * gap / dt;
     if (njac > 0 && gap <= m->opt.contact_margin) {
+      /* the approach before this step's loads (qvel_start): with
+       * gravity's g dt in it, a body resting on the support met it at
+       * g dt every step and bounced by restitution times that, hopping
+       * for ever (a box with restitution 0.5 and threshold 0 between
+       * 51.99 and 52.00 mm instead of resting at 50) */
       double v[3];
-      ss_dyn_point_velocity(m, d, m->geom_body[g], c->pos, v);
+      ss_dyn_point_velocity_of(m, d, d->qvel_start, m->geom_body[g], c->pos, v);
       double vn = ss_v3_dot(v, nw);
       if (pair->restitution > 0 && vn < -pair->restitution_threshold &&
           -pair->restitution * vn > c->vn_target)

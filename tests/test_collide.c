@@ -916,6 +916,38 @@ static void test_ball_on_slope(void)
   ss_model_free(m);
 }
 
+/* Restitution acts on a contact's approach before the step's loads: a
+ * box dropped onto the ground with restitution 0.5 (threshold 0) leaves
+ * it at half its impact speed, and once its bounces have died it rests
+ * at z = 0.05 exactly.  With gravity's g dt in the approach, the resting
+ * box met the ground at g dt every step and hopped for ever (z between
+ * 51.99 and 52.00 mm). */
+static void test_restitution_rest(void)
+{
+  const char *xml =
+      "<raisim version=\"1.0\"><timeStep value=\"0.001\"/><objects>"
+      "<ground name=\"g\" height=\"0\"/><box name=\"b\" mass=\"2\">"
+      "<dim x=\"0.2\" y=\"0.3\" z=\"0.1\"/><state pos=\"0 0 0.25\"/></box></objects>"
+      "<material><default friction=\"0.8\" restitution=\"0.5\" "
+      "restitution_threshold=\"0\"/></material></raisim>";
+  ssModel *m = NULL;
+  ssData *d = NULL;
+  ssError e;
+  int good = ss_scene_load_buffer(xml, strlen(xml), "bounce.xml", &m, &d, &e) == SS_OK;
+  double vin = 0, vout = 0, zlo = INFINITY, zhi = -INFINITY;
+  for (int t = 0; good && t < 3000; t++) {
+    double v = d->qvel[2];
+    good = ss_step(m, d, &e) == SS_OK;
+    if (!vout && d->qvel[2] > 0) vin = v, vout = d->qvel[2];
+    if (t >= 2000) zlo = fmin(zlo, d->qpos[2]), zhi = fmax(zhi, d->qpos[2]);
+  }
+  ok(good && vin < -1.9 && fabs(vout / vin + 0.5) <= 1e-12 && zlo == 0.05 && zhi == 0.05,
+     "box with restitution 0.5: leaves the ground at %.12f of its %.4f m/s impact, rests "
+     "at z %.9f-%.9f m after 2 s", vin ? -vout / vin : 0, vin, zlo, zhi);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 /* effective width b: DESIGN 2.4, invariant under yaw */
 static void test_width(void)
 {
@@ -1209,6 +1241,7 @@ int main(void)
   test_lowest_z();
   test_candidates();
   test_ball_on_slope();
+  test_restitution_rest();
   test_width();
   test_aabb();
   test_low_bounds();

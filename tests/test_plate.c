@@ -617,11 +617,18 @@ static void test_rigid_warm(void)
 }
 
 /* Twelve bodies of every shape thrown onto rigid hills and a plane
- * (tests/data/rigid_mix.xml) come to rest on several rigid contacts each.
- * Once they have settled (steps 2001-3000) the warm-started blocks take a
- * few sweeps a step (2.5), and at most one step in a hundred stops at the
- * sweep cap (1); one pass a block and cold rigid contacts took 63 sweeps
- * and 46 capped.  None falls through its support. */
+ * (tests/data/rigid_mix.xml) land on several rigid contacts each.  The
+ * boxes come to rest; the spheres, capsules and cylinders roll on (rigid
+ * contacts have no rolling resistance): they came to rest only while a
+ * round body's contact on a slope sat below its centre instead of where
+ * it touches (terrain.c, round_on_slope), which kept it from rolling.
+ * Over steps 2001-3000 the warm-started blocks take a few sweeps a step
+ * (2.05 with every body at rest; 4.8 now) and about one step in a
+ * hundred stops at the sweep cap (0 then, 12 now: a rolling body between
+ * a hill and the plane, the rigid blocks' stick/slip boundary of README
+ * "Where the solver does not yet meet its tolerance"); one pass a block
+ * and cold rigid contacts took 63 sweeps and 46 capped.  None falls
+ * through its support. */
 static void test_rigid_mix(void)
 {
   ssModel *m;
@@ -642,8 +649,9 @@ static void test_rigid_mix(void)
   }
   double low = INFINITY;
   for (int b = 0; b < m->nbody; b++) low = fmin(low, d->body_xpos[3 * b + 2]);
-  ok(good && sweeps <= 10 * 1000 && capped <= 10,
-     "twelve bodies at rest on rigid hills: %.1f sweeps a step, %d of 1000 steps at the cap",
+  ok(good && sweeps <= 10 * 1000 && capped <= 20,
+     "twelve bodies resting or rolling on rigid hills: %.1f sweeps a step, %d of 1000 steps "
+     "at the cap",
      sweeps / 1000.0, capped);
   ok(good && low > -0.3, "  none below the ground plane (lowest centre at z = %.3f m)", low);
   ss_data_free(d);
