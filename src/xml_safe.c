@@ -16,6 +16,8 @@
 
 typedef struct xmlGuard {
   startElementNsSAX2Func start; /* libxml2's tree builder */
+  charactersSAXFunc characters; /* its text and CDATA builders */
+  cdataBlockSAXFunc cdata;
   int doctype_line;  /* > 0: a DOCTYPE was met (parsing stopped there) */
   int entity_refused;
   int have_error;
@@ -92,6 +94,53 @@ static void on_start_element(void *ctx, const xmlChar *localname,
   node->_private = (void *)(intptr_t)line;
 }
 
+/* XML white space */
+static int is_space(char ch)
+{
+  return ch == ' ' || ch == '\t' || ch == '\n' || ch == '\r';
+}
+
+/* After text ch[0, len) went into the text or CDATA node last in the
+ * current element: record in the node's application pointer the line of
+ * its first character that is not white space (the one a message about
+ * stray text quotes).  libxml2's own line of a text node is where the
+ * parser stood when it made the node, the end of the first piece of text
+ * it delivered, which is the line of the next tag for ordinary text.  The
+ * parser delivers a piece once it has read past it, so its last character
+ * is on the current line and character k on that line less the newlines
+ * in ch[k, len). */
+static void record_text_line(xmlParserCtxtPtr p, const xmlChar *ch, int len)
+{
+  xmlNodePtr t = p && p->node ? p->node->last : NULL;
+  if (!t || t->_private || !p->input || p->input->line <= 0 ||
+      (t->type != XML_TEXT_NODE && t->type != XML_CDATA_SECTION_NODE))
+    return;
+  int k = 0;
+  while (k < len && is_space((char)ch[k])) k++;
+  if (k == len) return;
+  int nl = 0;
+  for (int i = k; i < len; i++)
+    if (ch[i] == '\n') nl++;
+  int line = p->input->line - nl;
+  t->_private = (void *)(intptr_t)(line > 0 ? line : 1);
+}
+
+static void on_characters(void *ctx, const xmlChar *ch, int len)
+{
+  xmlGuard *g = guard_of(ctx);
+  if (!g || !g->characters) return;
+  g->characters(ctx, ch, len);
+  record_text_line((xmlParserCtxtPtr)ctx, ch, len);
+}
+
+static void on_cdata(void *ctx, const xmlChar *ch, int len)
+{
+  xmlGuard *g = guard_of(ctx);
+  if (!g || !g->cdata) return;
+  g->cdata(ctx, ch, len);
+  record_text_line((xmlParserCtxtPtr)ctx, ch, len);
+}
+
 /* Deny-by-default external entity loader: nothing is ever fetched. */
 static xmlParserInputPtr deny_entity_loader(const char *url, const char *id,
                                             xmlParserCtxtPtr ctxt)
@@ -165,6 +214,15 @@ xmlDocPtr ss_xml_parse(const char *buf, size_t len, int huge, ssXmlResult *r)
       p->sax->internalSubset = on_internal_subset;
       g.start = p->sax->startElementNs;
       if (g.start) p->sax->startElementNs = on_start_element;
+      /* white space goes to the same builder (libxml2 compares the two
+       * pointers to tell whether blanks need telling apart: keep them
+       * equal) */
+      g.characters = p->sax->characters;
+      if (g.characters && p->sax->ignorableWhitespace == g.characters)
+        p->sax->ignorableWhitespace = on_characters;
+      if (g.characters) p->sax->characters = on_characters;
+      g.cdata = p->sax->cdataBlock;
+      if (g.cdata) p->sax->cdataBlock = on_cdata;
     }
     /* never XML_PARSE_NOENT, XML_PARSE_DTDLOAD, XML_PARSE_DTDATTR or
      * XML_PARSE_XINCLUDE */
@@ -189,7 +247,8 @@ xmlDocPtr ss_xml_parse(const char *buf, size_t len, int huge, ssXmlResult *r)
 
 int ss_xml_line(xmlNodePtr n)
 {
-  if (n->type == XML_ELEMENT_NODE && n->_private)
+  if ((n->type == XML_ELEMENT_NODE || n->type == XML_TEXT_NODE ||
+       n->type == XML_CDATA_SECTION_NODE) && n->_private)
     return (int)(intptr_t)n->_private;
   long l = xmlGetLineNo(n);
   return l > 0 && l < INT_MAX ? (int)l : 0;
@@ -197,12 +256,6 @@ int ss_xml_line(xmlNodePtr n)
 
 /* ---------------------------------------------------------------------- */
 /* attributes, children, value lists                                      */
-
-/* XML white space */
-static int is_space(char ch)
-{
-  return ch == ' ' || ch == '\t' || ch == '\n' || ch == '\r';
-}
 
 static int is_blank(const xmlChar *s)
 {
