@@ -10,7 +10,9 @@
  * camelCase: an upper-case letter stands for '_' plus its lower-case form
  * (xSize = x_size, centerX = center_x, linVel = lin_vel, bodyType =
  * body_type, articulatedSystem = articulated_system, pairProp = pair_prop).
- * `timestep` is a third spelling of time_step.  Giving one attribute twice
+ * Nothing else: a camelCase name starts with a lower-case letter and has no
+ * '_' and no two capitals in a row, so Box, TimeStep, x_Size and MASS are
+ * unknown names.  `timestep` is a third spelling of time_step.  Giving one attribute twice
  * in two spellings is an error.  Unknown elements and attributes are errors;
  * so is non-blank text inside an element.  Comments are ignored.
  *

@@ -311,19 +311,30 @@ typedef struct xEl {
   xmlChar *owned[MAX_ATTR];
 } xEl;
 
-/* camelCase -> snake_case; `timestep` -> time_step.  Names too long for
- * the buffer become "?" (never a valid name). */
+static int is_upper(char ch) { return ch >= 'A' && ch <= 'Z'; }
+
+/* camelCase -> snake_case; `timestep` -> time_step.  A name is one of the
+ * two spellings: snake_case (no capital letter) or camelCase (a lower-case
+ * first letter, no '_', no two capitals in a row); any other (`Box`,
+ * `x_Size`, `XSIZE`) and names too long for the buffer become "?" (never
+ * a valid name: reported as unknown under the name as written). */
 static void norm_name(const char *in, char out[NAME_CAP])
 {
+  int camel = 0;
+  for (const char *p = in; *p; p++) camel |= is_upper(*p);
+  if (camel && (!(in[0] >= 'a' && in[0] <= 'z') || strchr(in, '_'))) {
+    strcpy(out, "?");
+    return;
+  }
   size_t k = 0;
   for (const char *p = in; *p; p++) {
     char ch = *p;
-    if (k + 3 >= NAME_CAP) {
+    if (k + 3 >= NAME_CAP || (is_upper(ch) && is_upper(p[1]))) {
       strcpy(out, "?");
       return;
     }
-    if (ch >= 'A' && ch <= 'Z') {
-      if (k > 0 && out[k - 1] != '_') out[k++] = '_';
+    if (is_upper(ch)) {
+      out[k++] = '_';
       out[k++] = (char)(ch - 'A' + 'a');
     } else {
       out[k++] = ch;
@@ -374,7 +385,8 @@ static ssStatus el_open(readCtx *c, xmlNodePtr node, const char *parent_label,
     norm_name(x->raw, x->name);
     x->val = ss_xml_attr_text(c->doc, a, &e->owned[e->nattr]);
     e->nattr++;
-    for (int i = 0; i < e->nattr - 1; i++)
+    /* "?" (not a name of either spelling) is reported as unknown below */
+    for (int i = 0; i < e->nattr - 1 && strcmp(x->name, "?"); i++)
       if (!strcmp(e->attr[i].name, x->name))
         return fail(c, SS_ERR_PARSE, e->line,
                     "%s: attribute '%s' given twice (as '%s' and '%s')",
