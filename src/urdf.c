@@ -1011,7 +1011,7 @@ static ssStatus read_joint(uCtx *c, xmlNodePtr n)
                 joint_types);
   }
   int seen_o = 0, seen_p = 0, seen_c = 0, seen_a = 0, seen_l = 0, seen_d = 0,
-      seen_m = 0, axis_line = 0, has_lo = 0, has_hi = 0;
+      seen_m = 0, axis_line = 0, has_lo = 0, has_hi = 0, dyn_line = 0;
   double axis[3] = {1, 0, 0};
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
     xEl x;
@@ -1048,6 +1048,7 @@ static ssStatus read_joint(uCtx *c, xmlNodePtr n)
       if (!st) st = get_num_min(c, &x, "friction", 0, 0, 0, &j->friction);
       if (!st) st = get_num_min(c, &x, "stiffness", 0, 0, 0, &j->stiffness);
       if (!st) st = get_num(c, &x, "spring_mount", 0, &j->spring_mount);
+      dyn_line = x.line;
       el_free(&x);
     } else if (is_el(k, "mimic")) {
       uPending p;
@@ -1072,6 +1073,27 @@ static ssStatus read_joint(uCtx *c, xmlNodePtr n)
     } else {
       st = unknown_child(c, k, &e, kids);
     }
+  }
+  /* what the joint's degrees of freedom cannot take would be dropped
+   * without a word: a joint spring acts on one coordinate, and a fixed or
+   * floating joint (the latter is the world's, dropped) has no damper */
+  if (!st && seen_d && !is_1dof(j->type)) {
+    const char *bad = NULL;
+    double v = 0;
+    if (j->stiffness != 0) bad = "stiffness", v = j->stiffness;
+    else if (j->spring_mount != 0) bad = "spring_mount", v = j->spring_mount;
+    else if (j->damping != 0 && j->type != SS_JOINT_SPHERICAL)
+      bad = "damping", v = j->damping;
+    if (bad)
+      st = fail(c, SS_ERR_VALUE, dyn_line,
+                "%s <dynamics>: %s = %.17g on a %s joint, %s (damping acts on "
+                "revolute, continuous, prismatic and spherical joints; a joint "
+                "spring, stiffness and spring_mount, on the first three only)",
+                label, bad, v, type_name(j->type),
+                j->type == SS_JOINT_SPHERICAL ? "which has no joint spring"
+                : j->type == SS_JOINT_FIXED   ? "which does not move"
+                                              : "the free base, which has "
+                                                "neither damper nor spring");
   }
   if (!st && !seen_p)
     st = fail(c, SS_ERR_PARSE, e.line, "%s: missing <parent link=...>", label);

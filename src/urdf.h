@@ -47,7 +47,11 @@
  *       <dynamics damping [0] friction [0] stiffness [0] spring_mount [0]/>
  *                               all >= 0 but spring_mount; stiffness and
  *                               spring_mount are ours: a joint spring
- *                               tau = -stiffness (q - spring_mount)
+ *                               tau = -stiffness (q - spring_mount) on a
+ *                               revolute, continuous or prismatic joint;
+ *                               damping there and on a spherical joint;
+ *                               a non-zero value a joint cannot take is
+ *                               an error (friction: read, not simulated)
  *       <mimic joint=R multiplier [1] offset [0]/>  becomes an equality
  *                               closure q(this) = multiplier q(joint) + offset
  *       <calibration/>, <safety_controller/>   ignored
