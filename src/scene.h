@@ -96,7 +96,9 @@
  *              (the far side) and image column 0 the -x edge, so the picture
  *              looks like the bed seen from above with +x right, +y up.
  *   text       text="file"R x_size=R y_size=R: a text file of numbers
- *              separated by white space or commas, '#' starting a comment
+ *              separated by white space or by one comma (",," or a comma
+ *              before the first or after the last number is an empty
+ *              value, an error, as in vectors), '#' starting a comment
  *              that runs to the end of the line.  The first two numbers
  *              are the integers nx ny (by convention the first line), then
  *              nx*ny heights in the order of `height` (x fastest, first row
