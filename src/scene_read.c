@@ -250,9 +250,9 @@ typedef struct readCtx {
   ssError e;
   int npend, cappend;
   pendingSoil *pend;
-  int nqpend;
-  int qpend_sys[64];
-  double *qpend[64];   /* state qpos applied after the data exists */
+  int nqpend, capqpend;
+  int *qpend_sys;      /* (nqpend) systems whose qpos is applied after */
+  double **qpend;      /* (nqpend) the data exists: that qpos, owned */
   int clock_given;
   double clock_time;
   long clock_step;
@@ -1328,9 +1328,15 @@ static ssStatus read_heightmap(readCtx *c, xmlNodePtr n)
 
 static ssStatus pend_qpos(readCtx *c, int sys, double *q, int line)
 {
-  if (c->nqpend == 64)
-    return fail(c, SS_ERR_VALUE, line, "at most 64 articulated systems with a "
-                "reference_qpos per scene");
+  if (c->nqpend == c->capqpend) {
+    int cap = c->capqpend ? 2 * c->capqpend : 8;
+    int *ps = realloc(c->qpend_sys, (size_t)cap * sizeof *ps);
+    if (ps) c->qpend_sys = ps;
+    double **pq = ps ? realloc(c->qpend, (size_t)cap * sizeof *pq) : NULL;
+    if (!pq) return fail(c, SS_ERR_NOMEM, line, "out of memory");
+    c->qpend = pq;
+    c->capqpend = cap;
+  }
   c->qpend_sys[c->nqpend] = sys;
   c->qpend[c->nqpend++] = q;
   return SS_OK;
@@ -1828,7 +1834,11 @@ static void ctx_free(readCtx *c)
 {
   for (int i = 0; i < c->npend; i++) pending_free(&c->pend[i]);
   for (int i = 0; i < c->nqpend; i++) free(c->qpend[i]);
-  c->nqpend = 0;
+  free(c->qpend);
+  free(c->qpend_sys);
+  c->qpend = NULL;
+  c->qpend_sys = NULL;
+  c->nqpend = c->capqpend = 0;
   free(c->pend);
   c->pend = NULL;
   c->npend = 0;

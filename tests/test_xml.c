@@ -945,6 +945,49 @@ static void test_mesh_bodies(void)
   unlink(b);
 }
 
+/* An export writes every articulated system's reference_qpos and qpos, so
+ * its reader takes any number of them: 70 systems, exported, load again
+ * with the same state (the reader once kept at most 64 such qpos). */
+static void test_many_systems(void)
+{
+  enum { NSYS = 70 };
+  size_t cap = 300 * NSYS + 200, k = 0;
+  char *xml = malloc(cap);
+  if (!xml) return;
+  k += (size_t)snprintf(xml + k, cap - k, "<raisim><objects>\n");
+  for (int i = 0; i < NSYS; i++)
+    k += (size_t)snprintf(xml + k, cap - k,
+                          "<articulated_system name=\"s%d\" urdf_path=\"%s/tests/"
+                          "data/urdf/example.urdf\"><state pos=\"%d 0 1\"/>"
+                          "</articulated_system>\n", i, srcdir(), i);
+  snprintf(xml + k, cap - k, "</objects></raisim>\n");
+  ssModel *m = NULL, *m2 = NULL;
+  ssData *d = NULL, *d2 = NULL;
+  ssError e;
+  char a[512];
+  tmp_path(a, sizeof a, "many.xml");
+  ssStatus st = load_str(xml, &m, &d, &e);
+  free(xml);
+  if (!ok(st == SS_OK && m->nsys == NSYS, "%d articulated systems load", NSYS)) {
+    if (st) diag("%s:%d: %s", e.file, e.line, e.message);
+    ss_data_free(d);
+    ss_model_free(m);
+    return;
+  }
+  ok(ss_scene_export(m, d, a, &e) == SS_OK, "%d articulated systems export", NSYS);
+  st = ss_scene_load(a, &m2, &d2, &e);
+  if (st) diag("%s:%d: %s", e.file, e.line, e.message);
+  ok(st == SS_OK && m2->nsys == NSYS && m2->nq == m->nq &&
+         same_bits(d2->qpos, d->qpos, (size_t)m->nq) &&
+         same_bits(m2->qpos0, m->qpos0, (size_t)m->nq),
+     "their export (reference_qpos and qpos for each) loads with the same state");
+  ss_data_free(d2);
+  ss_model_free(m2);
+  ss_data_free(d);
+  ss_model_free(m);
+  unlink(a);
+}
+
 int main(void)
 {
   snprintf(tmpdir, sizeof tmpdir, "/tmp/soilsim-xml-XXXXXX");
@@ -960,6 +1003,7 @@ int main(void)
   test_round_trip();
   test_built_in_code();
   test_mesh_bodies();
+  test_many_systems();
   test_numbers();
   test_png();
   test_text();
