@@ -1375,7 +1375,7 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
   def.line = e.line;
   double *qpos = NULL, *qvel = NULL, *ref = NULL;
   int nqpos = 0, nqvel = 0, nref = 0, seen_state = 0, npd = 0;
-  pendingPd pd[64];
+  pendingPd *pd = NULL; /* (npd) read here, added once the system exists */
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
     char kn[NAME_CAP];
     if (!child_el(c, k, &e, kn, &st)) continue;
@@ -1399,12 +1399,22 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
                                        "velocity_target", "effort_limit", NULL};
       xEl pe;
       st = open_leaf(c, k, e.label, pa, &pe);
-      if (!st && npd == 64)
-        st = fail(c, SS_ERR_VALUE, pe.line, "%s: at most 64 <pd> per system", e.label);
       const char *jn = NULL;
       if (!st) st = get_str(c, &pe, "joint", 1, &jn);
+      /* cut short, it could name another joint (URDF names are shorter) */
+      if (!st && strlen(jn) >= sizeof pd->joint)
+        st = fail(c, SS_ERR_VALUE, pe.line,
+                  "%s: joint name '%.40s...' is too long (at most %d "
+                  "characters)", pe.label, jn, (int)sizeof pd->joint - 1);
       if (!st) {
-        pendingPd *p = &pd[npd];
+        pendingPd *p = realloc(pd, (size_t)(npd + 1) * sizeof *pd);
+        if (!p) {
+          st = fail(c, SS_ERR_NOMEM, pe.line, "out of memory");
+          el_free(&pe);
+          break;
+        }
+        pd = p;
+        p += npd;
         snprintf(p->joint, sizeof p->joint, "%s", jn);
         memset(p->g, 0, sizeof p->g);
         p->line = pe.line;
@@ -1485,6 +1495,7 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
     if (!st) qpos = NULL; /* owned by the pending list */
   }
   ss_urdf_free(u);
+  free(pd);
   free(qpos);
   free(qvel);
   free(ref);

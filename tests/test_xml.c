@@ -988,6 +988,85 @@ static void test_many_systems(void)
   unlink(a);
 }
 
+/* <pd>: any number per system (a 70-joint chain, each driven, loads and
+ * its export loads again; the reader once stopped at 64), and a joint name
+ * too long for any URDF joint is refused, not cut short into the name of
+ * another (a 128-character name once drove the 127-character joint that
+ * is its prefix). */
+static void test_many_pd(void)
+{
+  enum { NJ = 70 };
+  static const char *const link =
+      "<link name=\"l%d\"><inertial><mass value=\"1\"/><inertia ixx=\"0.1\" "
+      "ixy=\"0\" ixz=\"0\" iyy=\"0.1\" iyz=\"0\" izz=\"0.1\"/></inertial></link>\n";
+  size_t cap = 400 * NJ + 4096, k = 0;
+  char *urdf = malloc(cap), *xml = malloc(cap);
+  if (!urdf || !xml) {
+    free(urdf);
+    free(xml);
+    return;
+  }
+  char upath[512], spath[512], epath[512], long_name[128];
+  memset(long_name, 'j', sizeof long_name - 1);
+  long_name[sizeof long_name - 1] = 0; /* 127 characters */
+  tmp_path(upath, sizeof upath, "chain.urdf");
+  tmp_path(spath, sizeof spath, "chain.xml");
+  tmp_path(epath, sizeof epath, "chain_export.xml");
+  k += (size_t)snprintf(urdf + k, cap - k, "<robot name=\"chain\">\n");
+  for (int i = 0; i <= NJ; i++) k += (size_t)snprintf(urdf + k, cap - k, link, i);
+  /* joints j1 .. j69, and the last one named long_name */
+  for (int i = 1; i <= NJ; i++) {
+    char jn[160];
+    snprintf(jn, sizeof jn, "j%d", i);
+    k += (size_t)snprintf(urdf + k, cap - k,
+                          "<joint name=\"%s\" type=\"revolute\"><parent link=\"l%d\"/>"
+                          "<child link=\"l%d\"/><axis xyz=\"0 1 0\"/></joint>\n",
+                          i == NJ ? long_name : jn, i - 1, i);
+  }
+  snprintf(urdf + k, cap - k, "</robot>\n");
+  k = (size_t)snprintf(xml, cap, "<raisim><objects><articulated_system name=\"c\" "
+                       "urdf_path=\"chain.urdf\" base=\"fixed\">\n");
+  for (int i = 1; i < NJ; i++)
+    k += (size_t)snprintf(xml + k, cap - k, "<pd joint=\"j%d\" p_gain=\"1\" d_gain=\"0.1\"/>\n", i);
+  snprintf(xml + k, cap - k, "</articulated_system></objects></raisim>\n");
+  ssModel *m = NULL, *m2 = NULL;
+  ssData *d = NULL, *d2 = NULL;
+  ssError e;
+  ssStatus st = SS_ERR_IO;
+  if (write_file(upath, urdf) == 0 && write_file(spath, xml) == 0)
+    st = ss_scene_load(spath, &m, &d, &e);
+  if (st) diag("%s:%d: %s", e.file, e.line, e.message);
+  ok(st == SS_OK && m->npd == NJ - 1, "%d <pd> in one system load", NJ - 1);
+  if (st == SS_OK) {
+    st = ss_scene_export(m, d, epath, &e);
+    if (!st) st = ss_scene_load(epath, &m2, &d2, &e);
+    if (st) diag("%s:%d: %s", e.file, e.line, e.message);
+    ok(st == SS_OK && m2->npd == NJ - 1, "and their export loads again");
+  }
+  ss_data_free(d2);
+  ss_model_free(m2);
+  ss_data_free(d);
+  ss_model_free(m);
+  m = NULL;
+  d = NULL;
+  /* a <pd> naming the 127-character joint with one more letter */
+  snprintf(xml, cap, "<raisim><objects><articulated_system name=\"c\" "
+           "urdf_path=\"chain.urdf\" base=\"fixed\">\n<pd joint=\"%sX\" "
+           "p_gain=\"1\"/>\n</articulated_system></objects></raisim>\n", long_name);
+  st = SS_OK;
+  if (write_file(spath, xml) == 0) st = ss_scene_load(spath, &m, &d, &e);
+  ok(st != SS_OK && e.line == 2 && strstr(e.message, "is too long"),
+     "a <pd> joint name longer than any joint's is refused at its line (%s)",
+     st ? e.message : "loaded");
+  ss_data_free(d);
+  ss_model_free(m);
+  free(urdf);
+  free(xml);
+  unlink(upath);
+  unlink(spath);
+  unlink(epath);
+}
+
 int main(void)
 {
   snprintf(tmpdir, sizeof tmpdir, "/tmp/soilsim-xml-XXXXXX");
@@ -1004,6 +1083,7 @@ int main(void)
   test_built_in_code();
   test_mesh_bodies();
   test_many_systems();
+  test_many_pd();
   test_numbers();
   test_png();
   test_text();
