@@ -871,7 +871,7 @@ static ssStatus get_mesh_scale(readCtx *c, xEl *e, double s[3])
   const char *v = el_find(e, "scale");
   if (!v) return SS_OK;
   long n = ss_xml_vec_count(v);
-  if (n > 0 && n != 1 && n != 3)
+  if (n >= 0 && n != 1 && n != 3)
     return fail(c, SS_ERR_PARSE, e->line,
                 "%s: attribute 'scale' has %ld values, expected 1 (all axes) "
                 "or 3 (x y z)", e->label, n);
