@@ -1444,6 +1444,17 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
       st = ue.code;
     }
   }
+  /* a floating base (the default unless the URDF roots it at a fixed
+   * "world") needs mass: checked here, where the URDF's line is known, so
+   * that it is not a singular mass matrix at the first step */
+  if (!st && (base ? !strcmp(base, "floating")
+                   : u->world_base != SS_URDF_BASE_FIXED)) {
+    ssError ue;
+    if (ss_urdf_check_floating_root(u, &ue) != SS_OK) {
+      c->e = ue;
+      st = ue.code;
+    }
+  }
   /* kept absolute and normalised, so an export anywhere can name the same
    * files (messages above keep the path as the scene gives it) */
   char abspath[4096], absres[4096] = "";

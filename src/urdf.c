@@ -1808,6 +1808,59 @@ ssStatus ss_urdf_load(const char *path, const char *res_dir, ssUrdf **out,
   return st;
 }
 
+ssStatus ss_urdf_check_floating_root(const ssUrdf *u, ssError *err)
+{
+  if (!u || u->nlink < 1)
+    return ss_error_set(err, SS_ERR_VALUE, u ? u->path : "", 0,
+                        "the URDF has no link");
+  int nl = u->nlink, nj = u->njoint;
+  int *kid_first = malloc((size_t)nl * sizeof *kid_first);
+  int *kid_next = malloc((size_t)(nj ? nj : 1) * sizeof *kid_next);
+  int *stack = malloc((size_t)(2 * nl + 2) * sizeof *stack);
+  pose *tmp = malloc((size_t)nl * sizeof *tmp);
+  ssStatus st = SS_OK;
+  if (!kid_first || !kid_next || !stack || !tmp) {
+    st = ss_error_set(err, SS_ERR_NOMEM, u->path, 0, "out of memory");
+  } else {
+    /* child lists by final index (joint k's child is link k + 1), in the
+     * order composite() reads them */
+    int *kid_last = stack;
+    for (int i = 0; i < nl; i++) kid_first[i] = kid_last[i] = -1;
+    for (int j = 0; j < nj; j++) {
+      int a = u->joint[j].parent;
+      kid_next[j] = -1;
+      if (a < 0 || a >= nl) continue;
+      if (kid_last[a] < 0) kid_first[a] = j;
+      else kid_next[kid_last[a]] = j;
+      kid_last[a] = j;
+    }
+    uCtx c;
+    memset(&c, 0, sizeof c);
+    c.link = u->link;
+    c.joint = u->joint;
+    c.nlink = nl;
+    c.njoint = nj;
+    double M, com[3], I[9], ev[3] = {0, 0, 0};
+    composite(&c, 0, kid_first, kid_next, tmp, stack, &M, com, I);
+    if (M > 0) sym_eig3(I, ev);
+    const ssUrdfLink *L = &u->link[0];
+    if (!(M > 0) || !is_pd(ev))
+      st = ss_error_set(err, SS_ERR_VALUE, u->path, L->line,
+                        "link '%s' is the root of a floating base but, with "
+                        "the links fixed to it, has mass %.6g kg and "
+                        "principal moments %.6g, %.6g, %.6g kg m^2 (a floating "
+                        "base needs mass > 0 and a positive-definite "
+                        "rotational inertia: give it an <inertial>, or "
+                        "base=\"fixed\" in the scene)", L->name, M, ev[0],
+                        ev[1], ev[2]);
+  }
+  free(kid_first);
+  free(kid_next);
+  free(stack);
+  free(tmp);
+  return st;
+}
+
 int ss_urdf_find_link(const ssUrdf *u, const char *name)
 {
   if (!u || !name) return -1;

@@ -107,7 +107,8 @@
  * 1e-12 times the largest).  A link with mass > 0 needs a positive-definite
  * inertia of its own; a massless link's inertia must be positive semi-
  * definite.  The root of a tree whose base the scene decides is not checked
- * here: a floating base needs mass, which the scene builder checks.
+ * here: a floating base needs mass, which ss_urdf_check_floating_root
+ * checks for the scene.
  *
  * Mesh paths.  package://NAME/REST is looked up as BASE/REST, then as
  * BASE/NAME/REST, where BASE is res_dir when given, else the URDF's folder;
@@ -282,5 +283,11 @@ ssStatus ss_urdf_load(const char *path, const char *res_dir, ssUrdf **out,
 ssStatus ss_urdf_load_buffer(const char *buf, size_t len, const char *path,
                              const char *res_dir, ssUrdf **out, ssError *err);
 void ss_urdf_free(ssUrdf *u);  /* NULL ok */
+
+/* For a root the scene sets floating (see "Mass"): SS_OK when link 0 with
+ * the links fixed to it has mass > 0 and a positive-definite rotational
+ * inertia, the check every moving link gets; otherwise an error at the
+ * URDF's root link (file = the URDF, line = the link's). */
+ssStatus ss_urdf_check_floating_root(const ssUrdf *u, ssError *err);
 
 #endif /* SS_URDF_H */

@@ -990,11 +990,39 @@ static void test_bad_catalogue(void)
   catalogue_check(dir, ".urdf", "URDF", 30, load_bad_urdf);
 }
 
+/* ss_urdf_check_floating_root: a root without mass (massless_root.urdf:
+ * no <inertial>, nothing fixed to it) cannot float; one with mass can. */
+static void test_floating_root(void)
+{
+  char path[1024];
+  ssUrdf *u = NULL;
+  ssError e;
+  data_path(path, sizeof path, "massless_root.urdf");
+  ssStatus st = ss_urdf_load(path, NULL, &u, &e);
+  if (!ok(st == SS_OK, "massless_root.urdf loads (a fixed base may be massless)")) {
+    diag("%s:%d: %s", e.file, e.line, e.message);
+    return;
+  }
+  st = ss_urdf_check_floating_root(u, &e);
+  ok(st == SS_ERR_VALUE && !strcmp(e.file, path) && e.line == 5 &&
+         strstr(e.message, "link 'mount' is the root of a floating base"),
+     "its root cannot float: refused at the root link's line (%s:%d: %s)", e.file,
+     e.line, st ? e.message : "accepted");
+  ss_urdf_free(u);
+  u = NULL;
+  data_path(path, sizeof path, "example.urdf");
+  st = ss_urdf_load(path, NULL, &u, &e);
+  ok(st == SS_OK && ss_urdf_check_floating_root(u, &e) == SS_OK,
+     "example.urdf's root can float");
+  ss_urdf_free(u);
+}
+
 int main(void)
 {
   test_fourbar();
   test_example();
   test_world();
+  test_floating_root();
   test_paths();
   test_locale();
   test_size_cap();

@@ -1067,6 +1067,38 @@ static void test_many_pd(void)
   unlink(epath);
 }
 
+/* A floating base needs mass: a URDF whose root has none is refused when
+ * the scene loads, at the root link's line in the URDF (it once loaded and
+ * failed at the first step with a singular mass matrix and no line); on a
+ * fixed base it loads and steps. */
+static void test_massless_root(void)
+{
+  char xml[2048], urdf[1024];
+  snprintf(urdf, sizeof urdf, "%s/tests/data/urdf/massless_root.urdf", srcdir());
+  for (int fixed = 0; fixed < 2; fixed++) {
+    snprintf(xml, sizeof xml,
+             "<raisim><objects>\n<articulated_system name=\"a\" urdf_path=\"%s\"%s/>\n"
+             "</objects></raisim>\n", urdf, fixed ? " base=\"fixed\"" : "");
+    ssModel *m = NULL;
+    ssData *d = NULL;
+    ssError e;
+    memset(&e, 0, sizeof e);
+    ssStatus st = load_str(xml, &m, &d, &e);
+    if (fixed) {
+      if (st) diag("%s:%d: %s", e.file, e.line, e.message);
+      ok(st == SS_OK && ss_step(m, d, &e) == SS_OK,
+         "a massless root on a fixed base loads and steps");
+    } else {
+      ok(st != SS_OK && !strcmp(e.file, urdf) && e.line == 5 &&
+             strstr(e.message, "root of a floating base"),
+         "a massless root cannot float: refused at load, at its URDF line (%s:%d: %s)",
+         e.file, e.line, st ? e.message : "loaded");
+    }
+    ss_data_free(d);
+    ss_model_free(m);
+  }
+}
+
 int main(void)
 {
   snprintf(tmpdir, sizeof tmpdir, "/tmp/soilsim-xml-XXXXXX");
@@ -1084,6 +1116,7 @@ int main(void)
   test_mesh_bodies();
   test_many_systems();
   test_many_pd();
+  test_massless_root();
   test_numbers();
   test_png();
   test_text();
