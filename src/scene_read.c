@@ -1758,7 +1758,10 @@ static ssStatus read_camera(readCtx *c, xEl *e)
               m->camera_fov_deg);
   if (!st) st = get_str(c, e, "follow", 0, &follow);
   if (!st && follow) {
-    if (strlen(follow) >= sizeof m->camera_follow)
+    if (!*follow)
+      st = fail(c, SS_ERR_VALUE, e->line, "<camera>: follow is empty (give "
+                "the name of a body to follow, or leave the attribute out)");
+    else if (strlen(follow) >= sizeof m->camera_follow)
       st = fail(c, SS_ERR_VALUE, e->line, "<camera>: follow name is too long");
     else
       snprintf(m->camera_follow, sizeof m->camera_follow, "%s", follow);
