@@ -43,7 +43,9 @@
  *                               upper is given (the other is then 0, as in
  *                               URDF; lower <= upper) on a revolute or
  *                               prismatic joint; a continuous joint is never
- *                               limited; effort, velocity >= 0, 0 = none
+ *                               limited; effort, velocity >= 0 are read
+ *                               but not simulated (a scene's <pd
+ *                               effort_limit> bounds a drive)
  *       <dynamics damping [0] friction [0] stiffness [0] spring_mount [0]/>
  *                               all >= 0 but spring_mount; stiffness and
  *                               spring_mount are ours: a joint spring
@@ -219,8 +221,8 @@ typedef struct ssUrdfJoint {
   double axis[3];        /* unit axis in the child (joint) frame */
   int limited;           /* 1 if lower/upper apply */
   double lower, upper;   /* rad or m */
-  double effort;         /* N or N m; 0 = unlimited */
-  double velocity;       /* rad/s or m/s; 0 = unlimited */
+  double effort;         /* N or N m (stored; not simulated) */
+  double velocity;       /* rad/s or m/s (stored; not simulated) */
   double damping;        /* <dynamics damping> (N m s/rad or N s/m) */
   double friction;       /* <dynamics friction> (stored; not simulated) */
   double stiffness;      /* <dynamics stiffness> joint spring (extension) */
