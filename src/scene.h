@@ -133,8 +133,10 @@
  * loading is not safe to run concurrently with other libxml2 users.
  *
  * Errors.  Every error carries file = the scene path (as given) and line =
- * the line of the element at fault, and a message naming the object,
- * element or attribute and what is allowed.  Nothing is returned on error.
+ * the line of the element at fault (where its start tag begins; for a bad
+ * number, the line the number stands on, which in an attribute over many
+ * lines is a later one; for stray text, the line of the text), and a
+ * message naming the object, element or attribute and what is allowed.  Nothing is returned on error.
  * ---------------------------------------------------------------------------
  */
 #ifndef SS_SCENE_H

@@ -244,6 +244,8 @@ typedef struct pendingSoil {
 
 typedef struct readCtx {
   const char *path;  /* scene path for messages */
+  const char *buf;   /* the source, [0, len): lines of values in messages */
+  size_t len;
   char dir[1024];    /* [THIS_DIR] */
   xmlDocPtr doc;
   ssModel *m;
@@ -444,13 +446,24 @@ static ssStatus get_material(readCtx *c, xEl *e, const char **out)
   return SS_OK;
 }
 
+/* The line of value `index` of attribute `name` (normalised) of e: where
+ * it stands in the source, which for an attribute over many lines (an
+ * exported height map's arrays) is not the element's line. */
+static int value_line(readCtx *c, xEl *e, const char *name, long index)
+{
+  for (int i = 0; i < e->nattr; i++)
+    if (!strcmp(e->attr[i].name, name))
+      return ss_xml_value_line(c->buf, c->len, e->node, e->attr[i].raw, index);
+  return e->line;
+}
+
 static ssStatus bad_number(readCtx *c, xEl *e, const char *name, const char *tb,
                            const char *te, long index, long n, int why)
 {
   int len = (int)(te - tb) > 40 ? 40 : (int)(te - tb);
   char where[64] = "";
   if (n > 1) snprintf(where, sizeof where, " (value %ld of %ld)", index + 1, n);
-  return fail(c, SS_ERR_PARSE, e->line,
+  return fail(c, SS_ERR_PARSE, value_line(c, e, name, index),
               "%s: bad number '%.*s'%s in attribute '%s' (%s)", e->label, len,
               tb, where, name,
               why == 2 ? "out of range" : "expected a finite decimal number");
@@ -1875,6 +1888,8 @@ static ssStatus load(const char *buf, size_t len, const char *path,
   readCtx c;
   memset(&c, 0, sizeof c);
   c.path = path;
+  c.buf = buf;
+  c.len = len;
   ss_scene_path_dir(path, c.dir, sizeof c.dir);
 
   ssCLocale loc;

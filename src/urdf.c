@@ -56,6 +56,8 @@ typedef struct uPending {
 
 typedef struct uCtx {
   const char *path;      /* for messages */
+  const char *buf;       /* the source, [0, len): lines of values */
+  size_t len;
   char dir[1024];        /* the URDF's folder */
   const char *res_dir;
   xmlDocPtr doc;
@@ -223,7 +225,8 @@ static ssStatus parse_values(uCtx *c, const xEl *e, const char *name,
       char where[64] = "";
       if (cnt > 1)
         snprintf(where, sizeof where, " (value %ld of %ld)", k + 1, cnt);
-      return fail(c, SS_ERR_PARSE, e->line,
+      return fail(c, SS_ERR_PARSE,
+                  ss_xml_value_line(c->buf, c->len, e->node, name, k),
                   "%s: bad number '%.*s'%s in attribute '%s' (%s)", e->label,
                   len, tb, where, name,
                   r == 2 ? "out of range"
@@ -1752,6 +1755,8 @@ static ssStatus load(const char *buf, size_t len, const char *path,
   uCtx c;
   memset(&c, 0, sizeof c);
   c.path = path;
+  c.buf = buf;
+  c.len = len;
   c.res_dir = res_dir;
   ss_scene_path_dir(path, c.dir, sizeof c.dir);
 

@@ -124,7 +124,8 @@
  * SS_URDF_MAX_BYTES, any DOCTYPE refused, no entity expansion, no network,
  * a deny-all external entity loader, libxml2's messages captured, never
  * printed.  Every error has file = the URDF path, line = the line of the
- * element at fault, and a message naming the element, attribute, bad value
+ * element at fault (of the bad number itself in a value over many lines,
+ * of the text for stray text), and a message naming the element, attribute, bad value
  * and what is allowed.  Nothing is returned on error.  Not safe to run
  * concurrently with other libxml2 users (libxml2's handlers are global).
  *

@@ -44,6 +44,17 @@ xmlDocPtr ss_xml_parse(const char *buf, size_t len, int huge, ssXmlResult *r);
  * line, 0 when not known. */
 int ss_xml_line(xmlNodePtr n);
 
+/* The line of value k (0-based, as ss_xml_vec_next counts them) of
+ * attribute `attr` of element el, found in the document's source buf[0,
+ * len): an attribute may run over many lines (an exported height map's
+ * arrays do), and libxml2 keeps no line for it.  The element is located as
+ * the start tag whose turn in the source is its turn in document order;
+ * whenever the source does not read as expected there (another encoding
+ * than UTF-8 or ASCII, a reference such as &#32; inside the value), the
+ * element's own line is returned. */
+int ss_xml_value_line(const char *buf, size_t len, xmlNodePtr el,
+                      const char *attr, long k);
+
 /* The text of attribute a.  A single text child is returned as is
  * (*owned = NULL); otherwise the text is built and *owned is set to it,
  * for the caller to xmlFree.  Never NULL. */
