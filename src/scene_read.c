@@ -750,6 +750,20 @@ static int quat_is_zero(const double q[4])
   return q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] < 1e-18;
 }
 
+/* A quaternion whose squared length overflows (components of 1e200) would
+ * be normalised to 0 0 0 0 and stored as the identity: divide it by its
+ * largest component first (the direction is what it says).  Ordinary
+ * quaternions are left as they are, bit for bit. */
+static void quat_rescale(double q[4])
+{
+  double n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+  if (n2 < 1e300) return;
+  double big = 0;
+  for (int k = 0; k < 4; k++) big = fmax(big, fabs(q[k]));
+  if (big > 0 && isfinite(big))
+    for (int k = 0; k < 4; k++) q[k] /= big;
+}
+
 /* A quaternion already of unit length (to 1e-14) is stored as written, so
  * that an exported state reads back bit for bit (normalising it again could
  * move the last bit). */
@@ -816,6 +830,7 @@ static ssStatus read_state(readCtx *c, xmlNodePtr n, const char *label,
   if (!st) st = get_vec(c, &e, "quat", 4, 0, def->quat);
   if (!st) st = get_vec(c, &e, "lin_vel", 3, 0, def->lin_vel);
   if (!st) st = get_vec(c, &e, "ang_vel", 3, 0, def->ang_vel);
+  if (!st) quat_rescale(def->quat);
   if (!st && quat_is_zero(def->quat))
     st = fail(c, SS_ERR_VALUE, e.line,
               "%s: quat = %g %g %g %g has zero length (quaternions are w x y z)",
@@ -1202,6 +1217,7 @@ static ssStatus read_heightmap(readCtx *c, xmlNodePtr n)
   if (!st) st = get_material(c, &e, &def.material);
   if (!st) st = get_vec(c, &e, "pos", 3, 0, def.pos);
   if (!st) st = get_vec(c, &e, "quat", 4, 0, def.quat);
+  if (!st) quat_rescale(def.quat);
   if (!st && quat_is_zero(def.quat))
     st = fail(c, SS_ERR_VALUE, e.line,
               "%s: quat = %g %g %g %g has zero length (quaternions are w x y z)",
@@ -1403,6 +1419,7 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
       if (!st) st = get_list(c, &se, "reference_qpos", &nref, &ref);
       if (!st) st = get_vec(c, &se, "pos", 3, 0, def.pos);
       if (!st) st = get_vec(c, &se, "quat", 4, 0, def.quat);
+      if (!st) quat_rescale(def.quat);
       def.pose_given = el_find(&se, "pos") || el_find(&se, "quat");
       if (!st && quat_is_zero(def.quat))
         st = fail(c, SS_ERR_VALUE, se.line, "%s: quat has zero length", se.label);

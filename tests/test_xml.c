@@ -1099,6 +1099,43 @@ static void test_massless_root(void)
   }
 }
 
+/* A quaternion of huge components means its direction: 1e300 1e300 0 0 is
+ * a half turn's half about x, not the identity its overflowing length
+ * once normalised it to (a body, a height map, an articulated base). */
+static void test_huge_quaternions(void)
+{
+  char xml[2048];
+  snprintf(xml, sizeof xml,
+           "<raisim><objects>\n"
+           "<box name=\"b\" mass=\"1\"><dim x=\"1\" y=\"1\" z=\"1\"/>"
+           "<state pos=\"0 0 1\" quat=\"1e300 1e300 0 0\"/></box>\n"
+           "<heightmap name=\"h\" x_size=\"1\" y_size=\"1\" x_sample=\"2\" "
+           "y_sample=\"2\" height=\"0 0 0 0\" quat=\"1e300 0 0 -1e300\"/>\n"
+           "<articulated_system name=\"a\" urdf_path=\"%s/tests/data/urdf/example.urdf\">"
+           "<state pos=\"0 0 1\" quat=\"1e300 0 1e300 0\"/></articulated_system>\n"
+           "</objects></raisim>\n", srcdir());
+  ssModel *m = NULL;
+  ssData *d = NULL;
+  ssError e;
+  ssStatus st = load_str(xml, &m, &d, &e);
+  if (st) diag("%s:%d: %s", e.file, e.line, e.message);
+  const double h = sqrt(0.5);
+  int b = st ? -1 : ss_model_find_sys(m, "b"), a = st ? -1 : ss_model_find_sys(m, "a");
+  const double *qb = b >= 0 ? d->qpos + m->sys_qadr[b] + 3 : NULL;
+  const double *qa = a >= 0 ? d->qpos + m->sys_qadr[a] + 3 : NULL;
+  const double *qh = st ? NULL : m->hfield_quat0;
+  ok(qb && fabs(qb[0] - h) < 1e-15 && fabs(qb[1] - h) < 1e-15 && qb[2] == 0 && qb[3] == 0,
+     "body quat 1e300 1e300 0 0 is the turn it says (%g %g %g %g)", qb ? qb[0] : 0,
+     qb ? qb[1] : 0, qb ? qb[2] : 0, qb ? qb[3] : 0);
+  ok(qh && fabs(qh[0] - h) < 1e-15 && qh[1] == 0 && qh[2] == 0 && fabs(qh[3] + h) < 1e-15,
+     "height map quat 1e300 0 0 -1e300 too");
+  ok(qa && fabs(qa[0] - h) < 1e-15 && qa[1] == 0 && fabs(qa[2] - h) < 1e-15 && qa[3] == 0,
+     "articulated base quat 1e300 0 1e300 0 too");
+  ok(st == SS_OK && ss_step(m, d, &e) == SS_OK, "and the world steps");
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 int main(void)
 {
   snprintf(tmpdir, sizeof tmpdir, "/tmp/soilsim-xml-XXXXXX");
@@ -1117,6 +1154,7 @@ int main(void)
   test_many_systems();
   test_many_pd();
   test_massless_root();
+  test_huge_quaternions();
   test_numbers();
   test_png();
   test_text();
