@@ -263,8 +263,8 @@ ssStatus ss_hfield_read_text(const char *path, int *nx, int *ny,
     if (r != 0) {
       int tl = (int)(te - tb) > 40 ? 40 : (int)(te - tb);
       ss_error_set(err, SS_ERR_PARSE, path, line,
-                   "bad number '%.*s' (height %zu) in height-map text file: %s",
-                   tl, tb, k,
+                   "bad number '%.*s' (height %zu of %zu) in height-map text "
+                   "file: %s", tl, tb, k + 1, n,
                    r == 2 ? "out of range" : "expected a finite decimal number");
       free(h);
       free(buf);
