@@ -1014,7 +1014,8 @@ static ssStatus read_joint(uCtx *c, xmlNodePtr n)
                 joint_types);
   }
   int seen_o = 0, seen_p = 0, seen_c = 0, seen_a = 0, seen_l = 0, seen_d = 0,
-      seen_m = 0, axis_line = 0, has_lo = 0, has_hi = 0, dyn_line = 0;
+      seen_m = 0, axis_line = 0, has_lo = 0, has_hi = 0, dyn_line = 0,
+      seen_cal = 0, seen_saf = 0;
   double axis[3] = {1, 0, 0};
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
     xEl x;
@@ -1072,7 +1073,21 @@ static ssStatus read_joint(uCtx *c, xmlNodePtr n)
       if (!st) st = add_pending(c, &p, x.line);
       el_free(&x);
     } else if (is_el(k, "calibration") || is_el(k, "safety_controller")) {
-      /* ROS-specific, nothing to simulate */
+      /* ROS-specific, nothing to simulate: checked as URDF has them (a
+       * typo is reported, not dropped), then not used */
+      static const char *const a_cal[] = {"rising", "falling",
+                                          "reference_position", NULL};
+      static const char *const a_saf[] = {"soft_lower_limit", "soft_upper_limit",
+                                          "k_position", "k_velocity", NULL};
+      int cal = is_el(k, "calibration");
+      const char *const *allowed = cal ? a_cal : a_saf;
+      if (!(st = open_leaf(c, k, label, allowed, &x)))
+        st = once(c, cal ? &seen_cal : &seen_saf, &x);
+      for (int i = 0; !st && allowed[i]; i++) {
+        double v = 0;
+        st = get_num(c, &x, allowed[i], 0, &v);
+      }
+      el_free(&x);
     } else {
       st = unknown_child(c, k, &e, kids);
     }

@@ -56,7 +56,9 @@
  *                               an error (friction: read, not simulated)
  *       <mimic joint=R multiplier [1] offset [0]/>  becomes an equality
  *                               closure q(this) = multiplier q(joint) + offset
- *       <calibration/>, <safety_controller/>   ignored
+ *       <calibration rising falling reference_position/>,
+ *       <safety_controller soft_lower_limit soft_upper_limit k_position
+ *                          k_velocity/>   checked (names, numbers), not used
  *     </joint>
  *     <constraints>                         (any number; RaiSim's extension)
  *       <pin name body1=R body2=R anchor=R anchor2/>   anchor in body1's
