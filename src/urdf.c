@@ -54,6 +54,15 @@ typedef struct uPending {
   const char *attr1, *attr2; /* attribute names for messages */
 } uPending;
 
+/* Names to document indices (open addressing; slot = index + 1, 0 empty),
+ * so that finding a link or joint by name does not walk all of them (a
+ * URDF of many links took time quadratic in their number). */
+typedef struct nameTab {
+  int *slot;
+  int cap;  /* a power of two, or 0 */
+  int n;
+} nameTab;
+
 typedef struct uCtx {
   const char *path;      /* for messages */
   const char *buf;       /* the source, [0, len): lines of values */
@@ -72,6 +81,7 @@ typedef struct uCtx {
   int *link_extra;       /* line of the first inertial/visual/collision */
   int njoint, capjoint;
   ssUrdfJoint *joint;
+  nameTab link_tab, joint_tab;
 
   int npend, cappend;
   uPending *pend;
@@ -835,18 +845,64 @@ static ssStatus read_inertial(uCtx *c, xmlNodePtr n, const char *label,
   return st;
 }
 
+static uint64_t name_hash(const char *s)
+{
+  uint64_t h = 1469598103934665603ULL; /* FNV-1a */
+  for (; *s; s++) h = (h ^ (unsigned char)*s) * 1099511628211ULL;
+  return h;
+}
+
+/* The name of entry i: a link's (joints == 0) or a joint's. */
+static const char *entry_name(const uCtx *c, int joints, int i)
+{
+  return joints ? c->joint[i].name : c->link[i].name;
+}
+
+/* The slot of `name` in t: its entry's, or the empty one it would take. */
+static int tab_slot(const uCtx *c, const nameTab *t, int joints,
+                    const char *name)
+{
+  unsigned mask = (unsigned)t->cap - 1;
+  unsigned k = (unsigned)name_hash(name) & mask;
+  while (t->slot[k] && strcmp(entry_name(c, joints, t->slot[k] - 1), name))
+    k = (k + 1) & mask;
+  return (int)k;
+}
+
+static int tab_find(const uCtx *c, const nameTab *t, int joints,
+                    const char *name)
+{
+  return t->cap ? t->slot[tab_slot(c, t, joints, name)] - 1 : -1;
+}
+
+/* Enter entry i under its name (not yet entered); 0, or -1 out of memory. */
+static int tab_add(const uCtx *c, nameTab *t, int joints, int i)
+{
+  if (2 * (t->n + 1) > t->cap) {
+    nameTab g = {NULL, t->cap ? 2 * t->cap : 64, 0};
+    g.slot = calloc((size_t)g.cap, sizeof *g.slot);
+    if (!g.slot) return -1;
+    for (int k = 0; k < t->cap; k++)
+      if (t->slot[k])
+        g.slot[tab_slot(c, &g, joints, entry_name(c, joints, t->slot[k] - 1))] =
+            t->slot[k];
+    g.n = t->n;
+    free(t->slot);
+    *t = g;
+  }
+  t->slot[tab_slot(c, t, joints, entry_name(c, joints, i))] = i + 1;
+  t->n++;
+  return 0;
+}
+
 static int find_link_doc(const uCtx *c, const char *name)
 {
-  for (int i = 0; i < c->nlink; i++)
-    if (!strcmp(c->link[i].name, name)) return i;
-  return -1;
+  return tab_find(c, &c->link_tab, 0, name);
 }
 
 static int find_joint_doc(const uCtx *c, const char *name)
 {
-  for (int i = 0; i < c->njoint; i++)
-    if (!strcmp(c->joint[i].name, name)) return i;
-  return -1;
+  return tab_find(c, &c->joint_tab, 1, name);
 }
 
 static ssStatus add_geom(uCtx *c, ssUrdfLink *l, int *cap, const ssUrdfGeom *g)
@@ -877,10 +933,12 @@ static ssStatus read_link(uCtx *c, xmlNodePtr n)
   l->line = e.line;
   if (!st) {
     int i = find_link_doc(c, l->name);
-    if (i >= 0 && i < c->nlink - 1)
+    if (i >= 0)
       st = fail(c, SS_ERR_PARSE, e.line,
                 "duplicate link name '%s' (first at line %d)", l->name,
                 c->link[i].line);
+    else if (tab_add(c, &c->link_tab, 0, c->nlink - 1))
+      st = nomem(c, e.line);
   }
   char label[NAME_LEN + 16];
   snprintf(label, sizeof label, "link '%s'", l->name);
@@ -987,10 +1045,12 @@ static ssStatus read_joint(uCtx *c, xmlNodePtr n)
   j->line = e.line;
   if (!st) {
     int i = find_joint_doc(c, j->name);
-    if (i >= 0 && i < c->njoint - 1)
+    if (i >= 0)
       st = fail(c, SS_ERR_PARSE, e.line,
                 "duplicate joint name '%s' (first at line %d)", j->name,
                 c->joint[i].line);
+    else if (tab_add(c, &c->joint_tab, 1, c->njoint - 1))
+      st = nomem(c, e.line);
   }
   char label[NAME_LEN + 16];
   snprintf(label, sizeof label, "joint '%s'", j->name);
@@ -1749,6 +1809,8 @@ static void ctx_free(uCtx *c)
   free(c->joint);
   free(c->mat);
   free(c->pend);
+  free(c->link_tab.slot);
+  free(c->joint_tab.slot);
   if (c->doc) xmlFreeDoc(c->doc);
   memset(c, 0, sizeof *c);
 }

@@ -1124,12 +1124,58 @@ static void test_floating_root(void)
   ss_urdf_free(u);
 }
 
+/* CPU seconds to read a chain of n links on fixed joints (the best of
+ * two), or -1 when it does not load. */
+static double chain_seconds(int n)
+{
+  size_t cap = (size_t)n * 120 + 64, k = 0;
+  char *buf = malloc(cap);
+  if (!buf) return -1;
+  k += (size_t)snprintf(buf + k, cap - k, "<robot name=\"chain\">\n");
+  for (int i = 0; i <= n; i++)
+    k += (size_t)snprintf(buf + k, cap - k, "<link name=\"l%d\"/>\n", i);
+  for (int i = 1; i <= n; i++)
+    k += (size_t)snprintf(buf + k, cap - k,
+                          "<joint name=\"j%d\" type=\"fixed\"><parent link=\"l%d\"/>"
+                          "<child link=\"l%d\"/></joint>\n", i, i - 1, i);
+  k += (size_t)snprintf(buf + k, cap - k, "</robot>\n");
+  double best = -1;
+  for (int rep = 0; rep < 2; rep++) {
+    ssUrdf *u = NULL;
+    ssError e;
+    clock_t t0 = clock();
+    ssStatus st = ss_urdf_load_buffer(buf, k, "chain.urdf", NULL, &u, &e);
+    double t = (double)(clock() - t0) / CLOCKS_PER_SEC;
+    int good = st == SS_OK && u->nlink == n + 1;
+    ss_urdf_free(u);
+    if (!good) {
+      best = -1;
+      break;
+    }
+    if (best < 0 || t < best) best = t;
+  }
+  free(buf);
+  return best;
+}
+
+/* Links and joints are found by name in constant time: eight times the
+ * links take about eight times as long to read, not 64 (a 64 MiB URDF of
+ * short links once took hours). */
+static void test_many_links(void)
+{
+  double t1 = chain_seconds(4000), t8 = chain_seconds(32000);
+  ok(t1 >= 0 && t8 >= 0 && t8 < 24 * fmax(t1, 1e-3),
+     "reading 32000 links takes less than 24 times as long as 4000 (%.3f s, "
+     "%.3f s)", t8, t1);
+}
+
 int main(void)
 {
   test_fourbar();
   test_example();
   test_world();
   test_floating_root();
+  test_many_links();
   test_paths();
   test_locale();
   test_size_cap();
