@@ -469,11 +469,10 @@ static ssStatus bad_number(readCtx *c, xEl *e, const char *name, const char *tb,
               why == 2 ? "out of range" : "expected a finite decimal number");
 }
 
-/* Parse exactly n values of attribute `name` into out; `what` describes
- * the expected count for messages (NULL: just the number). */
-static ssStatus parse_values(readCtx *c, xEl *e, const char *name,
-                             const char *v, long n, const char *what,
-                             double *out)
+/* Check that attribute `name` (value v) has exactly n values; `what`
+ * describes the expected count for messages (NULL: just the number). */
+static ssStatus check_count(readCtx *c, xEl *e, const char *name,
+                            const char *v, long n, const char *what)
 {
   long got = ss_xml_vec_count(v);
   if (got < 0)
@@ -489,6 +488,16 @@ static ssStatus parse_values(readCtx *c, xEl *e, const char *name,
                 "%s: attribute '%s' has %ld value%s, expected %ld", e->label,
                 name, got, got == 1 ? "" : "s", n);
   }
+  return SS_OK;
+}
+
+/* Parse exactly n values of attribute `name` into out (check_count). */
+static ssStatus parse_values(readCtx *c, xEl *e, const char *name,
+                             const char *v, long n, const char *what,
+                             double *out)
+{
+  ssStatus st = check_count(c, e, name, v, n, what);
+  if (st) return st;
   const char *p = v, *tb = NULL, *te = NULL;
   for (long k = 0; k < n; k++) {
     ss_xml_vec_next(&p, k == 0, &tb, &te);
@@ -520,6 +529,9 @@ static ssStatus get_array(readCtx *c, xEl *e, const char *name, long n,
   *out = NULL;
   const char *v = el_find(e, name);
   if (!v) return required ? missing(c, e, name) : SS_OK;
+  /* the count first: a short attribute never costs n doubles */
+  ssStatus cs = check_count(c, e, name, v, n, what);
+  if (cs) return cs;
   double *a = malloc((size_t)(n > 0 ? n : 1) * sizeof *a);
   if (!a) return fail(c, SS_ERR_NOMEM, e->line, "out of memory");
   ssStatus st = parse_values(c, e, name, v, n, what, a);

@@ -21,7 +21,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -1136,6 +1138,48 @@ static void test_huge_quaternions(void)
   ss_model_free(m);
 }
 
+/* An array attribute's count is checked before its memory is taken: a
+ * one-number height for 10^8 vertices is "has 1 values, expected ...",
+ * even where 800 MB cannot be had (it was "out of memory").  Run in a
+ * child whose address space is capped 300 MB above what it uses. */
+static void test_count_before_alloc(void)
+{
+  static const char xml[] =
+      "<raisim><objects><heightmap name=\"h\" x_size=\"1\" y_size=\"1\" "
+      "x_sample=\"10000\" y_sample=\"10000\" height=\"0\"/></objects></raisim>";
+  fflush(stdout);
+  pid_t pid = fork();
+  if (pid == 0) {
+    long pages = 0;
+    FILE *f = fopen("/proc/self/statm", "r");
+    if (!f || fscanf(f, "%ld", &pages) != 1) _exit(77);
+    fclose(f);
+    rlim_t cap = (rlim_t)pages * (rlim_t)sysconf(_SC_PAGESIZE) + ((rlim_t)300 << 20);
+    struct rlimit r = {cap, cap};
+    if (setrlimit(RLIMIT_AS, &r) != 0) _exit(77);
+    void *probe = malloc(16 << 20); /* a checker's allocator may not cope */
+    if (!probe) _exit(77);
+    free(probe);
+    ssModel *m = NULL;
+    ssData *d = NULL;
+    ssError e;
+    ssStatus st = ss_scene_load_buffer(xml, sizeof xml - 1, "mem.xml", &m, &d, &e);
+    _exit(st != SS_OK && strstr(e.message, "has 1 values, expected") ? 0 : 1);
+  }
+  int status = 0;
+  if (pid < 0 || waitpid(pid, &status, 0) != pid || !WIFEXITED(status)) {
+    ok(0, "a short height array for 10^8 vertices: the check ran");
+    return;
+  }
+  if (WEXITSTATUS(status) == 77) {
+    ok(1, "# SKIP the address space cannot be capped here");
+    return;
+  }
+  ok(WEXITSTATUS(status) == 0,
+     "a short height array for 10^8 vertices is reported as such within "
+     "300 MB (its count is checked before 800 MB are allocated)");
+}
+
 int main(void)
 {
   snprintf(tmpdir, sizeof tmpdir, "/tmp/soilsim-xml-XXXXXX");
@@ -1155,6 +1199,7 @@ int main(void)
   test_many_pd();
   test_massless_root();
   test_huge_quaternions();
+  test_count_before_alloc();
   test_numbers();
   test_png();
   test_text();
