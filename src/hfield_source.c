@@ -198,7 +198,9 @@ ssStatus ss_hfield_read_text(const char *path, int *nx, int *ny,
   ssStatus st = ss_read_file(path, SS_SCENE_MAX_BYTES, &buf, &len, err);
   if (st != SS_OK) return st;
 
-  textScan s = {buf, buf + len, 1, 0, 0};
+  /* a UTF-8 byte order mark (as Windows editors write) is no number */
+  size_t bom = len >= 3 && !memcmp(buf, "\xef\xbb\xbf", 3) ? 3 : 0;
+  textScan s = {buf + bom, buf + len, 1, 0, 0};
   const char *tb, *te;
   int line = 1;
   long dims[2];

@@ -99,7 +99,8 @@
  *              separated by white space or by one comma (",," or a comma
  *              before the first or after the last number is an empty
  *              value, an error, as in vectors), '#' starting a comment
- *              that runs to the end of the line.  The first two numbers
+ *              that runs to the end of the line (a UTF-8 byte order mark
+ *              at the start is skipped).  The first two numbers
  *              are the integers nx ny (by convention the first line), then
  *              nx*ny heights in the order of `height` (x fastest, first row
  *              on the -y edge).

@@ -595,6 +595,31 @@ static void test_text(void)
      "text: sizes from the attributes, rigid without <soil>");
   ss_data_free(d);
   ss_model_free(m);
+
+  /* the same file saved with a UTF-8 byte order mark reads the same */
+  char txt[512], *body = NULL;
+  snprintf(txt, sizeof txt, "%s/tests/data/hfield_4x3.txt", srcdir());
+  body = slurp(txt, NULL);
+  char bom_txt[512], bom_xml[512], xml[1024];
+  tmp_path(bom_txt, sizeof bom_txt, "bom.txt");
+  tmp_path(bom_xml, sizeof bom_xml, "bom.xml");
+  FILE *f = body ? fopen(bom_txt, "wb") : NULL;
+  int made = f && fputs("\xef\xbb\xbf", f) >= 0 && fputs(body, f) >= 0;
+  if (f) made &= fclose(f) == 0;
+  snprintf(xml, sizeof xml, "<raisim><objects><heightmap name=\"bumps\" text=\"bom.txt\" "
+           "x_size=\"3\" y_size=\"2\"/></objects></raisim>\n");
+  made = made && write_file(bom_xml, xml) == 0;
+  m = NULL;
+  d = NULL;
+  st = made ? ss_scene_load(bom_xml, &m, &d, &e) : SS_ERR_IO;
+  if (st) diag("%s:%d: %s", e.file, e.line, e.message);
+  ok(st == SS_OK && m->hfield_nx[0] == 4 && same_bits(m->hfield_data, want, 12),
+     "text: a file starting with a UTF-8 byte order mark reads the same");
+  ss_data_free(d);
+  ss_model_free(m);
+  free(body);
+  unlink(bom_txt);
+  unlink(bom_xml);
 }
 
 static void test_generated(void)
