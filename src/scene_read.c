@@ -1402,6 +1402,7 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
   if (!st) st = el_allow(c, &e, allowed);
   const char *name = NULL, *raw = NULL, *res = NULL, *base = NULL, *mat = NULL;
   if (!st) st = get_str(c, &e, "name", 1, &name);
+  if (!st) snprintf(e.label, sizeof e.label, "%s '%.100s'", e.name, name);
   if (!st) st = get_str(c, &e, "urdf_path", 1, &raw);
   if (!st) st = get_str(c, &e, "res_dir", 0, &res);
   if (!st) st = get_str(c, &e, "base", 0, &base);
@@ -1481,8 +1482,8 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
       if (ue.line > 0)
         c->e = ue;
       else
-        fail(c, ue.code, e.line, "%s '%s': cannot load URDF %s: %s", e.label,
-             name, path, ue.message);
+        fail(c, ue.code, e.line, "%s: cannot load URDF %s: %s", e.label,
+             path, ue.message);
       st = ue.code;
     }
   }
