@@ -47,7 +47,8 @@
  *       <ground name=R height [0] material [default]/>
  *       <box|sphere|cylinder|capsule name=R mass=R(dynamic; static: optional,
  *            > 0) material body_type [dynamic|static] rgba="r g b a" (each
- *            in [0, 1])>   (a static body: no velocity, no external force)
+ *            in [0, 1], a > 0)>   (a static body: no velocity, no external
+ *            force)
  *         <dim .../>R   box: x y z (full edges); sphere: radius;
  *                       cylinder, capsule: radius height (along local z)
  *         <state pos [0 0 0] quat [1 0 0 0] lin_vel [0] ang_vel [0]/>

@@ -981,6 +981,13 @@ static ssStatus read_body(readCtx *c, xmlNodePtr n, ssGeomType shape)
         st = fail(c, SS_ERR_VALUE, e.line,
                   "%s: rgba component %d = %g is invalid: must be in [0, 1]",
                   e.label, k + 1, def.rgba[k]);
+    /* the model takes alpha 0 for "no colour given" and draws the body in
+     * its default colour: an invisible body cannot be asked for */
+    if (!st && def.rgba[3] == 0)
+      st = fail(c, SS_ERR_VALUE, e.line,
+                "%s: rgba alpha (component 4) = 0 is invalid: must be in (0, "
+                "1] (bodies are drawn opaque at 1, translucent below; leave "
+                "rgba out for the default colour)", e.label);
   }
   if (!st && is_mesh) {
     const char *raw = NULL;
