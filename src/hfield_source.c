@@ -127,16 +127,28 @@ void ss_terrain_generate(const ssTerrainProps *p, double *height)
 typedef struct textScan {
   const char *p, *end;
   int line;
+  int any;   /* a token was read */
+  int comma; /* the line of a comma passed since the last token, or 0 */
 } textScan;
 
 /* Next token (a run of characters that are neither white space, ',' nor
- * '#'); comments and separators skipped.  Returns 0 at the end. */
+ * '#'); comments and separators skipped.  Returns 1 with the token, 0 at
+ * the end, -1 at an empty value (a comma before the first token, after
+ * another comma or after the last token) with *line that comma's line. */
 static int next_token(textScan *s, const char **tb, const char **te, int *line)
 {
   const char *p = s->p;
   for (;;) {
     while (p < s->end && (*p == ' ' || *p == '\t' || *p == '\r' ||
                           *p == '\n' || *p == ',' || *p == '\f' || *p == '\v')) {
+      if (*p == ',') {
+        if (s->comma || !s->any) {
+          *line = s->line;
+          s->p = p;
+          return -1;
+        }
+        s->comma = s->line;
+      }
       if (*p == '\n') s->line++;
       p++;
     }
@@ -148,6 +160,10 @@ static int next_token(textScan *s, const char **tb, const char **te, int *line)
   }
   if (p >= s->end) {
     s->p = p;
+    if (s->comma) {
+      *line = s->comma;
+      return -1;
+    }
     return 0;
   }
   *tb = p;
@@ -157,7 +173,19 @@ static int next_token(textScan *s, const char **tb, const char **te, int *line)
   *te = p;
   *line = s->line;
   s->p = p;
+  s->any = 1;
+  s->comma = 0;
   return 1;
+}
+
+/* The error for next_token's -1. */
+static ssStatus empty_value(const char *path, int line, ssError *err)
+{
+  return ss_error_set(err, SS_ERR_PARSE, path, line,
+                      "empty value in height-map text file: a comma with no "
+                      "number on one side (numbers are separated by white "
+                      "space or by one comma; none before the first or after "
+                      "the last)");
 }
 
 ssStatus ss_hfield_read_text(const char *path, int *nx, int *ny,
@@ -170,12 +198,19 @@ ssStatus ss_hfield_read_text(const char *path, int *nx, int *ny,
   ssStatus st = ss_read_file(path, SS_SCENE_MAX_BYTES, &buf, &len, err);
   if (st != SS_OK) return st;
 
-  textScan s = {buf, buf + len, 1};
+  /* a UTF-8 byte order mark (as Windows editors write) is no number */
+  size_t bom = len >= 3 && !memcmp(buf, "\xef\xbb\xbf", 3) ? 3 : 0;
+  textScan s = {buf + bom, buf + len, 1, 0, 0};
   const char *tb, *te;
   int line = 1;
   long dims[2];
   for (int k = 0; k < 2; k++) {
-    if (!next_token(&s, &tb, &te, &line)) {
+    int got = next_token(&s, &tb, &te, &line);
+    if (got < 0) {
+      free(buf);
+      return empty_value(path, line, err);
+    }
+    if (!got) {
       free(buf);
       return ss_error_set(err, SS_ERR_PARSE, path, s.line,
                           "height-map text file ends before its size: it "
@@ -205,7 +240,12 @@ ssStatus ss_hfield_read_text(const char *path, int *nx, int *ny,
    * allocation */
   textScan c = s;
   size_t count = 0;
-  while (next_token(&c, &tb, &te, &line)) count++;
+  int got;
+  while ((got = next_token(&c, &tb, &te, &line)) > 0) count++;
+  if (got < 0) {
+    free(buf);
+    return empty_value(path, line, err);
+  }
   if (count != n) {
     free(buf);
     return ss_error_set(err, SS_ERR_PARSE, path, c.line,
@@ -225,8 +265,8 @@ ssStatus ss_hfield_read_text(const char *path, int *nx, int *ny,
     if (r != 0) {
       int tl = (int)(te - tb) > 40 ? 40 : (int)(te - tb);
       ss_error_set(err, SS_ERR_PARSE, path, line,
-                   "bad number '%.*s' (height %zu) in height-map text file: %s",
-                   tl, tb, k,
+                   "bad number '%.*s' (height %zu of %zu) in height-map text "
+                   "file: %s", tl, tb, k + 1, n,
                    r == 2 ? "out of range" : "expected a finite decimal number");
       free(h);
       free(buf);

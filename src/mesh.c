@@ -22,13 +22,16 @@
 #include "mesh.h"
 #include "ss_math.h"
 
+#include <assimp/cfileio.h>
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
 #include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -221,6 +224,102 @@ static ssStatus build_bvh(ssMesh *m, ssError *err, const char *what)
   int *bc = realloc(m->bvh_child, (size_t)m->nnode * 2 * sizeof *bc);
   if (bc) m->bvh_child = bc;
   return SS_OK;
+}
+
+/* ---------------------------------------------------------------------- */
+/* assimp's file access                                                    */
+
+/* Every file assimp opens for an import goes through these: the mesh file
+ * and what it names (an OBJ's mtllib, a glTF's buffers, ...).  Only a
+ * regular file of at most MESH_MAX_BYTES is opened, and for reading only:
+ * a FIFO or a device named inside a mesh file is refused at once instead
+ * of waited on (opened without O_NONBLOCK, a FIFO blocks until a writer
+ * comes, so the import would hang), and a huge or endless one is never
+ * read into memory.  Refused, the file is missing to assimp. */
+static FILE *file_of(struct aiFile *f) { return (FILE *)(void *)f->UserData; }
+
+static size_t io_read(struct aiFile *f, char *buf, size_t size, size_t count)
+{
+  return fread(buf, size, count, file_of(f));
+}
+
+static size_t io_write(struct aiFile *f, const char *buf, size_t size,
+                       size_t count)
+{
+  (void)f;
+  (void)buf;
+  (void)size;
+  (void)count;
+  return 0;
+}
+
+static size_t io_tell(struct aiFile *f)
+{
+  off_t t = ftello(file_of(f));
+  return t < 0 ? 0 : (size_t)t;
+}
+
+static size_t io_size(struct aiFile *f)
+{
+  struct stat sb;
+  return fstat(fileno(file_of(f)), &sb) == 0 && sb.st_size > 0
+             ? (size_t)sb.st_size
+             : 0;
+}
+
+static enum aiReturn io_seek(struct aiFile *f, size_t off, enum aiOrigin o)
+{
+  int whence = o == aiOrigin_CUR ? SEEK_CUR : o == aiOrigin_END ? SEEK_END
+                                                                : SEEK_SET;
+  /* a backward move arrives as a wrapped size_t */
+  off_t d = whence == SEEK_SET ? (off_t)off : (off_t)(long long)off;
+  if (whence == SEEK_SET && off > (size_t)MESH_MAX_BYTES) return aiReturn_FAILURE;
+  return fseeko(file_of(f), d, whence) == 0 ? aiReturn_SUCCESS
+                                            : aiReturn_FAILURE;
+}
+
+static void io_flush(struct aiFile *f) { (void)f; }
+
+static struct aiFile *io_open(struct aiFileIO *io, const char *name,
+                              const char *mode)
+{
+  (void)io;
+  if (!name || !mode || strchr(mode, 'w') || strchr(mode, 'a') ||
+      strchr(mode, '+'))
+    return NULL;
+  int fd = open(name, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return NULL;
+  struct stat sb;
+  int flags = fcntl(fd, F_GETFL);
+  if (fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode) ||
+      (long long)sb.st_size > MESH_MAX_BYTES || flags < 0 ||
+      fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0) {
+    close(fd);
+    return NULL;
+  }
+  FILE *fp = fdopen(fd, "rb");
+  struct aiFile *f = fp ? calloc(1, sizeof *f) : NULL;
+  if (!f) {
+    if (fp) fclose(fp);
+    else close(fd);
+    return NULL;
+  }
+  f->ReadProc = io_read;
+  f->WriteProc = io_write;
+  f->TellProc = io_tell;
+  f->FileSizeProc = io_size;
+  f->SeekProc = io_seek;
+  f->FlushProc = io_flush;
+  f->UserData = (aiUserData)(void *)fp;
+  return f;
+}
+
+static void io_close(struct aiFileIO *io, struct aiFile *f)
+{
+  (void)io;
+  if (!f) return;
+  fclose(file_of(f));
+  free(f);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -469,11 +568,13 @@ ssStatus ss_mesh_load(const char *path, const double scale[3], ssMesh **out,
     return ss_error_set(err, SS_ERR_IO, path, 0, "cannot read mesh: %s",
                         strerror(errno));
 
-  /* no logger is attached: assimp prints nothing */
-  const struct aiScene *sc = aiImportFile(
+  /* no logger is attached: assimp prints nothing; it reads files through
+   * io_open only */
+  struct aiFileIO io = {io_open, io_close, NULL};
+  const struct aiScene *sc = aiImportFileEx(
       path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
                 aiProcess_GenSmoothNormals | aiProcess_PreTransformVertices |
-                aiProcess_ValidateDataStructure);
+                aiProcess_ValidateDataStructure, &io);
   if (!sc) {
     const char *why = aiGetErrorString();
     return ss_error_set(err, SS_ERR_PARSE, path, 0, "cannot load mesh: %s",

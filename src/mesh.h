@@ -40,7 +40,9 @@ typedef struct ssMesh {
  * per axis (scale NULL: 1 1 1; each value non-zero; a mirroring scale keeps
  * the winding counter-clockwise), with a BVH.  Points and lines are
  * dropped; at most 10 million triangles.  Errors name the path and what
- * assimp said; nothing is printed. */
+ * assimp said; nothing is printed.  The file and every file it names (an
+ * OBJ's mtllib, a glTF's buffers) are opened only when they are regular
+ * files of at most 512 MiB: a FIFO or device is never waited on. */
 ssStatus ss_mesh_load(const char *path, const double scale[3], ssMesh **out,
                       ssError *err);
 /* Build a mesh from arrays (copies them) -- for tests and generators. */

@@ -10,7 +10,9 @@
  * camelCase: an upper-case letter stands for '_' plus its lower-case form
  * (xSize = x_size, centerX = center_x, linVel = lin_vel, bodyType =
  * body_type, articulatedSystem = articulated_system, pairProp = pair_prop).
- * `timestep` is a third spelling of time_step.  Giving one attribute twice
+ * Nothing else: a camelCase name starts with a lower-case letter and has no
+ * '_' and no two capitals in a row, so Box, TimeStep, x_Size and MASS are
+ * unknown names.  `timestep` is a third spelling of time_step.  Giving one attribute twice
  * in two spellings is an error.  Unknown elements and attributes are errors;
  * so is non-blank text inside an element.  Comments are ignored.
  *
@@ -45,7 +47,8 @@
  *       <ground name=R height [0] material [default]/>
  *       <box|sphere|cylinder|capsule name=R mass=R(dynamic; static: optional,
  *            > 0) material body_type [dynamic|static] rgba="r g b a" (each
- *            in [0, 1])>   (a static body: no velocity, no external force)
+ *            in [0, 1], a > 0)>   (a static body: no velocity, no external
+ *            force)
  *         <dim .../>R   box: x y z (full edges); sphere: radius;
  *                       cylinder, capsule: radius height (along local z)
  *         <state pos [0 0 0] quat [1 0 0 0] lin_vel [0] ang_vel [0]/>
@@ -94,8 +97,11 @@
  *              (the far side) and image column 0 the -x edge, so the picture
  *              looks like the bed seen from above with +x right, +y up.
  *   text       text="file"R x_size=R y_size=R: a text file of numbers
- *              separated by white space or commas, '#' starting a comment
- *              that runs to the end of the line.  The first two numbers
+ *              separated by white space or by one comma (",," or a comma
+ *              before the first or after the last number is an empty
+ *              value, an error, as in vectors), '#' starting a comment
+ *              that runs to the end of the line (a UTF-8 byte order mark
+ *              at the start is skipped).  The first two numbers
  *              are the integers nx ny (by convention the first line), then
  *              nx*ny heights in the order of `height` (x fastest, first row
  *              on the -y edge).
@@ -129,8 +135,10 @@
  * loading is not safe to run concurrently with other libxml2 users.
  *
  * Errors.  Every error carries file = the scene path (as given) and line =
- * the line of the element at fault, and a message naming the object,
- * element or attribute and what is allowed.  Nothing is returned on error.
+ * the line of the element at fault (where its start tag begins; for a bad
+ * number, the line the number stands on, which in an attribute over many
+ * lines is a later one; for stray text, the line of the text), and a
+ * message naming the object, element or attribute and what is allowed.  Nothing is returned on error.
  * ---------------------------------------------------------------------------
  */
 #ifndef SS_SCENE_H

@@ -244,15 +244,17 @@ typedef struct pendingSoil {
 
 typedef struct readCtx {
   const char *path;  /* scene path for messages */
+  const char *buf;   /* the source, [0, len): lines of values in messages */
+  size_t len;
   char dir[1024];    /* [THIS_DIR] */
   xmlDocPtr doc;
   ssModel *m;
   ssError e;
   int npend, cappend;
   pendingSoil *pend;
-  int nqpend;
-  int qpend_sys[64];
-  double *qpend[64];   /* state qpos applied after the data exists */
+  int nqpend, capqpend;
+  int *qpend_sys;      /* (nqpend) systems whose qpos is applied after */
+  double **qpend;      /* (nqpend) the data exists: that qpos, owned */
   int clock_given;
   double clock_time;
   long clock_step;
@@ -311,19 +313,30 @@ typedef struct xEl {
   xmlChar *owned[MAX_ATTR];
 } xEl;
 
-/* camelCase -> snake_case; `timestep` -> time_step.  Names too long for
- * the buffer become "?" (never a valid name). */
+static int is_upper(char ch) { return ch >= 'A' && ch <= 'Z'; }
+
+/* camelCase -> snake_case; `timestep` -> time_step.  A name is one of the
+ * two spellings: snake_case (no capital letter) or camelCase (a lower-case
+ * first letter, no '_', no two capitals in a row); any other (`Box`,
+ * `x_Size`, `XSIZE`) and names too long for the buffer become "?" (never
+ * a valid name: reported as unknown under the name as written). */
 static void norm_name(const char *in, char out[NAME_CAP])
 {
+  int camel = 0;
+  for (const char *p = in; *p; p++) camel |= is_upper(*p);
+  if (camel && (!(in[0] >= 'a' && in[0] <= 'z') || strchr(in, '_'))) {
+    strcpy(out, "?");
+    return;
+  }
   size_t k = 0;
   for (const char *p = in; *p; p++) {
     char ch = *p;
-    if (k + 3 >= NAME_CAP) {
+    if (k + 3 >= NAME_CAP || (is_upper(ch) && is_upper(p[1]))) {
       strcpy(out, "?");
       return;
     }
-    if (ch >= 'A' && ch <= 'Z') {
-      if (k > 0 && out[k - 1] != '_') out[k++] = '_';
+    if (is_upper(ch)) {
+      out[k++] = '_';
       out[k++] = (char)(ch - 'A' + 'a');
     } else {
       out[k++] = ch;
@@ -374,7 +387,8 @@ static ssStatus el_open(readCtx *c, xmlNodePtr node, const char *parent_label,
     norm_name(x->raw, x->name);
     x->val = ss_xml_attr_text(c->doc, a, &e->owned[e->nattr]);
     e->nattr++;
-    for (int i = 0; i < e->nattr - 1; i++)
+    /* "?" (not a name of either spelling) is reported as unknown below */
+    for (int i = 0; i < e->nattr - 1 && strcmp(x->name, "?"); i++)
       if (!strcmp(e->attr[i].name, x->name))
         return fail(c, SS_ERR_PARSE, e->line,
                     "%s: attribute '%s' given twice (as '%s' and '%s')",
@@ -432,23 +446,33 @@ static ssStatus get_material(readCtx *c, xEl *e, const char **out)
   return SS_OK;
 }
 
+/* The line of value `index` of attribute `name` (normalised) of e: where
+ * it stands in the source, which for an attribute over many lines (an
+ * exported height map's arrays) is not the element's line. */
+static int value_line(readCtx *c, xEl *e, const char *name, long index)
+{
+  for (int i = 0; i < e->nattr; i++)
+    if (!strcmp(e->attr[i].name, name))
+      return ss_xml_value_line(c->buf, c->len, e->node, e->attr[i].raw, index);
+  return e->line;
+}
+
 static ssStatus bad_number(readCtx *c, xEl *e, const char *name, const char *tb,
                            const char *te, long index, long n, int why)
 {
   int len = (int)(te - tb) > 40 ? 40 : (int)(te - tb);
   char where[64] = "";
   if (n > 1) snprintf(where, sizeof where, " (value %ld of %ld)", index + 1, n);
-  return fail(c, SS_ERR_PARSE, e->line,
+  return fail(c, SS_ERR_PARSE, value_line(c, e, name, index),
               "%s: bad number '%.*s'%s in attribute '%s' (%s)", e->label, len,
               tb, where, name,
               why == 2 ? "out of range" : "expected a finite decimal number");
 }
 
-/* Parse exactly n values of attribute `name` into out; `what` describes
- * the expected count for messages (NULL: just the number). */
-static ssStatus parse_values(readCtx *c, xEl *e, const char *name,
-                             const char *v, long n, const char *what,
-                             double *out)
+/* Check that attribute `name` (value v) has exactly n values; `what`
+ * describes the expected count for messages (NULL: just the number). */
+static ssStatus check_count(readCtx *c, xEl *e, const char *name,
+                            const char *v, long n, const char *what)
 {
   long got = ss_xml_vec_count(v);
   if (got < 0)
@@ -464,6 +488,16 @@ static ssStatus parse_values(readCtx *c, xEl *e, const char *name,
                 "%s: attribute '%s' has %ld value%s, expected %ld", e->label,
                 name, got, got == 1 ? "" : "s", n);
   }
+  return SS_OK;
+}
+
+/* Parse exactly n values of attribute `name` into out (check_count). */
+static ssStatus parse_values(readCtx *c, xEl *e, const char *name,
+                             const char *v, long n, const char *what,
+                             double *out)
+{
+  ssStatus st = check_count(c, e, name, v, n, what);
+  if (st) return st;
   const char *p = v, *tb = NULL, *te = NULL;
   for (long k = 0; k < n; k++) {
     ss_xml_vec_next(&p, k == 0, &tb, &te);
@@ -495,6 +529,9 @@ static ssStatus get_array(readCtx *c, xEl *e, const char *name, long n,
   *out = NULL;
   const char *v = el_find(e, name);
   if (!v) return required ? missing(c, e, name) : SS_OK;
+  /* the count first: a short attribute never costs n doubles */
+  ssStatus cs = check_count(c, e, name, v, n, what);
+  if (cs) return cs;
   double *a = malloc((size_t)(n > 0 ? n : 1) * sizeof *a);
   if (!a) return fail(c, SS_ERR_NOMEM, e->line, "out of memory");
   ssStatus st = parse_values(c, e, name, v, n, what, a);
@@ -725,6 +762,20 @@ static int quat_is_zero(const double q[4])
   return q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] < 1e-18;
 }
 
+/* A quaternion whose squared length overflows (components of 1e200) would
+ * be normalised to 0 0 0 0 and stored as the identity: divide it by its
+ * largest component first (the direction is what it says).  Ordinary
+ * quaternions are left as they are, bit for bit. */
+static void quat_rescale(double q[4])
+{
+  double n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+  if (n2 < 1e300) return;
+  double big = 0;
+  for (int k = 0; k < 4; k++) big = fmax(big, fabs(q[k]));
+  if (big > 0 && isfinite(big))
+    for (int k = 0; k < 4; k++) q[k] /= big;
+}
+
 /* A quaternion already of unit length (to 1e-14) is stored as written, so
  * that an exported state reads back bit for bit (normalising it again could
  * move the last bit). */
@@ -791,6 +842,7 @@ static ssStatus read_state(readCtx *c, xmlNodePtr n, const char *label,
   if (!st) st = get_vec(c, &e, "quat", 4, 0, def->quat);
   if (!st) st = get_vec(c, &e, "lin_vel", 3, 0, def->lin_vel);
   if (!st) st = get_vec(c, &e, "ang_vel", 3, 0, def->ang_vel);
+  if (!st) quat_rescale(def->quat);
   if (!st && quat_is_zero(def->quat))
     st = fail(c, SS_ERR_VALUE, e.line,
               "%s: quat = %g %g %g %g has zero length (quaternions are w x y z)",
@@ -859,7 +911,7 @@ static ssStatus get_mesh_scale(readCtx *c, xEl *e, double s[3])
   const char *v = el_find(e, "scale");
   if (!v) return SS_OK;
   long n = ss_xml_vec_count(v);
-  if (n > 0 && n != 1 && n != 3)
+  if (n >= 0 && n != 1 && n != 3)
     return fail(c, SS_ERR_PARSE, e->line,
                 "%s: attribute 'scale' has %ld values, expected 1 (all axes) "
                 "or 3 (x y z)", e->label, n);
@@ -929,6 +981,13 @@ static ssStatus read_body(readCtx *c, xmlNodePtr n, ssGeomType shape)
         st = fail(c, SS_ERR_VALUE, e.line,
                   "%s: rgba component %d = %g is invalid: must be in [0, 1]",
                   e.label, k + 1, def.rgba[k]);
+    /* the model takes alpha 0 for "no colour given" and draws the body in
+     * its default colour: an invisible body cannot be asked for */
+    if (!st && def.rgba[3] == 0)
+      st = fail(c, SS_ERR_VALUE, e.line,
+                "%s: rgba alpha (component 4) = 0 is invalid: must be in (0, "
+                "1] (bodies are drawn opaque at 1, translucent below; leave "
+                "rgba out for the default colour)", e.label);
   }
   if (!st && is_mesh) {
     const char *raw = NULL;
@@ -1177,6 +1236,7 @@ static ssStatus read_heightmap(readCtx *c, xmlNodePtr n)
   if (!st) st = get_material(c, &e, &def.material);
   if (!st) st = get_vec(c, &e, "pos", 3, 0, def.pos);
   if (!st) st = get_vec(c, &e, "quat", 4, 0, def.quat);
+  if (!st) quat_rescale(def.quat);
   if (!st && quat_is_zero(def.quat))
     st = fail(c, SS_ERR_VALUE, e.line,
               "%s: quat = %g %g %g %g has zero length (quaternions are w x y z)",
@@ -1316,9 +1376,15 @@ static ssStatus read_heightmap(readCtx *c, xmlNodePtr n)
 
 static ssStatus pend_qpos(readCtx *c, int sys, double *q, int line)
 {
-  if (c->nqpend == 64)
-    return fail(c, SS_ERR_VALUE, line, "at most 64 articulated systems with a "
-                "reference_qpos per scene");
+  if (c->nqpend == c->capqpend) {
+    int cap = c->capqpend ? 2 * c->capqpend : 8;
+    int *ps = realloc(c->qpend_sys, (size_t)cap * sizeof *ps);
+    if (ps) c->qpend_sys = ps;
+    double **pq = ps ? realloc(c->qpend, (size_t)cap * sizeof *pq) : NULL;
+    if (!pq) return fail(c, SS_ERR_NOMEM, line, "out of memory");
+    c->qpend = pq;
+    c->capqpend = cap;
+  }
   c->qpend_sys[c->nqpend] = sys;
   c->qpend[c->nqpend++] = q;
   return SS_OK;
@@ -1343,6 +1409,7 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
   if (!st) st = el_allow(c, &e, allowed);
   const char *name = NULL, *raw = NULL, *res = NULL, *base = NULL, *mat = NULL;
   if (!st) st = get_str(c, &e, "name", 1, &name);
+  if (!st) snprintf(e.label, sizeof e.label, "%s '%.100s'", e.name, name);
   if (!st) st = get_str(c, &e, "urdf_path", 1, &raw);
   if (!st) st = get_str(c, &e, "res_dir", 0, &res);
   if (!st) st = get_str(c, &e, "base", 0, &base);
@@ -1357,7 +1424,7 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
   def.line = e.line;
   double *qpos = NULL, *qvel = NULL, *ref = NULL;
   int nqpos = 0, nqvel = 0, nref = 0, seen_state = 0, npd = 0;
-  pendingPd pd[64];
+  pendingPd *pd = NULL; /* (npd) read here, added once the system exists */
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
     char kn[NAME_CAP];
     if (!child_el(c, k, &e, kn, &st)) continue;
@@ -1372,6 +1439,7 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
       if (!st) st = get_list(c, &se, "reference_qpos", &nref, &ref);
       if (!st) st = get_vec(c, &se, "pos", 3, 0, def.pos);
       if (!st) st = get_vec(c, &se, "quat", 4, 0, def.quat);
+      if (!st) quat_rescale(def.quat);
       def.pose_given = el_find(&se, "pos") || el_find(&se, "quat");
       if (!st && quat_is_zero(def.quat))
         st = fail(c, SS_ERR_VALUE, se.line, "%s: quat has zero length", se.label);
@@ -1381,12 +1449,22 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
                                        "velocity_target", "effort_limit", NULL};
       xEl pe;
       st = open_leaf(c, k, e.label, pa, &pe);
-      if (!st && npd == 64)
-        st = fail(c, SS_ERR_VALUE, pe.line, "%s: at most 64 <pd> per system", e.label);
       const char *jn = NULL;
       if (!st) st = get_str(c, &pe, "joint", 1, &jn);
+      /* cut short, it could name another joint (URDF names are shorter) */
+      if (!st && strlen(jn) >= sizeof pd->joint)
+        st = fail(c, SS_ERR_VALUE, pe.line,
+                  "%s: joint name '%.40s...' is too long (at most %d "
+                  "characters)", pe.label, jn, (int)sizeof pd->joint - 1);
       if (!st) {
-        pendingPd *p = &pd[npd];
+        pendingPd *p = realloc(pd, (size_t)(npd + 1) * sizeof *pd);
+        if (!p) {
+          st = fail(c, SS_ERR_NOMEM, pe.line, "out of memory");
+          el_free(&pe);
+          break;
+        }
+        pd = p;
+        p += npd;
         snprintf(p->joint, sizeof p->joint, "%s", jn);
         memset(p->g, 0, sizeof p->g);
         p->line = pe.line;
@@ -1411,8 +1489,19 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
       if (ue.line > 0)
         c->e = ue;
       else
-        fail(c, ue.code, e.line, "%s '%s': cannot load URDF %s: %s", e.label,
-             name, path, ue.message);
+        fail(c, ue.code, e.line, "%s: cannot load URDF %s: %s", e.label,
+             path, ue.message);
+      st = ue.code;
+    }
+  }
+  /* a floating base (the default unless the URDF roots it at a fixed
+   * "world") needs mass: checked here, where the URDF's line is known, so
+   * that it is not a singular mass matrix at the first step */
+  if (!st && (base ? !strcmp(base, "floating")
+                   : u->world_base != SS_URDF_BASE_FIXED)) {
+    ssError ue;
+    if (ss_urdf_check_floating_root(u, &ue) != SS_OK) {
+      c->e = ue;
       st = ue.code;
     }
   }
@@ -1467,6 +1556,7 @@ static ssStatus read_articulated(readCtx *c, xmlNodePtr n)
     if (!st) qpos = NULL; /* owned by the pending list */
   }
   ss_urdf_free(u);
+  free(pd);
   free(qpos);
   free(qvel);
   free(ref);
@@ -1718,7 +1808,10 @@ static ssStatus read_camera(readCtx *c, xEl *e)
               m->camera_fov_deg);
   if (!st) st = get_str(c, e, "follow", 0, &follow);
   if (!st && follow) {
-    if (strlen(follow) >= sizeof m->camera_follow)
+    if (!*follow)
+      st = fail(c, SS_ERR_VALUE, e->line, "<camera>: follow is empty (give "
+                "the name of a body to follow, or leave the attribute out)");
+    else if (strlen(follow) >= sizeof m->camera_follow)
       st = fail(c, SS_ERR_VALUE, e->line, "<camera>: follow name is too long");
     else
       snprintf(m->camera_follow, sizeof m->camera_follow, "%s", follow);
@@ -1816,7 +1909,11 @@ static void ctx_free(readCtx *c)
 {
   for (int i = 0; i < c->npend; i++) pending_free(&c->pend[i]);
   for (int i = 0; i < c->nqpend; i++) free(c->qpend[i]);
-  c->nqpend = 0;
+  free(c->qpend);
+  free(c->qpend_sys);
+  c->qpend = NULL;
+  c->qpend_sys = NULL;
+  c->nqpend = c->capqpend = 0;
   free(c->pend);
   c->pend = NULL;
   c->npend = 0;
@@ -1828,6 +1925,8 @@ static ssStatus load(const char *buf, size_t len, const char *path,
   readCtx c;
   memset(&c, 0, sizeof c);
   c.path = path;
+  c.buf = buf;
+  c.len = len;
   ss_scene_path_dir(path, c.dir, sizeof c.dir);
 
   ssCLocale loc;

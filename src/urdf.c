@@ -54,8 +54,19 @@ typedef struct uPending {
   const char *attr1, *attr2; /* attribute names for messages */
 } uPending;
 
+/* Names to document indices (open addressing; slot = index + 1, 0 empty),
+ * so that finding a link or joint by name does not walk all of them (a
+ * URDF of many links took time quadratic in their number). */
+typedef struct nameTab {
+  int *slot;
+  int cap;  /* a power of two, or 0 */
+  int n;
+} nameTab;
+
 typedef struct uCtx {
   const char *path;      /* for messages */
+  const char *buf;       /* the source, [0, len): lines of values */
+  size_t len;
   char dir[1024];        /* the URDF's folder */
   const char *res_dir;
   xmlDocPtr doc;
@@ -70,6 +81,7 @@ typedef struct uCtx {
   int *link_extra;       /* line of the first inertial/visual/collision */
   int njoint, capjoint;
   ssUrdfJoint *joint;
+  nameTab link_tab, joint_tab;
 
   int npend, cappend;
   uPending *pend;
@@ -223,7 +235,8 @@ static ssStatus parse_values(uCtx *c, const xEl *e, const char *name,
       char where[64] = "";
       if (cnt > 1)
         snprintf(where, sizeof where, " (value %ld of %ld)", k + 1, cnt);
-      return fail(c, SS_ERR_PARSE, e->line,
+      return fail(c, SS_ERR_PARSE,
+                  ss_xml_value_line(c->buf, c->len, e->node, name, k),
                   "%s: bad number '%.*s'%s in attribute '%s' (%s)", e->label,
                   len, tb, where, name,
                   r == 2 ? "out of range"
@@ -832,18 +845,64 @@ static ssStatus read_inertial(uCtx *c, xmlNodePtr n, const char *label,
   return st;
 }
 
+static uint64_t name_hash(const char *s)
+{
+  uint64_t h = 1469598103934665603ULL; /* FNV-1a */
+  for (; *s; s++) h = (h ^ (unsigned char)*s) * 1099511628211ULL;
+  return h;
+}
+
+/* The name of entry i: a link's (joints == 0) or a joint's. */
+static const char *entry_name(const uCtx *c, int joints, int i)
+{
+  return joints ? c->joint[i].name : c->link[i].name;
+}
+
+/* The slot of `name` in t: its entry's, or the empty one it would take. */
+static int tab_slot(const uCtx *c, const nameTab *t, int joints,
+                    const char *name)
+{
+  unsigned mask = (unsigned)t->cap - 1;
+  unsigned k = (unsigned)name_hash(name) & mask;
+  while (t->slot[k] && strcmp(entry_name(c, joints, t->slot[k] - 1), name))
+    k = (k + 1) & mask;
+  return (int)k;
+}
+
+static int tab_find(const uCtx *c, const nameTab *t, int joints,
+                    const char *name)
+{
+  return t->cap ? t->slot[tab_slot(c, t, joints, name)] - 1 : -1;
+}
+
+/* Enter entry i under its name (not yet entered); 0, or -1 out of memory. */
+static int tab_add(const uCtx *c, nameTab *t, int joints, int i)
+{
+  if (2 * (t->n + 1) > t->cap) {
+    nameTab g = {NULL, t->cap ? 2 * t->cap : 64, 0};
+    g.slot = calloc((size_t)g.cap, sizeof *g.slot);
+    if (!g.slot) return -1;
+    for (int k = 0; k < t->cap; k++)
+      if (t->slot[k])
+        g.slot[tab_slot(c, &g, joints, entry_name(c, joints, t->slot[k] - 1))] =
+            t->slot[k];
+    g.n = t->n;
+    free(t->slot);
+    *t = g;
+  }
+  t->slot[tab_slot(c, t, joints, entry_name(c, joints, i))] = i + 1;
+  t->n++;
+  return 0;
+}
+
 static int find_link_doc(const uCtx *c, const char *name)
 {
-  for (int i = 0; i < c->nlink; i++)
-    if (!strcmp(c->link[i].name, name)) return i;
-  return -1;
+  return tab_find(c, &c->link_tab, 0, name);
 }
 
 static int find_joint_doc(const uCtx *c, const char *name)
 {
-  for (int i = 0; i < c->njoint; i++)
-    if (!strcmp(c->joint[i].name, name)) return i;
-  return -1;
+  return tab_find(c, &c->joint_tab, 1, name);
 }
 
 static ssStatus add_geom(uCtx *c, ssUrdfLink *l, int *cap, const ssUrdfGeom *g)
@@ -874,10 +933,12 @@ static ssStatus read_link(uCtx *c, xmlNodePtr n)
   l->line = e.line;
   if (!st) {
     int i = find_link_doc(c, l->name);
-    if (i >= 0 && i < c->nlink - 1)
+    if (i >= 0)
       st = fail(c, SS_ERR_PARSE, e.line,
                 "duplicate link name '%s' (first at line %d)", l->name,
                 c->link[i].line);
+    else if (tab_add(c, &c->link_tab, 0, c->nlink - 1))
+      st = nomem(c, e.line);
   }
   char label[NAME_LEN + 16];
   snprintf(label, sizeof label, "link '%s'", l->name);
@@ -984,10 +1045,12 @@ static ssStatus read_joint(uCtx *c, xmlNodePtr n)
   j->line = e.line;
   if (!st) {
     int i = find_joint_doc(c, j->name);
-    if (i >= 0 && i < c->njoint - 1)
+    if (i >= 0)
       st = fail(c, SS_ERR_PARSE, e.line,
                 "duplicate joint name '%s' (first at line %d)", j->name,
                 c->joint[i].line);
+    else if (tab_add(c, &c->joint_tab, 1, c->njoint - 1))
+      st = nomem(c, e.line);
   }
   char label[NAME_LEN + 16];
   snprintf(label, sizeof label, "joint '%s'", j->name);
@@ -1011,7 +1074,8 @@ static ssStatus read_joint(uCtx *c, xmlNodePtr n)
                 joint_types);
   }
   int seen_o = 0, seen_p = 0, seen_c = 0, seen_a = 0, seen_l = 0, seen_d = 0,
-      seen_m = 0, axis_line = 0, has_lo = 0, has_hi = 0;
+      seen_m = 0, axis_line = 0, has_lo = 0, has_hi = 0, dyn_line = 0,
+      seen_cal = 0, seen_saf = 0;
   double axis[3] = {1, 0, 0};
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
     xEl x;
@@ -1048,6 +1112,7 @@ static ssStatus read_joint(uCtx *c, xmlNodePtr n)
       if (!st) st = get_num_min(c, &x, "friction", 0, 0, 0, &j->friction);
       if (!st) st = get_num_min(c, &x, "stiffness", 0, 0, 0, &j->stiffness);
       if (!st) st = get_num(c, &x, "spring_mount", 0, &j->spring_mount);
+      dyn_line = x.line;
       el_free(&x);
     } else if (is_el(k, "mimic")) {
       uPending p;
@@ -1068,10 +1133,45 @@ static ssStatus read_joint(uCtx *c, xmlNodePtr n)
       if (!st) st = add_pending(c, &p, x.line);
       el_free(&x);
     } else if (is_el(k, "calibration") || is_el(k, "safety_controller")) {
-      /* ROS-specific, nothing to simulate */
+      /* ROS-specific, nothing to simulate: checked as URDF has them (a
+       * typo is reported, not dropped), then not used */
+      static const char *const a_cal[] = {"rising", "falling",
+                                          "reference_position", NULL};
+      static const char *const a_saf[] = {"soft_lower_limit", "soft_upper_limit",
+                                          "k_position", "k_velocity", NULL};
+      int cal = is_el(k, "calibration");
+      const char *const *allowed = cal ? a_cal : a_saf;
+      if (!(st = open_leaf(c, k, label, allowed, &x)))
+        st = once(c, cal ? &seen_cal : &seen_saf, &x);
+      for (int i = 0; !st && allowed[i]; i++) {
+        double v = 0;
+        st = get_num(c, &x, allowed[i], 0, &v);
+      }
+      el_free(&x);
     } else {
       st = unknown_child(c, k, &e, kids);
     }
+  }
+  /* what the joint's degrees of freedom cannot take would be dropped
+   * without a word: a joint spring acts on one coordinate, and a fixed or
+   * floating joint (the latter is the world's, dropped) has no damper */
+  if (!st && seen_d && !is_1dof(j->type)) {
+    const char *bad = NULL;
+    double v = 0;
+    if (j->stiffness != 0) bad = "stiffness", v = j->stiffness;
+    else if (j->spring_mount != 0) bad = "spring_mount", v = j->spring_mount;
+    else if (j->damping != 0 && j->type != SS_JOINT_SPHERICAL)
+      bad = "damping", v = j->damping;
+    if (bad)
+      st = fail(c, SS_ERR_VALUE, dyn_line,
+                "%s <dynamics>: %s = %.17g on a %s joint, %s (damping acts on "
+                "revolute, continuous, prismatic and spherical joints; a joint "
+                "spring, stiffness and spring_mount, on the first three only)",
+                label, bad, v, type_name(j->type),
+                j->type == SS_JOINT_SPHERICAL ? "which has no joint spring"
+                : j->type == SS_JOINT_FIXED   ? "which does not move"
+                                              : "the free base, which has "
+                                                "neither damper nor spring");
   }
   if (!st && !seen_p)
     st = fail(c, SS_ERR_PARSE, e.line, "%s: missing <parent link=...>", label);
@@ -1709,6 +1809,8 @@ static void ctx_free(uCtx *c)
   free(c->joint);
   free(c->mat);
   free(c->pend);
+  free(c->link_tab.slot);
+  free(c->joint_tab.slot);
   if (c->doc) xmlFreeDoc(c->doc);
   memset(c, 0, sizeof *c);
 }
@@ -1730,6 +1832,8 @@ static ssStatus load(const char *buf, size_t len, const char *path,
   uCtx c;
   memset(&c, 0, sizeof c);
   c.path = path;
+  c.buf = buf;
+  c.len = len;
   c.res_dir = res_dir;
   ss_scene_path_dir(path, c.dir, sizeof c.dir);
 
@@ -1783,6 +1887,59 @@ ssStatus ss_urdf_load(const char *path, const char *res_dir, ssUrdf **out,
   if (st != SS_OK) return st;
   st = load(buf, len, path, res_dir, out, err);
   free(buf);
+  return st;
+}
+
+ssStatus ss_urdf_check_floating_root(const ssUrdf *u, ssError *err)
+{
+  if (!u || u->nlink < 1)
+    return ss_error_set(err, SS_ERR_VALUE, u ? u->path : "", 0,
+                        "the URDF has no link");
+  int nl = u->nlink, nj = u->njoint;
+  int *kid_first = malloc((size_t)nl * sizeof *kid_first);
+  int *kid_next = malloc((size_t)(nj ? nj : 1) * sizeof *kid_next);
+  int *stack = malloc((size_t)(2 * nl + 2) * sizeof *stack);
+  pose *tmp = malloc((size_t)nl * sizeof *tmp);
+  ssStatus st = SS_OK;
+  if (!kid_first || !kid_next || !stack || !tmp) {
+    st = ss_error_set(err, SS_ERR_NOMEM, u->path, 0, "out of memory");
+  } else {
+    /* child lists by final index (joint k's child is link k + 1), in the
+     * order composite() reads them */
+    int *kid_last = stack;
+    for (int i = 0; i < nl; i++) kid_first[i] = kid_last[i] = -1;
+    for (int j = 0; j < nj; j++) {
+      int a = u->joint[j].parent;
+      kid_next[j] = -1;
+      if (a < 0 || a >= nl) continue;
+      if (kid_last[a] < 0) kid_first[a] = j;
+      else kid_next[kid_last[a]] = j;
+      kid_last[a] = j;
+    }
+    uCtx c;
+    memset(&c, 0, sizeof c);
+    c.link = u->link;
+    c.joint = u->joint;
+    c.nlink = nl;
+    c.njoint = nj;
+    double M, com[3], I[9], ev[3] = {0, 0, 0};
+    composite(&c, 0, kid_first, kid_next, tmp, stack, &M, com, I);
+    if (M > 0) sym_eig3(I, ev);
+    const ssUrdfLink *L = &u->link[0];
+    if (!(M > 0) || !is_pd(ev))
+      st = ss_error_set(err, SS_ERR_VALUE, u->path, L->line,
+                        "link '%s' is the root of a floating base but, with "
+                        "the links fixed to it, has mass %.6g kg and "
+                        "principal moments %.6g, %.6g, %.6g kg m^2 (a floating "
+                        "base needs mass > 0 and a positive-definite "
+                        "rotational inertia: give it an <inertial>, or "
+                        "base=\"fixed\" in the scene)", L->name, M, ev[0],
+                        ev[1], ev[2]);
+  }
+  free(kid_first);
+  free(kid_next);
+  free(stack);
+  free(tmp);
   return st;
 }
 

@@ -43,14 +43,22 @@
  *                               upper is given (the other is then 0, as in
  *                               URDF; lower <= upper) on a revolute or
  *                               prismatic joint; a continuous joint is never
- *                               limited; effort, velocity >= 0, 0 = none
+ *                               limited; effort, velocity >= 0 are read
+ *                               but not simulated (a scene's <pd
+ *                               effort_limit> bounds a drive)
  *       <dynamics damping [0] friction [0] stiffness [0] spring_mount [0]/>
  *                               all >= 0 but spring_mount; stiffness and
  *                               spring_mount are ours: a joint spring
- *                               tau = -stiffness (q - spring_mount)
+ *                               tau = -stiffness (q - spring_mount) on a
+ *                               revolute, continuous or prismatic joint;
+ *                               damping there and on a spherical joint;
+ *                               a non-zero value a joint cannot take is
+ *                               an error (friction: read, not simulated)
  *       <mimic joint=R multiplier [1] offset [0]/>  becomes an equality
  *                               closure q(this) = multiplier q(joint) + offset
- *       <calibration/>, <safety_controller/>   ignored
+ *       <calibration rising falling reference_position/>,
+ *       <safety_controller soft_lower_limit soft_upper_limit k_position
+ *                          k_velocity/>   checked (names, numbers), not used
  *     </joint>
  *     <constraints>                         (any number; RaiSim's extension)
  *       <pin name body1=R body2=R anchor=R anchor2/>   anchor in body1's
@@ -103,7 +111,8 @@
  * 1e-12 times the largest).  A link with mass > 0 needs a positive-definite
  * inertia of its own; a massless link's inertia must be positive semi-
  * definite.  The root of a tree whose base the scene decides is not checked
- * here: a floating base needs mass, which the scene builder checks.
+ * here: a floating base needs mass, which ss_urdf_check_floating_root
+ * checks for the scene.
  *
  * Mesh paths.  package://NAME/REST is looked up as BASE/REST, then as
  * BASE/NAME/REST, where BASE is res_dir when given, else the URDF's folder;
@@ -117,7 +126,8 @@
  * SS_URDF_MAX_BYTES, any DOCTYPE refused, no entity expansion, no network,
  * a deny-all external entity loader, libxml2's messages captured, never
  * printed.  Every error has file = the URDF path, line = the line of the
- * element at fault, and a message naming the element, attribute, bad value
+ * element at fault (of the bad number itself in a value over many lines,
+ * of the text for stray text), and a message naming the element, attribute, bad value
  * and what is allowed.  Nothing is returned on error.  Not safe to run
  * concurrently with other libxml2 users (libxml2's handlers are global).
  *
@@ -214,8 +224,8 @@ typedef struct ssUrdfJoint {
   double axis[3];        /* unit axis in the child (joint) frame */
   int limited;           /* 1 if lower/upper apply */
   double lower, upper;   /* rad or m */
-  double effort;         /* N or N m; 0 = unlimited */
-  double velocity;       /* rad/s or m/s; 0 = unlimited */
+  double effort;         /* N or N m (stored; not simulated) */
+  double velocity;       /* rad/s or m/s (stored; not simulated) */
   double damping;        /* <dynamics damping> (N m s/rad or N s/m) */
   double friction;       /* <dynamics friction> (stored; not simulated) */
   double stiffness;      /* <dynamics stiffness> joint spring (extension) */
@@ -278,5 +288,11 @@ ssStatus ss_urdf_load(const char *path, const char *res_dir, ssUrdf **out,
 ssStatus ss_urdf_load_buffer(const char *buf, size_t len, const char *path,
                              const char *res_dir, ssUrdf **out, ssError *err);
 void ss_urdf_free(ssUrdf *u);  /* NULL ok */
+
+/* For a root the scene sets floating (see "Mass"): SS_OK when link 0 with
+ * the links fixed to it has mass > 0 and a positive-definite rotational
+ * inertia, the check every moving link gets; otherwise an error at the
+ * URDF's root link (file = the URDF, line = the link's). */
+ssStatus ss_urdf_check_floating_root(const ssUrdf *u, ssError *err);
 
 #endif /* SS_URDF_H */

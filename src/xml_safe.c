@@ -16,6 +16,8 @@
 
 typedef struct xmlGuard {
   startElementNsSAX2Func start; /* libxml2's tree builder */
+  charactersSAXFunc characters; /* its text and CDATA builders */
+  cdataBlockSAXFunc cdata;
   int doctype_line;  /* > 0: a DOCTYPE was met (parsing stopped there) */
   int entity_refused;
   int have_error;
@@ -92,6 +94,53 @@ static void on_start_element(void *ctx, const xmlChar *localname,
   node->_private = (void *)(intptr_t)line;
 }
 
+/* XML white space */
+static int is_space(char ch)
+{
+  return ch == ' ' || ch == '\t' || ch == '\n' || ch == '\r';
+}
+
+/* After text ch[0, len) went into the text or CDATA node last in the
+ * current element: record in the node's application pointer the line of
+ * its first character that is not white space (the one a message about
+ * stray text quotes).  libxml2's own line of a text node is where the
+ * parser stood when it made the node, the end of the first piece of text
+ * it delivered, which is the line of the next tag for ordinary text.  The
+ * parser delivers a piece once it has read past it, so its last character
+ * is on the current line and character k on that line less the newlines
+ * in ch[k, len). */
+static void record_text_line(xmlParserCtxtPtr p, const xmlChar *ch, int len)
+{
+  xmlNodePtr t = p && p->node ? p->node->last : NULL;
+  if (!t || t->_private || !p->input || p->input->line <= 0 ||
+      (t->type != XML_TEXT_NODE && t->type != XML_CDATA_SECTION_NODE))
+    return;
+  int k = 0;
+  while (k < len && is_space((char)ch[k])) k++;
+  if (k == len) return;
+  int nl = 0;
+  for (int i = k; i < len; i++)
+    if (ch[i] == '\n') nl++;
+  int line = p->input->line - nl;
+  t->_private = (void *)(intptr_t)(line > 0 ? line : 1);
+}
+
+static void on_characters(void *ctx, const xmlChar *ch, int len)
+{
+  xmlGuard *g = guard_of(ctx);
+  if (!g || !g->characters) return;
+  g->characters(ctx, ch, len);
+  record_text_line((xmlParserCtxtPtr)ctx, ch, len);
+}
+
+static void on_cdata(void *ctx, const xmlChar *ch, int len)
+{
+  xmlGuard *g = guard_of(ctx);
+  if (!g || !g->cdata) return;
+  g->cdata(ctx, ch, len);
+  record_text_line((xmlParserCtxtPtr)ctx, ch, len);
+}
+
 /* Deny-by-default external entity loader: nothing is ever fetched. */
 static xmlParserInputPtr deny_entity_loader(const char *url, const char *id,
                                             xmlParserCtxtPtr ctxt)
@@ -165,6 +214,15 @@ xmlDocPtr ss_xml_parse(const char *buf, size_t len, int huge, ssXmlResult *r)
       p->sax->internalSubset = on_internal_subset;
       g.start = p->sax->startElementNs;
       if (g.start) p->sax->startElementNs = on_start_element;
+      /* white space goes to the same builder (libxml2 compares the two
+       * pointers to tell whether blanks need telling apart: keep them
+       * equal) */
+      g.characters = p->sax->characters;
+      if (g.characters && p->sax->ignorableWhitespace == g.characters)
+        p->sax->ignorableWhitespace = on_characters;
+      if (g.characters) p->sax->characters = on_characters;
+      g.cdata = p->sax->cdataBlock;
+      if (g.cdata) p->sax->cdataBlock = on_cdata;
     }
     /* never XML_PARSE_NOENT, XML_PARSE_DTDLOAD, XML_PARSE_DTDATTR or
      * XML_PARSE_XINCLUDE */
@@ -189,20 +247,149 @@ xmlDocPtr ss_xml_parse(const char *buf, size_t len, int huge, ssXmlResult *r)
 
 int ss_xml_line(xmlNodePtr n)
 {
-  if (n->type == XML_ELEMENT_NODE && n->_private)
+  if ((n->type == XML_ELEMENT_NODE || n->type == XML_TEXT_NODE ||
+       n->type == XML_CDATA_SECTION_NODE) && n->_private)
     return (int)(intptr_t)n->_private;
   long l = xmlGetLineNo(n);
   return l > 0 && l < INT_MAX ? (int)l : 0;
 }
 
 /* ---------------------------------------------------------------------- */
-/* attributes, children, value lists                                      */
+/* lines of values in the source                                           */
 
-/* XML white space */
-static int is_space(char ch)
+/* The number of elements before el in document order. */
+static long element_ordinal(xmlNodePtr el)
 {
-  return ch == ' ' || ch == '\t' || ch == '\n' || ch == '\r';
+  xmlNodePtr root = el;
+  while (root->parent && root->parent->type == XML_ELEMENT_NODE)
+    root = root->parent;
+  long n = 0;
+  for (xmlNodePtr x = root; x;) {
+    if (x == el) return n;
+    n++;
+    /* the next element in document order: the first child element, else
+     * the next sibling element of x or of its nearest ancestor that has
+     * one, below the root */
+    xmlNodePtr next = NULL;
+    for (xmlNodePtr k = x->children; k && !next; k = k->next)
+      if (k->type == XML_ELEMENT_NODE) next = k;
+    for (xmlNodePtr up = x; !next && up && up != root; up = up->parent)
+      for (xmlNodePtr k = up->next; k && !next; k = k->next)
+        if (k->type == XML_ELEMENT_NODE) next = k;
+    x = next;
+  }
+  return -1;
 }
+
+/* A source reader that counts lines as libxml2 does (LF, CR LF and a lone
+ * CR each end one). */
+typedef struct srcScan {
+  const char *p, *end;
+  int line;
+} srcScan;
+
+static void scan_step(srcScan *s)
+{
+  if (*s->p == '\n' || (*s->p == '\r' && (s->p + 1 >= s->end || s->p[1] != '\n')))
+    s->line++;
+  s->p++;
+}
+
+/* Skip to just after `mark`; 0 when it is not found. */
+static int scan_past(srcScan *s, const char *mark)
+{
+  size_t n = strlen(mark);
+  while (s->p < s->end) {
+    if ((size_t)(s->end - s->p) >= n && !memcmp(s->p, mark, n)) {
+      for (size_t i = 0; i < n; i++) scan_step(s);
+      return 1;
+    }
+    scan_step(s);
+  }
+  return 0;
+}
+
+static int name_char(char ch)
+{
+  return ch && !is_space(ch) && ch != '=' && ch != '>' && ch != '/' &&
+         ch != '<' && ch != '"' && ch != '\'';
+}
+
+int ss_xml_value_line(const char *buf, size_t len, xmlNodePtr el,
+                      const char *attr, long k)
+{
+  int fallback = ss_xml_line(el);
+  long want = buf && attr ? element_ordinal(el) : -1;
+  if (want < 0) return fallback;
+  srcScan s = {buf, buf + len, 1};
+  long seen = -1;
+  /* the start tags in order, past the prolog, comments, PIs and CDATA */
+  while (s.p < s.end) {
+    if (*s.p != '<') {
+      scan_step(&s);
+      continue;
+    }
+    const char *q = s.p + 1;
+    size_t left = (size_t)(s.end - q);
+    int ok = 1;
+    if (left >= 3 && !memcmp(q, "!--", 3)) ok = scan_past(&s, "-->");
+    else if (left >= 8 && !memcmp(q, "![CDATA[", 8)) ok = scan_past(&s, "]]>");
+    else if (left >= 1 && *q == '?') ok = scan_past(&s, "?>");
+    else if (left >= 1 && *q == '!') ok = scan_past(&s, ">");
+    else if (left >= 1 && *q == '/') ok = scan_past(&s, ">");
+    else if (++seen == want) break;
+    else scan_step(&s);
+    if (!ok) return fallback;
+  }
+  if (seen != want || s.p >= s.end || s.line != fallback) return fallback;
+  /* the tag's name, then its attributes */
+  scan_step(&s);
+  const char *nm = (const char *)el->name;
+  size_t nl = strlen(nm);
+  if ((size_t)(s.end - s.p) <= nl || memcmp(s.p, nm, nl) || name_char(s.p[nl]))
+    return fallback;
+  for (size_t i = 0; i < nl; i++) scan_step(&s);
+  size_t al = strlen(attr);
+  for (;;) {
+    while (s.p < s.end && is_space(*s.p)) scan_step(&s);
+    if (s.p >= s.end || !name_char(*s.p)) return fallback;
+    const char *an = s.p;
+    while (s.p < s.end && name_char(*s.p)) scan_step(&s);
+    int match = (size_t)(s.p - an) == al && !memcmp(an, attr, al);
+    while (s.p < s.end && is_space(*s.p)) scan_step(&s);
+    if (s.p >= s.end || *s.p != '=') return fallback;
+    scan_step(&s);
+    while (s.p < s.end && is_space(*s.p)) scan_step(&s);
+    if (s.p >= s.end || (*s.p != '"' && *s.p != '\'')) return fallback;
+    char quote = *s.p;
+    scan_step(&s);
+    const char *v = s.p, *ve = memchr(v, quote, (size_t)(s.end - v));
+    if (!ve) return fallback;
+    if (!match) {
+      while (s.p < ve) scan_step(&s);
+      scan_step(&s);
+      continue;
+    }
+    if (memchr(v, '&', (size_t)(ve - v))) return fallback;
+    /* value k: tokens as ss_xml_vec_next splits them */
+    long idx = -1;
+    int in_token = 0;
+    while (s.p < ve) {
+      char ch = *s.p;
+      if (is_space(ch) || ch == ',') {
+        in_token = 0;
+      } else if (!in_token) {
+        in_token = 1;
+        if (++idx == k) return s.line;
+      }
+      scan_step(&s);
+    }
+    return fallback;
+  }
+}
+
+/* ---------------------------------------------------------------------- */
+/* attributes, children, value lists                                      */
 
 static int is_blank(const xmlChar *s)
 {

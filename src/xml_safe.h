@@ -31,15 +31,29 @@ typedef struct ssXmlResult {
  * return NULL and say why in *r.  huge != 0 lifts libxml2's size limits
  * (XML_PARSE_HUGE; the caller bounds len).  libxml2's global error
  * handlers and entity loader are replaced for the parse only.  Every
- * element's node->_private holds the line where its start tag begins
- * (ss_xml_line). */
+ * element's node->_private holds the line where its start tag begins, and
+ * every text or CDATA node's that holds more than white space the line of
+ * its first other character (ss_xml_line). */
 xmlDocPtr ss_xml_parse(const char *buf, size_t len, int huge, ssXmlResult *r);
 
-/* The line where an element's start tag begins, as recorded by
- * ss_xml_parse (libxml2's own node line is where the start tag ends, the
- * last line of a multi-line tag, and stops at 65535); other nodes: their
- * libxml2 line, 0 when not known. */
+/* The line where an element's start tag begins, or where the text of a
+ * text or CDATA node begins (its first character that is not white
+ * space), as recorded by ss_xml_parse (libxml2's own node line is where
+ * the start tag ends, the last line of a multi-line tag, and for text the
+ * line of the next tag; it stops at 65535); other nodes: their libxml2
+ * line, 0 when not known. */
 int ss_xml_line(xmlNodePtr n);
+
+/* The line of value k (0-based, as ss_xml_vec_next counts them) of
+ * attribute `attr` of element el, found in the document's source buf[0,
+ * len): an attribute may run over many lines (an exported height map's
+ * arrays do), and libxml2 keeps no line for it.  The element is located as
+ * the start tag whose turn in the source is its turn in document order;
+ * whenever the source does not read as expected there (another encoding
+ * than UTF-8 or ASCII, a reference such as &#32; inside the value), the
+ * element's own line is returned. */
+int ss_xml_value_line(const char *buf, size_t len, xmlNodePtr el,
+                      const char *attr, long k);
 
 /* The text of attribute a.  A single text child is returned as is
  * (*owned = NULL); otherwise the text is built and *owned is set to it,

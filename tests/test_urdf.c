@@ -14,10 +14,16 @@
 #include "tap.h"
 #include "catalogue.h"
 
+#include <errno.h>
 #include <locale.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
 #include <string.h>
 
 static const char *srcdir(void)
@@ -672,6 +678,107 @@ static void test_mesh_formats(void)
   ok(1, "ss_mesh_free(NULL) is fine");
 }
 
+/* ss_mesh_load in a child process: its status as the exit code (0 loaded,
+ * 1 refused), 2 when it had not returned after `seconds` (it is killed). */
+static int load_in_child(const char *path, int seconds)
+{
+  fflush(stdout);
+  pid_t pid = fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    ssMesh *m = NULL;
+    ssError e;
+    ssStatus st = ss_mesh_load(path, NULL, &m, &e);
+    ss_mesh_free(m);
+    _exit(st == SS_OK ? 0 : 1);
+  }
+  for (int k = 0; k < 100 * seconds; k++) {
+    int status = 0;
+    if (waitpid(pid, &status, WNOHANG) == pid)
+      return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    struct timespec ts = {0, 10000000};
+    nanosleep(&ts, NULL);
+  }
+  kill(pid, SIGKILL);
+  waitpid(pid, NULL, 0);
+  return 2;
+}
+
+/* Files a mesh file names (an OBJ's mtllib, a glTF's buffer) are read
+ * through the same checks as the mesh: a FIFO there is refused at once,
+ * never waited on (the import once blocked for good opening it), and a
+ * regular one is read as before. */
+static void test_mesh_named_files(void)
+{
+  char dir[] = "/tmp/soilsim-urdf-XXXXXX", obj[128], mtl[128], gltf[128],
+       bin[128], fifo[128], src[1024];
+  if (!mkdtemp(dir)) {
+    ok(0, "a temporary folder: %s", strerror(errno));
+    return;
+  }
+  snprintf(obj, sizeof obj, "%s/tet.obj", dir);
+  snprintf(mtl, sizeof mtl, "%s/tet.mtl", dir);
+  snprintf(gltf, sizeof gltf, "%s/tet.gltf", dir);
+  snprintf(bin, sizeof bin, "%s/tet.bin", dir);
+  snprintf(fifo, sizeof fifo, "%s/fifo.bin", dir);
+  FILE *f = fopen(obj, "w");
+  if (f) {
+    fputs("mtllib tet.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+          "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n", f);
+    fclose(f);
+  }
+  /* the glTF fixture with its buffer moved out to a file */
+  data_path(src, sizeof src, "meshes/tetra.gltf");
+  char *g = slurp(src, NULL), *uri = g ? strstr(g, "\"data:") : NULL;
+  char *end = uri ? strchr(uri + 1, '"') : NULL;
+  int made = mkfifo(mtl, 0600) == 0 && mkfifo(fifo, 0600) == 0 && f && end;
+  if (made) {
+    /* the buffer's 72 bytes: the base64 after the comma */
+    static const char b64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    unsigned char raw[128];
+    size_t n = 0;
+    unsigned acc = 0;
+    int bits = 0;
+    for (const char *p = strchr(uri, ',') + 1; p < end && *p != '='; p++) {
+      const char *c = strchr(b64, *p);
+      if (!c) break;
+      acc = (acc << 6) | (unsigned)(c - b64);
+      bits += 6;
+      if (bits >= 8 && n < sizeof raw) {
+        bits -= 8;
+        raw[n++] = (unsigned char)(acc >> bits);
+      }
+    }
+    FILE *b = fopen(bin, "wb");
+    made = b && fwrite(raw, 1, n, b) == n && n == 72;
+    if (b) made &= fclose(b) == 0;
+    for (int k = 0; k < 2 && made; k++) {
+      FILE *o = fopen(gltf, "w");
+      made = o && fprintf(o, "%.*s\"%s\"%s", (int)(uri - g), g,
+                          k ? "fifo.bin" : "tet.bin", end + 1) > 0;
+      if (o) made &= fclose(o) == 0;
+      if (!made) break;
+      int r = load_in_child(gltf, 10);
+      if (k)
+        ok(r == 1, "a glTF whose buffer is a FIFO is refused at once (%s)",
+           r == 2 ? "it hung" : r == 0 ? "loaded" : "refused");
+      else
+        ok(r == 0, "a glTF with its buffer in a file beside it loads");
+    }
+    int r = load_in_child(obj, 10);
+    ok(r == 0, "an OBJ whose mtllib is a FIFO loads at once without it (%s)",
+       r == 2 ? "it hung" : r == 1 ? "refused" : "loaded");
+  }
+  if (!made) ok(0, "the files for the named-file checks could be made");
+  free(g);
+  unlink(obj);
+  unlink(mtl);
+  unlink(gltf);
+  unlink(bin);
+  unlink(fifo);
+  rmdir(dir);
+}
+
 static void test_mesh_arrays(void)
 {
   /* the corner tetrahedron: faces z = 0, y = 0, x = 0, x + y + z = 1 */
@@ -990,16 +1097,91 @@ static void test_bad_catalogue(void)
   catalogue_check(dir, ".urdf", "URDF", 30, load_bad_urdf);
 }
 
+/* ss_urdf_check_floating_root: a root without mass (massless_root.urdf:
+ * no <inertial>, nothing fixed to it) cannot float; one with mass can. */
+static void test_floating_root(void)
+{
+  char path[1024];
+  ssUrdf *u = NULL;
+  ssError e;
+  data_path(path, sizeof path, "massless_root.urdf");
+  ssStatus st = ss_urdf_load(path, NULL, &u, &e);
+  if (!ok(st == SS_OK, "massless_root.urdf loads (a fixed base may be massless)")) {
+    diag("%s:%d: %s", e.file, e.line, e.message);
+    return;
+  }
+  st = ss_urdf_check_floating_root(u, &e);
+  ok(st == SS_ERR_VALUE && !strcmp(e.file, path) && e.line == 5 &&
+         strstr(e.message, "link 'mount' is the root of a floating base"),
+     "its root cannot float: refused at the root link's line (%s:%d: %s)", e.file,
+     e.line, st ? e.message : "accepted");
+  ss_urdf_free(u);
+  u = NULL;
+  data_path(path, sizeof path, "example.urdf");
+  st = ss_urdf_load(path, NULL, &u, &e);
+  ok(st == SS_OK && ss_urdf_check_floating_root(u, &e) == SS_OK,
+     "example.urdf's root can float");
+  ss_urdf_free(u);
+}
+
+/* CPU seconds to read a chain of n links on fixed joints (the best of
+ * two), or -1 when it does not load. */
+static double chain_seconds(int n)
+{
+  size_t cap = (size_t)n * 120 + 64, k = 0;
+  char *buf = malloc(cap);
+  if (!buf) return -1;
+  k += (size_t)snprintf(buf + k, cap - k, "<robot name=\"chain\">\n");
+  for (int i = 0; i <= n; i++)
+    k += (size_t)snprintf(buf + k, cap - k, "<link name=\"l%d\"/>\n", i);
+  for (int i = 1; i <= n; i++)
+    k += (size_t)snprintf(buf + k, cap - k,
+                          "<joint name=\"j%d\" type=\"fixed\"><parent link=\"l%d\"/>"
+                          "<child link=\"l%d\"/></joint>\n", i, i - 1, i);
+  k += (size_t)snprintf(buf + k, cap - k, "</robot>\n");
+  double best = -1;
+  for (int rep = 0; rep < 2; rep++) {
+    ssUrdf *u = NULL;
+    ssError e;
+    clock_t t0 = clock();
+    ssStatus st = ss_urdf_load_buffer(buf, k, "chain.urdf", NULL, &u, &e);
+    double t = (double)(clock() - t0) / CLOCKS_PER_SEC;
+    int good = st == SS_OK && u->nlink == n + 1;
+    ss_urdf_free(u);
+    if (!good) {
+      best = -1;
+      break;
+    }
+    if (best < 0 || t < best) best = t;
+  }
+  free(buf);
+  return best;
+}
+
+/* Links and joints are found by name in constant time: eight times the
+ * links take about eight times as long to read, not 64 (a 64 MiB URDF of
+ * short links once took hours). */
+static void test_many_links(void)
+{
+  double t1 = chain_seconds(4000), t8 = chain_seconds(32000);
+  ok(t1 >= 0 && t8 >= 0 && t8 < 24 * fmax(t1, 1e-3),
+     "reading 32000 links takes less than 24 times as long as 4000 (%.3f s, "
+     "%.3f s)", t8, t1);
+}
+
 int main(void)
 {
   test_fourbar();
   test_example();
   test_world();
+  test_floating_root();
+  test_many_links();
   test_paths();
   test_locale();
   test_size_cap();
   test_mesh_obj();
   test_mesh_formats();
+  test_mesh_named_files();
   test_mesh_arrays();
   test_watertight();
   test_bad_catalogue();

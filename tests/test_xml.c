@@ -21,7 +21,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -593,6 +595,31 @@ static void test_text(void)
      "text: sizes from the attributes, rigid without <soil>");
   ss_data_free(d);
   ss_model_free(m);
+
+  /* the same file saved with a UTF-8 byte order mark reads the same */
+  char txt[512], *body = NULL;
+  snprintf(txt, sizeof txt, "%s/tests/data/hfield_4x3.txt", srcdir());
+  body = slurp(txt, NULL);
+  char bom_txt[512], bom_xml[512], xml[1024];
+  tmp_path(bom_txt, sizeof bom_txt, "bom.txt");
+  tmp_path(bom_xml, sizeof bom_xml, "bom.xml");
+  FILE *f = body ? fopen(bom_txt, "wb") : NULL;
+  int made = f && fputs("\xef\xbb\xbf", f) >= 0 && fputs(body, f) >= 0;
+  if (f) made &= fclose(f) == 0;
+  snprintf(xml, sizeof xml, "<raisim><objects><heightmap name=\"bumps\" text=\"bom.txt\" "
+           "x_size=\"3\" y_size=\"2\"/></objects></raisim>\n");
+  made = made && write_file(bom_xml, xml) == 0;
+  m = NULL;
+  d = NULL;
+  st = made ? ss_scene_load(bom_xml, &m, &d, &e) : SS_ERR_IO;
+  if (st) diag("%s:%d: %s", e.file, e.line, e.message);
+  ok(st == SS_OK && m->hfield_nx[0] == 4 && same_bits(m->hfield_data, want, 12),
+     "text: a file starting with a UTF-8 byte order mark reads the same");
+  ss_data_free(d);
+  ss_model_free(m);
+  free(body);
+  unlink(bom_txt);
+  unlink(bom_xml);
 }
 
 static void test_generated(void)
@@ -945,6 +972,239 @@ static void test_mesh_bodies(void)
   unlink(b);
 }
 
+/* An export writes every articulated system's reference_qpos and qpos, so
+ * its reader takes any number of them: 70 systems, exported, load again
+ * with the same state (the reader once kept at most 64 such qpos). */
+static void test_many_systems(void)
+{
+  enum { NSYS = 70 };
+  size_t cap = 300 * NSYS + 200, k = 0;
+  char *xml = malloc(cap);
+  if (!xml) return;
+  k += (size_t)snprintf(xml + k, cap - k, "<raisim><objects>\n");
+  for (int i = 0; i < NSYS; i++)
+    k += (size_t)snprintf(xml + k, cap - k,
+                          "<articulated_system name=\"s%d\" urdf_path=\"%s/tests/"
+                          "data/urdf/example.urdf\"><state pos=\"%d 0 1\"/>"
+                          "</articulated_system>\n", i, srcdir(), i);
+  snprintf(xml + k, cap - k, "</objects></raisim>\n");
+  ssModel *m = NULL, *m2 = NULL;
+  ssData *d = NULL, *d2 = NULL;
+  ssError e;
+  char a[512];
+  tmp_path(a, sizeof a, "many.xml");
+  ssStatus st = load_str(xml, &m, &d, &e);
+  free(xml);
+  if (!ok(st == SS_OK && m->nsys == NSYS, "%d articulated systems load", NSYS)) {
+    if (st) diag("%s:%d: %s", e.file, e.line, e.message);
+    ss_data_free(d);
+    ss_model_free(m);
+    return;
+  }
+  ok(ss_scene_export(m, d, a, &e) == SS_OK, "%d articulated systems export", NSYS);
+  st = ss_scene_load(a, &m2, &d2, &e);
+  if (st) diag("%s:%d: %s", e.file, e.line, e.message);
+  ok(st == SS_OK && m2->nsys == NSYS && m2->nq == m->nq &&
+         same_bits(d2->qpos, d->qpos, (size_t)m->nq) &&
+         same_bits(m2->qpos0, m->qpos0, (size_t)m->nq),
+     "their export (reference_qpos and qpos for each) loads with the same state");
+  ss_data_free(d2);
+  ss_model_free(m2);
+  ss_data_free(d);
+  ss_model_free(m);
+  unlink(a);
+}
+
+/* <pd>: any number per system (a 70-joint chain, each driven, loads and
+ * its export loads again; the reader once stopped at 64), and a joint name
+ * too long for any URDF joint is refused, not cut short into the name of
+ * another (a 128-character name once drove the 127-character joint that
+ * is its prefix). */
+static void test_many_pd(void)
+{
+  enum { NJ = 70 };
+  static const char *const link =
+      "<link name=\"l%d\"><inertial><mass value=\"1\"/><inertia ixx=\"0.1\" "
+      "ixy=\"0\" ixz=\"0\" iyy=\"0.1\" iyz=\"0\" izz=\"0.1\"/></inertial></link>\n";
+  size_t cap = 400 * NJ + 4096, k = 0;
+  char *urdf = malloc(cap), *xml = malloc(cap);
+  if (!urdf || !xml) {
+    free(urdf);
+    free(xml);
+    return;
+  }
+  char upath[512], spath[512], epath[512], long_name[128];
+  memset(long_name, 'j', sizeof long_name - 1);
+  long_name[sizeof long_name - 1] = 0; /* 127 characters */
+  tmp_path(upath, sizeof upath, "chain.urdf");
+  tmp_path(spath, sizeof spath, "chain.xml");
+  tmp_path(epath, sizeof epath, "chain_export.xml");
+  k += (size_t)snprintf(urdf + k, cap - k, "<robot name=\"chain\">\n");
+  for (int i = 0; i <= NJ; i++) k += (size_t)snprintf(urdf + k, cap - k, link, i);
+  /* joints j1 .. j69, and the last one named long_name */
+  for (int i = 1; i <= NJ; i++) {
+    char jn[160];
+    snprintf(jn, sizeof jn, "j%d", i);
+    k += (size_t)snprintf(urdf + k, cap - k,
+                          "<joint name=\"%s\" type=\"revolute\"><parent link=\"l%d\"/>"
+                          "<child link=\"l%d\"/><axis xyz=\"0 1 0\"/></joint>\n",
+                          i == NJ ? long_name : jn, i - 1, i);
+  }
+  snprintf(urdf + k, cap - k, "</robot>\n");
+  k = (size_t)snprintf(xml, cap, "<raisim><objects><articulated_system name=\"c\" "
+                       "urdf_path=\"chain.urdf\" base=\"fixed\">\n");
+  for (int i = 1; i < NJ; i++)
+    k += (size_t)snprintf(xml + k, cap - k, "<pd joint=\"j%d\" p_gain=\"1\" d_gain=\"0.1\"/>\n", i);
+  snprintf(xml + k, cap - k, "</articulated_system></objects></raisim>\n");
+  ssModel *m = NULL, *m2 = NULL;
+  ssData *d = NULL, *d2 = NULL;
+  ssError e;
+  ssStatus st = SS_ERR_IO;
+  if (write_file(upath, urdf) == 0 && write_file(spath, xml) == 0)
+    st = ss_scene_load(spath, &m, &d, &e);
+  if (st) diag("%s:%d: %s", e.file, e.line, e.message);
+  ok(st == SS_OK && m->npd == NJ - 1, "%d <pd> in one system load", NJ - 1);
+  if (st == SS_OK) {
+    st = ss_scene_export(m, d, epath, &e);
+    if (!st) st = ss_scene_load(epath, &m2, &d2, &e);
+    if (st) diag("%s:%d: %s", e.file, e.line, e.message);
+    ok(st == SS_OK && m2->npd == NJ - 1, "and their export loads again");
+  }
+  ss_data_free(d2);
+  ss_model_free(m2);
+  ss_data_free(d);
+  ss_model_free(m);
+  m = NULL;
+  d = NULL;
+  /* a <pd> naming the 127-character joint with one more letter */
+  snprintf(xml, cap, "<raisim><objects><articulated_system name=\"c\" "
+           "urdf_path=\"chain.urdf\" base=\"fixed\">\n<pd joint=\"%sX\" "
+           "p_gain=\"1\"/>\n</articulated_system></objects></raisim>\n", long_name);
+  st = SS_OK;
+  if (write_file(spath, xml) == 0) st = ss_scene_load(spath, &m, &d, &e);
+  ok(st != SS_OK && e.line == 2 && strstr(e.message, "is too long"),
+     "a <pd> joint name longer than any joint's is refused at its line (%s)",
+     st ? e.message : "loaded");
+  ss_data_free(d);
+  ss_model_free(m);
+  free(urdf);
+  free(xml);
+  unlink(upath);
+  unlink(spath);
+  unlink(epath);
+}
+
+/* A floating base needs mass: a URDF whose root has none is refused when
+ * the scene loads, at the root link's line in the URDF (it once loaded and
+ * failed at the first step with a singular mass matrix and no line); on a
+ * fixed base it loads and steps. */
+static void test_massless_root(void)
+{
+  char xml[2048], urdf[1024];
+  snprintf(urdf, sizeof urdf, "%s/tests/data/urdf/massless_root.urdf", srcdir());
+  for (int fixed = 0; fixed < 2; fixed++) {
+    snprintf(xml, sizeof xml,
+             "<raisim><objects>\n<articulated_system name=\"a\" urdf_path=\"%s\"%s/>\n"
+             "</objects></raisim>\n", urdf, fixed ? " base=\"fixed\"" : "");
+    ssModel *m = NULL;
+    ssData *d = NULL;
+    ssError e;
+    memset(&e, 0, sizeof e);
+    ssStatus st = load_str(xml, &m, &d, &e);
+    if (fixed) {
+      if (st) diag("%s:%d: %s", e.file, e.line, e.message);
+      ok(st == SS_OK && ss_step(m, d, &e) == SS_OK,
+         "a massless root on a fixed base loads and steps");
+    } else {
+      ok(st != SS_OK && !strcmp(e.file, urdf) && e.line == 5 &&
+             strstr(e.message, "root of a floating base"),
+         "a massless root cannot float: refused at load, at its URDF line (%s:%d: %s)",
+         e.file, e.line, st ? e.message : "loaded");
+    }
+    ss_data_free(d);
+    ss_model_free(m);
+  }
+}
+
+/* A quaternion of huge components means its direction: 1e300 1e300 0 0 is
+ * a half turn's half about x, not the identity its overflowing length
+ * once normalised it to (a body, a height map, an articulated base). */
+static void test_huge_quaternions(void)
+{
+  char xml[2048];
+  snprintf(xml, sizeof xml,
+           "<raisim><objects>\n"
+           "<box name=\"b\" mass=\"1\"><dim x=\"1\" y=\"1\" z=\"1\"/>"
+           "<state pos=\"0 0 1\" quat=\"1e300 1e300 0 0\"/></box>\n"
+           "<heightmap name=\"h\" x_size=\"1\" y_size=\"1\" x_sample=\"2\" "
+           "y_sample=\"2\" height=\"0 0 0 0\" quat=\"1e300 0 0 -1e300\"/>\n"
+           "<articulated_system name=\"a\" urdf_path=\"%s/tests/data/urdf/example.urdf\">"
+           "<state pos=\"0 0 1\" quat=\"1e300 0 1e300 0\"/></articulated_system>\n"
+           "</objects></raisim>\n", srcdir());
+  ssModel *m = NULL;
+  ssData *d = NULL;
+  ssError e;
+  ssStatus st = load_str(xml, &m, &d, &e);
+  if (st) diag("%s:%d: %s", e.file, e.line, e.message);
+  const double h = sqrt(0.5);
+  int b = st ? -1 : ss_model_find_sys(m, "b"), a = st ? -1 : ss_model_find_sys(m, "a");
+  const double *qb = b >= 0 ? d->qpos + m->sys_qadr[b] + 3 : NULL;
+  const double *qa = a >= 0 ? d->qpos + m->sys_qadr[a] + 3 : NULL;
+  const double *qh = st ? NULL : m->hfield_quat0;
+  ok(qb && fabs(qb[0] - h) < 1e-15 && fabs(qb[1] - h) < 1e-15 && qb[2] == 0 && qb[3] == 0,
+     "body quat 1e300 1e300 0 0 is the turn it says (%g %g %g %g)", qb ? qb[0] : 0,
+     qb ? qb[1] : 0, qb ? qb[2] : 0, qb ? qb[3] : 0);
+  ok(qh && fabs(qh[0] - h) < 1e-15 && qh[1] == 0 && qh[2] == 0 && fabs(qh[3] + h) < 1e-15,
+     "height map quat 1e300 0 0 -1e300 too");
+  ok(qa && fabs(qa[0] - h) < 1e-15 && qa[1] == 0 && fabs(qa[2] - h) < 1e-15 && qa[3] == 0,
+     "articulated base quat 1e300 0 1e300 0 too");
+  ok(st == SS_OK && ss_step(m, d, &e) == SS_OK, "and the world steps");
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
+/* An array attribute's count is checked before its memory is taken: a
+ * one-number height for 10^8 vertices is "has 1 values, expected ...",
+ * even where 800 MB cannot be had (it was "out of memory").  Run in a
+ * child whose address space is capped 300 MB above what it uses. */
+static void test_count_before_alloc(void)
+{
+  static const char xml[] =
+      "<raisim><objects><heightmap name=\"h\" x_size=\"1\" y_size=\"1\" "
+      "x_sample=\"10000\" y_sample=\"10000\" height=\"0\"/></objects></raisim>";
+  fflush(stdout);
+  pid_t pid = fork();
+  if (pid == 0) {
+    long pages = 0;
+    FILE *f = fopen("/proc/self/statm", "r");
+    if (!f || fscanf(f, "%ld", &pages) != 1) _exit(77);
+    fclose(f);
+    rlim_t cap = (rlim_t)pages * (rlim_t)sysconf(_SC_PAGESIZE) + ((rlim_t)300 << 20);
+    struct rlimit r = {cap, cap};
+    if (setrlimit(RLIMIT_AS, &r) != 0) _exit(77);
+    void *probe = malloc(16 << 20); /* a checker's allocator may not cope */
+    if (!probe) _exit(77);
+    free(probe);
+    ssModel *m = NULL;
+    ssData *d = NULL;
+    ssError e;
+    ssStatus st = ss_scene_load_buffer(xml, sizeof xml - 1, "mem.xml", &m, &d, &e);
+    _exit(st != SS_OK && strstr(e.message, "has 1 values, expected") ? 0 : 1);
+  }
+  int status = 0;
+  if (pid < 0 || waitpid(pid, &status, 0) != pid || !WIFEXITED(status)) {
+    ok(0, "a short height array for 10^8 vertices: the check ran");
+    return;
+  }
+  if (WEXITSTATUS(status) == 77) {
+    ok(1, "# SKIP the address space cannot be capped here");
+    return;
+  }
+  ok(WEXITSTATUS(status) == 0,
+     "a short height array for 10^8 vertices is reported as such within "
+     "300 MB (its count is checked before 800 MB are allocated)");
+}
+
 int main(void)
 {
   snprintf(tmpdir, sizeof tmpdir, "/tmp/soilsim-xml-XXXXXX");
@@ -960,6 +1220,11 @@ int main(void)
   test_round_trip();
   test_built_in_code();
   test_mesh_bodies();
+  test_many_systems();
+  test_many_pd();
+  test_massless_root();
+  test_huge_quaternions();
+  test_count_before_alloc();
   test_numbers();
   test_png();
   test_text();
