@@ -165,6 +165,19 @@ static inline void ss_quat_identity(double q[4]) { q[0] = 1; q[1] = q[2] = q[3] 
 static inline double ss_quat_normalize(double q[4])
 {
   double n = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (!(n > 1e-150 && n < 1e150)) {
+    /* squares that overflow (1e300 1e300 0 0 gave n = inf and zeros) or
+     * underflow: the direction from q scaled by its largest entry first */
+    double s = fmax(fmax(fabs(q[0]), fabs(q[1])), fmax(fabs(q[2]), fabs(q[3])));
+    if (s > 0 && s < INFINITY) {
+      double u[4] = {q[0] / s, q[1] / s, q[2] / s, q[3] / s};
+      double nu = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + u[3] * u[3]);
+      if (nu > 0) {
+        for (int k = 0; k < 4; k++) q[k] = u[k] / nu;
+        return nu * s;
+      }
+    }
+  }
   if (n > 0) { q[0] /= n; q[1] /= n; q[2] /= n; q[3] /= n; }
   else ss_quat_identity(q);
   return n;

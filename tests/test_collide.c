@@ -948,6 +948,30 @@ static void test_restitution_rest(void)
   ss_model_free(m);
 }
 
+/* ss_quat_normalize keeps the direction of a quaternion whose squares
+ * overflow or underflow: (1e300, 1e300, 0, 0) came out as zeros (its norm
+ * inf) and (1e-200, 1e-200, 0, 0) as the identity (its squares 0); an
+ * ordinary one keeps its bits, a zero one becomes the identity */
+static void test_quat_normalize(void)
+{
+  const double h = 0.70710678118654752;
+  double big[4] = {1e300, 1e300, 0, 0}, tiny[4] = {1e-200, -1e-200, 0, 0};
+  double q[4] = {0.3, -0.4, 0.5, 0.1}, q2[4], z[4] = {0, 0, 0, 0};
+  double n = sqrt(0.3 * 0.3 + 0.4 * 0.4 + 0.5 * 0.5 + 0.1 * 0.1);
+  for (int k = 0; k < 4; k++) q2[k] = q[k] / n;
+  double nb = ss_quat_normalize(big), nt = ss_quat_normalize(tiny), nq = ss_quat_normalize(q);
+  ss_quat_normalize(z);
+  ok(fabs(big[0] - h) < 1e-15 && fabs(big[1] - h) < 1e-15 && big[2] == 0 && big[3] == 0 &&
+         fabs(nb / 1.4142135623730951e300 - 1) < 1e-15,
+     "a quaternion of 1e300 entries keeps its direction (%.17g %.17g, norm %.6g)", big[0],
+     big[1], nb);
+  ok(fabs(tiny[0] - h) < 1e-15 && fabs(tiny[1] + h) < 1e-15 &&
+         fabs(nt / 1.4142135623730951e-200 - 1) < 1e-15,
+     "... and one of 1e-200 entries (%.17g %.17g)", tiny[0], tiny[1]);
+  ok(!memcmp(q, q2, sizeof q) && nq == n && z[0] == 1 && z[1] == 0 && z[2] == 0 && z[3] == 0,
+     "... an ordinary one is divided by its norm as before, a zero one is the identity");
+}
+
 /* effective width b: DESIGN 2.4, invariant under yaw */
 static void test_width(void)
 {
@@ -1242,6 +1266,7 @@ int main(void)
   test_candidates();
   test_ball_on_slope();
   test_restitution_rest();
+  test_quat_normalize();
   test_width();
   test_aabb();
   test_low_bounds();
