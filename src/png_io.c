@@ -338,12 +338,12 @@ static int encode_png(pngWriteCtx *c, FILE *fp, int w, int h,
   return 0;
 }
 
-ssStatus ss_png_write_rgba_to(ssAtomicFile *af, int w, int h,
-                              const unsigned char *rgba, ssError *err)
+/* the image a writer is given: pixels, and a size each side >= 1 within
+ * SS_PNG_MAX_PIXELS (checked before a file is opened, and again by the
+ * writer into an open one) */
+static ssStatus check_image(const char *path, int w, int h, const unsigned char *rgba,
+                            ssError *err)
 {
-  const char *path = af && af->path[0] ? af->path : "";
-  if (!af || !af->fp)
-    return ss_error_set(err, SS_ERR_STATE, path, 0, "PNG output not open");
   if (!rgba)
     return ss_error_set(err, SS_ERR_VALUE, path, 0, "no pixels to write");
   if (w <= 0 || h <= 0 || (double)w * (double)h > (double)SS_PNG_MAX_PIXELS)
@@ -351,6 +351,17 @@ ssStatus ss_png_write_rgba_to(ssAtomicFile *af, int w, int h,
                         "invalid PNG size %d x %d (each side >= 1, at most %ld "
                         "pixels)",
                         w, h, (long)SS_PNG_MAX_PIXELS);
+  return SS_OK;
+}
+
+ssStatus ss_png_write_rgba_to(ssAtomicFile *af, int w, int h,
+                              const unsigned char *rgba, ssError *err)
+{
+  const char *path = af && af->path[0] ? af->path : "";
+  if (!af || !af->fp)
+    return ss_error_set(err, SS_ERR_STATE, path, 0, "PNG output not open");
+  ssStatus bad = check_image(path, w, h, rgba, err);
+  if (bad != SS_OK) return bad;
 
   pngWriteCtx c;
   memset(&c, 0, sizeof c);
@@ -383,13 +394,8 @@ ssStatus ss_png_write_rgba(const char *path, int w, int h,
 {
   if (!path)
     return ss_error_set(err, SS_ERR_VALUE, "", 0, "no PNG path given");
-  if (!rgba)
-    return ss_error_set(err, SS_ERR_VALUE, path, 0, "no pixels to write");
-  if (w <= 0 || h <= 0 || (double)w * (double)h > (double)SS_PNG_MAX_PIXELS)
-    return ss_error_set(err, SS_ERR_VALUE, path, 0,
-                        "invalid PNG size %d x %d (each side >= 1, at most %ld "
-                        "pixels)",
-                        w, h, (long)SS_PNG_MAX_PIXELS);
+  ssStatus bad = check_image(path, w, h, rgba, err);
+  if (bad != SS_OK) return bad;
 
   ssAtomicFile af;
   memset(&af, 0, sizeof af);

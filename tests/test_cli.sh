@@ -623,15 +623,23 @@ check "a checkpoint restores into an export of its world (plate_arm): identical 
 # rubber before the ground's concrete, which an export listing grounds
 # first turned round (its pair_prop's names swapped, its checkpoints
 # refused as "a different world")
+# round_trip SCENE NAME STEPS WHAT: run, export and checkpoint at STEPS;
+# export the export again; restore the checkpoint into the export
+# (check evaluates its condition later: the name goes in rt_name)
+round_trip() {
+  rt_name=$2
+  run "$1" --steps "$3" --export "$tmp/rt_$2.xml" --checkpoint "$tmp/rt_$2.ckpt@$3" --quiet
+  rc1=$rc
+  run "$tmp/rt_$2.xml" --steps 0 --export "$tmp/rt2_$2.xml" --quiet
+  rc2=$rc
+  run "$tmp/rt_$2.xml" --steps 1 --restore "$tmp/rt_$2.ckpt" --quiet
+  check "$4: export, reload, export again: identical; its checkpoint restores into the export" \
+    '[ "$rc1" -eq 0 ] && [ "$rc2" -eq 0 ] && rc_is 0 &&
+     cmp -s "$tmp/rt_$rt_name.xml" "$tmp/rt2_$rt_name.xml"'
+}
 for s in "$top_srcdir"/scenes/*.xml; do
   b=$(basename "$s" .xml)
-  run "$s" --steps 20 --export "$tmp/rt_$b.xml" --checkpoint "$tmp/rt_$b.ckpt@20" --quiet
-  rc1=$rc
-  run "$tmp/rt_$b.xml" --steps 0 --export "$tmp/rt2_$b.xml" --quiet
-  rc2=$rc
-  run "$tmp/rt_$b.xml" --steps 1 --restore "$tmp/rt_$b.ckpt" --quiet
-  check "$b.xml: export, reload, export again: identical; its checkpoint restores into the export" \
-    '[ "$rc1" -eq 0 ] && [ "$rc2" -eq 0 ] && rc_is 0 && cmp -s "$tmp/rt_$b.xml" "$tmp/rt2_$b.xml"'
+  round_trip "$s" "$b" 20 "$b.xml"
 done
 # a <material> before <objects> (as RaiSim's examples have it) names its
 # pairs' materials first: with one naming materials no object has, the
@@ -644,13 +652,7 @@ mat_pair='<material><default friction="0.8"/><pair_prop name1="wood" name2="rubb
 sed -e "s|<objects>|$mat_pair|" -e 's|<box name="plate"|& material="rubber"|' \
   -e 's|<heightmap name="soil"|& material="wood"|' "$PLATE" >"$tmp/mat2.xml"
 for b in mat1 mat2; do
-  run "$tmp/$b.xml" --steps 5 --export "$tmp/rt_$b.xml" --checkpoint "$tmp/rt_$b.ckpt@5" --quiet
-  rc1=$rc
-  run "$tmp/rt_$b.xml" --steps 0 --export "$tmp/rt2_$b.xml" --quiet
-  rc2=$rc
-  run "$tmp/rt_$b.xml" --steps 1 --restore "$tmp/rt_$b.ckpt" --quiet
-  check "<material> before <objects> ($b): export, reload, export again: identical; its checkpoint restores into the export" \
-    '[ "$rc1" -eq 0 ] && [ "$rc2" -eq 0 ] && rc_is 0 && cmp -s "$tmp/rt_$b.xml" "$tmp/rt2_$b.xml"'
+  round_trip "$tmp/$b.xml" "$b" 5 "<material> before <objects> ($b)"
 done
 run "$PLATE" --steps 0 --checkpoint "$tmp/zero.ckpt@0" --export "$tmp/zero0.xml" --quiet
 run "$PLATE" --steps 0 --restore "$tmp/zero.ckpt" --export "$tmp/zero1.xml" --quiet
