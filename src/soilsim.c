@@ -350,6 +350,14 @@ static int same_output(const OutputName *a, const OutputName *b)
   return !strcmp(a->abs, b->abs);
 }
 
+/* The separator between folder dir and a name in it: none where dir
+ * already ends in '/' (--render fr/ named fr//frame_000000.png) */
+static const char *dir_sep(const char *dir)
+{
+  size_t n = strlen(dir);
+  return n && dir[n - 1] == '/' ? "" : "/";
+}
+
 /* Whether name is a frame's: frame_%06ld.png, as render_step names them.
  * Every such name in the --render folder is the renderer's, whether or
  * not this run's --steps and --render-every reach that step. */
@@ -896,7 +904,8 @@ static ssStatus render_step(ssRenderer *r, const Options *o, const ssModel *m,
                             ssError *err)
 {
   char path[2048];
-  int n = snprintf(path, sizeof path, "%s/frame_%06ld.png", o->render_dir, k);
+  int n = snprintf(path, sizeof path, "%s%sframe_%06ld.png", o->render_dir,
+                   dir_sep(o->render_dir), k);
   if (n < 0 || (size_t)n >= sizeof path)
     return ss_error_set(err, SS_ERR_IO, o->render_dir, 0,
                         "--render: path too long");
@@ -1005,7 +1014,8 @@ static void print_summary(FILE *out, const Options *o, const ssModel *m,
   if (o->export_path) fprintf(out, "export      %s\n", o->export_path);
   if (o->csv_path) fprintf(out, "csv         %s\n", o->csv_path);
   if (o->render_dir)
-    fprintf(out, "frames      %s/frame_*.png (%ld)\n", o->render_dir, nframes);
+    fprintf(out, "frames      %s%sframe_*.png (%ld)\n", o->render_dir,
+            dir_sep(o->render_dir), nframes);
   if (o->rut_map) fprintf(out, "rut map     %s\n", o->rut_map);
   for (int i = 0; i < o->nckpt; i++)
     fprintf(out, "checkpoint  %s (after step %ld)\n", o->ckpt[i].path,
@@ -1050,7 +1060,8 @@ static int run(const Options *o)
      * name refused a folder that held a folder of that name, and named a
      * file the run never writes */
     char probe[2048];
-    snprintf(probe, sizeof probe, "%s/frame_%06d.png", o->render_dir, 0);
+    snprintf(probe, sizeof probe, "%s%sframe_%06d.png", o->render_dir,
+             dir_sep(o->render_dir), 0);
     if (make_dirs(o->render_dir, &err) != SS_OK ||
         check_output(probe, "--render", &err) != SS_OK)
       goto fail;

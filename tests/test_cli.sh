@@ -508,6 +508,10 @@ check "--render creates the folder; frames 0, 4, 8 and the last step (10)" \
    is_png "$tmp/frames/sub/frame_000008.png" &&
    is_png "$tmp/frames/sub/frame_000010.png" &&
    [ "$(ls "$tmp/frames/sub" | wc -l)" -eq 4 ]'
+run "$PLATE" --steps 2 --render "$tmp/frames/slash/" --size 160x120
+check "--render DIR/: the summary names DIR/frame_*.png, not DIR//frame_*.png" \
+  'rc_is 0 && is_png "$tmp/frames/slash/frame_000002.png" &&
+   out_has "$tmp/frames/slash/frame_*.png (2)" && ! out_has "//frame"'
 
 cat >"$tmp/nosoil.xml" <<'EOF'
 <raisim version="1.0">
