@@ -1262,6 +1262,7 @@ static ssStatus read_constraints(uCtx *c, xmlNodePtr n)
       st = unknown_child(c, k, &e, kids);
       continue;
     }
+    if (!st && el_find(&x, "name")) st = get_name(c, &x, "name", p.cl.name);
     int eq = p.cl.type == SS_CLOSURE_EQUALITY;
     p.attr1 = eq ? "joint1" : "body1";
     p.attr2 = eq ? "joint2" : "body2";
@@ -1694,6 +1695,16 @@ static ssStatus build_tree(uCtx *c, ssUrdf *u)
         u->closure[kc++] = p->cl;
       }
     }
+  for (int i = 0; i < u->nclosure && !st; i++) {
+    const ssUrdfClosure *q = &u->closure[i];
+    for (int k = 0; k < i && q->name[0]; k++)
+      if (!strcmp(u->closure[k].name, q->name)) {
+        st = fail(c, SS_ERR_PARSE, q->line,
+                  "duplicate constraint name '%s' (first at line %d)", q->name,
+                  u->closure[k].line);
+        break;
+      }
+  }
   for (int i = 0; i < u->nspring && !st; i++) {
     ssUrdfSpring *s = &u->spring[i];
     if (!s->name[0]) snprintf(s->name, sizeof s->name, "spring%d", i);

@@ -236,6 +236,9 @@ typedef struct ssUrdfJoint {
 /* closure types: ssClosureType in soilsim.h */
 
 typedef struct ssUrdfClosure {
+  char name[128];        /* <constraints> child's name, "" when it has none
+                            (and for a <mimic>'s); two named alike are an
+                            error, as two springs are */
   int type;              /* ssClosureType */
   int body1, body2;      /* links (pin, distance) */
   double anchor1[3];     /* in body1's frame */
