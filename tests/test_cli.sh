@@ -13,6 +13,10 @@
 
 top_srcdir=${top_srcdir:-.}
 top_builddir=${top_builddir:-.}
+# absolute, as make check gives them: some checks run from other folders
+# (a relative top_srcdir failed there when run by hand)
+top_srcdir=$(cd "$top_srcdir" && pwd) || exit 1
+top_builddir=$(cd "$top_builddir" && pwd) || exit 1
 SOILSIM=$top_builddir/soilsim
 PLATE=$top_srcdir/scenes/plate.xml
 
