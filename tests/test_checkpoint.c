@@ -1371,6 +1371,38 @@ static void test_step_limit(void)
   ss_model_free(m2);
 }
 
+/* A forged-checkpoint case: scene run for `steps` steps and checkpointed
+ * (good, n bytes), and two more data of it run `settle` steps, the one a
+ * forged file is loaded into (d2) and its twin, which shows that a
+ * refused load leaves d2 as it was (forge_open: 0 where any of it
+ * failed; forge_close frees what there is) */
+typedef struct Forge {
+  ssModel *m;
+  ssData *d, *d2, *twin;
+  unsigned char *good;
+  size_t n;
+} Forge;
+
+static int forge_open(const char *scene, int steps, int settle, Forge *f)
+{
+  memset(f, 0, sizeof *f);
+  if (!load_scene(scene, &f->m, &f->d)) return 0;
+  f->good = run(f->m, f->d, steps) ? snapshot(f->m, f->d, &f->n) : NULL;
+  f->d2 = ss_data_new(f->m);
+  f->twin = ss_data_new(f->m);
+  return f->good && f->d2 && f->twin && run(f->m, f->d2, settle) &&
+         run(f->m, f->twin, settle);
+}
+
+static void forge_close(Forge *f)
+{
+  free(f->good);
+  ss_data_free(f->twin);
+  ss_data_free(f->d2);
+  ss_data_free(f->d);
+  ss_model_free(f->m);
+}
+
 /* A checkpoint forged with a correct checksum but a clock the scene
  * reader would refuse (time negative or not finite; the step count is
  * checked by the forge table above) is refused as corrupted with a
@@ -1378,30 +1410,20 @@ static void test_step_limit(void)
  * data unchanged: its export could not be read back. */
 static void test_forged_clock(void)
 {
-  ssModel *m;
-  ssData *d;
-  if (!load_scene("plate.xml", &m, &d)) {
-    ok(0, "plate.xml loads");
-    return;
-  }
-  size_t n = 0;
-  unsigned char *good = run(m, d, 20) ? snapshot(m, d, &n) : NULL;
-  unsigned char *p = good ? malloc(n) : NULL;
-  size_t at = good ? find_section(good, n, "CLCK") : 0;
-  ssData *twin = ss_data_new(m);
-  if (!p || !at || !twin || !run(m, twin, 20)) {
-    ok(0, "forged clocks: a checkpoint with a clock section");
-    free(good);
-    free(p);
-    ss_data_free(twin);
-    ss_data_free(d);
-    ss_model_free(m);
+  Forge f;
+  int good = forge_open("plate.xml", 20, 20, &f);
+  ssModel *m = f.m;
+  size_t n = f.n, at = good ? find_section(f.good, n, "CLCK") : 0;
+  unsigned char *p = at ? malloc(n) : NULL;
+  if (!p) {
+    ok(0, "forged clocks: a checkpoint of plate.xml with a clock section");
+    forge_close(&f);
     return;
   }
   const double times[] = {-1.0, -1e-300, -INFINITY, NAN};
   int refused = 0, named = 0, info = 0;
   for (int k = 0; k < 4; k++) {
-    memcpy(p, good, n);
+    memcpy(p, f.good, n);
     uint64_t bits;
     memcpy(&bits, &times[k], 8);
     put(p + at + 16, bits, 8);
@@ -1409,20 +1431,17 @@ static void test_forged_clock(void)
     ssError e;
     ssCheckpointInfo ci;
     ss_error_clear(&e);
-    refused += ss_checkpoint_load_buffer(m, d, p, n, &e) == SS_ERR_PARSE;
+    refused += ss_checkpoint_load_buffer(m, f.d2, p, n, &e) == SS_ERR_PARSE;
     named += strstr(e.message, "clock time") && strstr(e.message, "finite and >= 0");
     diag("forged time %g: %s", times[k], e.message);
     info += ss_checkpoint_info_buffer(p, n, &ci, &e) == SS_ERR_PARSE;
   }
-  ok(refused == 4 && named == 4 && info == 4 && same_state(m, d, twin),
+  ok(refused == 4 && named == 4 && info == 4 && same_state(m, f.d2, f.twin),
      "checkpoints with a correct checksum and a time of -1, -1e-300, -inf or NaN "
      "are refused as corrupted, naming the clock, data unchanged (%d, %d, %d)",
      refused, named, info);
-  free(good);
   free(p);
-  ss_data_free(twin);
-  ss_data_free(d);
-  ss_model_free(m);
+  forge_close(&f);
 }
 
 /* good (n bytes) with section tag's payload replaced by the plen bytes
@@ -1455,17 +1474,14 @@ static unsigned char *with_section(const unsigned char *good, size_t n, const ch
  * the list rebuilt, does not keep. */
 static void test_forged_soil_list(void)
 {
-  ssModel *m;
-  ssData *d;
-  if (!load_scene("plate.xml", &m, &d)) {
-    ok(0, "plate.xml loads");
-    return;
-  }
-  size_t n = 0, len = 0;
-  unsigned char *good = run(m, d, 300) ? snapshot(m, d, &n) : NULL;
-  unsigned char *p = good ? with_section(good, n, "LOAD", NULL, 0, &len) : NULL;
-  ssData *d2 = ss_data_new(m), *twin = ss_data_new(m);
-  if (!p || !d2 || !twin || !run(m, d2, 5) || !run(m, twin, 5)) {
+  Forge f;
+  int opened = forge_open("plate.xml", 300, 5, &f);
+  ssModel *m = f.m;
+  ssData *d = f.d, *d2 = f.d2, *twin = f.twin;
+  unsigned char *good = f.good;
+  size_t n = f.n, len = 0;
+  unsigned char *p = opened ? with_section(good, n, "LOAD", NULL, 0, &len) : NULL;
+  if (!p) {
     ok(0, "forged loaded-vertex list: a checkpoint of the settled plate");
     goto out;
   }
@@ -1514,12 +1530,8 @@ static void test_forged_soil_list(void)
     d2->soil_sinkage[far] = keep;
   }
 out:
-  free(good);
   free(p);
-  ss_data_free(twin);
-  ss_data_free(d2);
-  ss_data_free(d);
-  ss_model_free(m);
+  forge_close(&f);
 }
 
 /* A checkpoint whose Newton records (the next steps start from 2 c_1 -
@@ -1529,19 +1541,15 @@ out:
  * start overflowed. */
 static void test_forged_newton(void)
 {
-  ssModel *m;
-  ssData *d;
-  if (!load_scene("plate_arm.xml", &m, &d)) {
-    ok(0, "plate_arm.xml loads");
-    return;
-  }
-  size_t n = 0;
-  unsigned char *good = run(m, d, 120) ? snapshot(m, d, &n) : NULL;
-  size_t at = good ? find_section(good, n, "NEWT") : 0;
+  Forge f;
+  int opened = forge_open("plate_arm.xml", 120, 5, &f);
+  ssModel *m = f.m;
+  ssData *d2 = f.d2, *twin = f.twin;
+  unsigned char *good = f.good;
+  size_t n = f.n, at = opened ? find_section(good, n, "NEWT") : 0;
   unsigned char *p = at ? malloc(n) : NULL;
-  ssData *d2 = ss_data_new(m), *twin = ss_data_new(m);
   int n0 = at ? (int)le(good + at + 16 + 16, 4) : 0;
-  if (!p || !d2 || !twin || n0 <= 0 || !run(m, d2, 5) || !run(m, twin, 5)) {
+  if (!p || n0 <= 0) {
     ok(0, "forged Newton records: a checkpoint of plate_arm.xml with them");
     goto out;
   }
@@ -1565,12 +1573,8 @@ static void test_forged_newton(void)
   st = ss_checkpoint_load_buffer(m, d2, good, n, &e);
   ok(st == SS_OK && run(m, d2, 5), "the checkpoint as written restores and steps");
 out:
-  free(good);
   free(p);
-  ss_data_free(twin);
-  ss_data_free(d2);
-  ss_data_free(d);
-  ss_model_free(m);
+  forge_close(&f);
 }
 
 /* A soil material edited between steps (a supported use: test_plate's
