@@ -516,7 +516,7 @@ static Mat mat_of(const NGroup *G, double dt)
   const ssSoilMaterial *mat = G->mat;
   Mat M = {dt, mat->sinkage_exponent,
            mat->elastic_stiffness, mat->damping, mat->friction_coefficient,
-           ss_soil_janosi_inverse(mat) > 0 ? dt / mat->shear_displacement : 0,
+           G->ik > 0 ? dt / mat->shear_displacement : 0,
            mat->sinkage_exponent == 1.0, {0, {0}, 0, NULL}, G->gq, G->gmax};
   if (!M.linear) {
     M.pser = ss_pow_series(M.n - 1);
