@@ -675,6 +675,15 @@ static ssStatus flush_output(ssAtomicFile *f, ssError *err)
   return SS_OK;
 }
 
+/* An open output committed (put in place), and marked no longer open so
+ * that a later failure does not abort it; SS_OK where it is not open */
+static ssStatus commit_output(ssAtomicFile *f, int *open, ssError *err)
+{
+  if (!*open) return SS_OK;
+  *open = 0;
+  return ss_atomic_commit(f, err);
+}
+
 static ssStatus check_output(const char *path, const char *flag, ssError *err)
 {
   ssError e;
@@ -1181,19 +1190,16 @@ static int run(const Options *o)
   if (g_signal) {
     progress_clear(&prog);
     /* what is written as the run goes stays: say what that is */
-    if (nckpt && nframes)
-      fprintf(stderr, "soilsim: interrupted after step %ld; only the %d "
-              "checkpoint%s of earlier steps and the %ld frame%s drawn so far "
-              "written\n", done, nckpt, nckpt == 1 ? "" : "s", nframes,
-              nframes == 1 ? "" : "s");
-    else if (nckpt)
-      fprintf(stderr, "soilsim: interrupted after step %ld; only the %d "
-              "checkpoint%s of earlier steps written\n", done, nckpt,
-              nckpt == 1 ? "" : "s");
-    else if (nframes)
-      fprintf(stderr, "soilsim: interrupted after step %ld; only the %ld "
-              "frame%s drawn so far written\n", done, nframes,
-              nframes == 1 ? "" : "s");
+    char ck[64] = "", fr[64] = "";
+    if (nckpt)
+      snprintf(ck, sizeof ck, "the %d checkpoint%s of earlier steps", nckpt,
+               nckpt == 1 ? "" : "s");
+    if (nframes)
+      snprintf(fr, sizeof fr, "the %ld frame%s drawn so far", nframes,
+               nframes == 1 ? "" : "s");
+    if (nckpt || nframes)
+      fprintf(stderr, "soilsim: interrupted after step %ld; only %s%s%s written\n", done,
+              ck, nckpt && nframes ? " and " : "", fr);
     else
       fprintf(stderr, "soilsim: interrupted after step %ld; no output files "
               "written\n", done);
@@ -1213,37 +1219,23 @@ static int run(const Options *o)
       goto fail;
     /* a stream (a FIFO's reader waits for its end) is finished at once:
      * it has nothing to roll back */
-    if (rut.direct) {
-      rut_open = 0;
-      if (ss_atomic_commit(&rut, &err) != SS_OK) goto fail;
-    }
+    if (rut.direct && commit_output(&rut, &rut_open, &err) != SS_OK) goto fail;
   }
   if (o->export_path) {
     if (open_output(&exp, o->export_path, "--export", &err) != SS_OK)
       goto fail;
     exp_open = 1;
     if (ss_scene_export_to(m, d, &exp, &err) != SS_OK) goto fail;
-    if (exp.direct) {
-      exp_open = 0;
-      if (ss_atomic_commit(&exp, &err) != SS_OK) goto fail;
-    }
+    if (exp.direct && commit_output(&exp, &exp_open, &err) != SS_OK) goto fail;
   }
   if ((rut_open && flush_output(&rut, &err) != SS_OK) ||
       (exp_open && flush_output(&exp, &err) != SS_OK) ||
       (csv_open && flush_output(&csv, &err) != SS_OK))
     goto fail;
-  if (rut_open) {
-    rut_open = 0;
-    if (ss_atomic_commit(&rut, &err) != SS_OK) goto fail;
-  }
-  if (exp_open) {
-    exp_open = 0;
-    if (ss_atomic_commit(&exp, &err) != SS_OK) goto fail;
-  }
-  if (csv_open) {
-    csv_open = 0;
-    if (ss_atomic_commit(&csv, &err) != SS_OK) goto fail;
-  }
+  if (commit_output(&rut, &rut_open, &err) != SS_OK ||
+      commit_output(&exp, &exp_open, &err) != SS_OK ||
+      commit_output(&csv, &csv_open, &err) != SS_OK)
+    goto fail;
   if (!o->quiet)
     print_summary(output_is_stdout(o) ? stderr : stdout, o, m, d, done, wall,
                   nframes, unconverged, o->restore ? &restored : NULL);
