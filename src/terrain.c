@@ -526,33 +526,22 @@ static int mesh_candidates(const ssModel *m, int g, const ssShape *s,
 static void round_on_slope(const ssModel *m, int h, const ssShape *s,
                            double pts[][3], int npt)
 {
-  int type = s->type;
-  if (type != SS_GEOM_SPHERE && type != SS_GEOM_CAPSULE && type != SS_GEOM_CYLINDER) return;
-  double r = s->size[0];
-  for (int pass = 0; pass < 2; pass++) {
-    if (type == SS_GEOM_CYLINDER) {
+  int type = s->type, ring = type == SS_GEOM_CYLINDER;
+  if (type != SS_GEOM_SPHERE && type != SS_GEOM_CAPSULE && !ring) return;
+  double low[SS_RIGID_CANDIDATES][3];
+  for (int pass = 0; pass < 2; pass++)
+    for (int k = 0; k < (ring ? 1 : npt); k++) {
       double zs, nl[3];
-      if (!hfield_sample(m, h, pts[0][0], pts[0][1], &zs, nl) || (nl[0] == 0 && nl[1] == 0))
-        return;
-      ss_shape_candidates(s, nl, pts, npt);
-      continue;
-    }
-    for (int k = 0; k < npt; k++) {
-      double zs, nl[3], c[3];
-      if (!hfield_sample(m, h, pts[k][0], pts[k][1], &zs, nl) || (nl[0] == 0 && nl[1] == 0))
+      if (!hfield_sample(m, h, pts[k][0], pts[k][1], &zs, nl) || (nl[0] == 0 && nl[1] == 0)) {
+        if (ring) return;
         continue;
-      /* the centre of the sphere, or of the capsule's end k */
-      ss_v3_copy(c, s->pos);
-      if (type == SS_GEOM_CAPSULE) {
-        double e = k ? 0.5 : -0.5;
-        c[0] += e * s->size[1] * s->R[2];
-        c[1] += e * s->size[1] * s->R[5];
-        c[2] += e * s->size[1] * s->R[8];
       }
-      ss_v3_copy(pts[k], c);
-      ss_v3_addscl(pts[k], nl, -r);
+      /* the candidates lowest along nl: the whole ring, or point k (the
+       * sphere's, or the capsule's end k's) */
+      ss_shape_candidates(s, nl, low, npt);
+      if (ring) memcpy(pts, low, (size_t)npt * sizeof low[0]);
+      else ss_v3_copy(pts[k], low[k]);
     }
-  }
 }
 
 /* Coulomb contacts of geom g against a rigid surface: candidate points of
