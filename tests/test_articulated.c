@@ -476,17 +476,27 @@ static void test_xforce_window(void)
   }
 }
 
+/* a 2 kg bob 0.5 m out along x from a revolute joint "hinge" about -y
+ * (level at q = 0), the pendulum of the PD and limit tests; *hinge: the
+ * joint's index */
+static ssUrdf *level_pendulum(int *hinge)
+{
+  ssUrdf *u = urdf_new();
+  int base = add_link(u, "base", 1, NULL, 0.01, 0.01, 0.01);
+  double com[3] = {0.5, 0, 0};
+  int bob = add_link(u, "bob", 2, com, 0.001, 0.001, 0.001);
+  int j = add_joint(u, "hinge", SS_JOINT_REVOLUTE, base, bob, NULL, ny_axis());
+  if (hinge) *hinge = j;
+  return u;
+}
+
 /* a PD target written non-finite between steps is refused by name, the
  * state left as it was, and no checkpoint is written of it: it made the
  * step fail as "too stiff", and a checkpoint its own reader refused as
  * corrupted */
 static void test_pd_target_finite(void)
 {
-  ssUrdf *u = urdf_new();
-  int base = add_link(u, "base", 1, NULL, 0.01, 0.01, 0.01);
-  double com[3] = {0.5, 0, 0};
-  int bob = add_link(u, "bob", 2, com, 0.001, 0.001, 0.001);
-  add_joint(u, "hinge", SS_JOINT_REVOLUTE, base, bob, NULL, ny_axis());
+  ssUrdf *u = level_pendulum(NULL);
   ssError e;
   World w = build(u, 1, NULL);
   ss_model_add_pd(w.m, 0, "hinge", 100, 10, 0, 0, 0, 0, &e);
@@ -912,11 +922,8 @@ static void test_distance_equality(void)
  * comes to rest on the limit and never passes it */
 static void test_limit(void)
 {
-  ssUrdf *u = urdf_new();
-  int base = add_link(u, "base", 1, NULL, 0.01, 0.01, 0.01);
-  double com[3] = {0.5, 0, 0};
-  int bob = add_link(u, "bob", 2, com, 0.001, 0.001, 0.001);
-  int j = add_joint(u, "hinge", SS_JOINT_REVOLUTE, base, bob, NULL, ny_axis());
+  int j;
+  ssUrdf *u = level_pendulum(&j);
   u->joint[j].limited = 1;
   u->joint[j].lower = -0.5;
   u->joint[j].upper = 0.5;
