@@ -2354,7 +2354,9 @@ ssStatus ss_art_rows(const ssModel *m, ssData *d, ssError *err)
       c->vertex = -1;
       c->dof = m->body_dofadr[b];
       c->g0 = gap;
-      c->vn_target = gap >= 0 ? -gap / dt : -m->opt.rigid_erp * gap / dt;
+      /* (past the limit: stop there; the push moves it back,
+       * ss_solver_push) */
+      c->vn_target = gap >= 0 ? -gap / dt : 0;
       ss_art_dof_row(d, s, c->dof, side == 1 ? -1 : 1, d->jac + c->jadr, c->G);
     }
   }

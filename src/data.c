@@ -22,6 +22,7 @@ ssData *ss_data_new(const ssModel *m)
   d->qvel = calloc(nv, sizeof(double));
   d->qvel_free = calloc(nv, sizeof(double));
   d->qvel_start = calloc(nv, sizeof(double));
+  d->qvel_push = calloc(nv, sizeof(double));
   d->sys_active = calloc(ns, 1);
   d->body_xpos = calloc(nb * 3, sizeof(double));
   d->body_xquat = calloc(nb * 4, sizeof(double));
@@ -39,7 +40,8 @@ ssData *ss_data_new(const ssModel *m)
   d->soil_sinkage = calloc(nhd, sizeof(double));
   d->soil_plastic = calloc(nhd, sizeof(double));
   d->soil_shear = calloc(nhd, sizeof(double));
-  if (!d->qpos || !d->qvel || !d->qvel_free || !d->qvel_start || !d->sys_active ||
+  if (!d->qpos || !d->qvel || !d->qvel_free || !d->qvel_start || !d->qvel_push ||
+      !d->sys_active ||
       !d->body_xpos || !d->body_xquat || !d->body_xmat || !d->geom_xpos ||
       !d->geom_xmat || !d->geom_patch || !d->hfield_pow || !d->body_iinv ||
       !d->body_xipos || !d->pd_target ||
@@ -61,6 +63,7 @@ void ss_data_free(ssData *d)
 {
   if (!d) return;
   free(d->qpos); free(d->qvel); free(d->qvel_free); free(d->qvel_start);
+  free(d->qvel_push);
   free(d->sys_active);
   free(d->body_xpos); free(d->body_xquat); free(d->body_xmat);
   free(d->geom_xpos); free(d->geom_xmat); free(d->geom_patch); free(d->body_iinv);

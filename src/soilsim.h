@@ -159,7 +159,10 @@ typedef struct ssOption {
                                 what the reach cannot see, the contacts'
                                 own change of that velocity within the
                                 step (2 m/s at dt = 1 ms) */
-  double rigid_erp;          /* fraction of rigid penetration removed per step */
+  double rigid_erp;          /* fraction of rigid penetration (or of a joint
+                                past its limit) removed per step, by a
+                                push that moves positions only
+                                (ss_solver_push) */
 } ssOption;
 
 ssOption ss_option_default(void);
@@ -506,6 +509,9 @@ typedef struct ssData {
   double *jac;            /* contact Jacobians and responses (internal) */
   size_t cap_jac;
   double *qvel_free;      /* (nv) velocity before contact impulses */
+  double *qvel_push;      /* (nv) the step's push out of penetrations, which
+                             moves the positions and not the velocities
+                             (ss_solver_push; scratch within a step) */
   double *qvel_start;     /* (nv) velocity at the step's start, before its
                              loads: a rigid contact's approach speed for
                              restitution (ss_step sets it) */

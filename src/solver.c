@@ -1839,6 +1839,84 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   return SS_OK;
 }
 
+/* ---------------------------------------------------------------------- */
+/* the push out of penetrations                                            */
+
+/* The push's sweeps: its answer moves positions only, by rigid_erp of a
+ * penetration, so a relative change of 1e-6 is far below what anyone
+ * sees (a micrometre of a metre's penetration); the cap bounds a step
+ * whose rigid contacts couple stiffly (a vehicle's wheels through its
+ * suspension), where the push is then partly made and the next step's
+ * makes the rest. */
+enum { PUSH_SWEEPS = 50 };
+#define PUSH_TOL 1e-6
+
+/* (solver.h) */
+int ss_solver_push(const ssModel *m, ssData *d)
+{
+  /* a moving system's rigid contacts and joint limits, any of them
+   * penetrating */
+  int n = 0, deep = 0;
+  for (int i = 0; i < d->ncontact; i++) {
+    const ssContact *c = d->contact + i;
+    if ((c->type == SS_CONTACT_RIGID || c->type == SS_CONTACT_LIMIT) && c->nv > 0) {
+      n++;
+      deep |= c->g0 < 0;
+    }
+  }
+  if (!deep) return 0;
+  int *idx = malloc((size_t)n * sizeof *idx);
+  double *p = calloc((size_t)n, sizeof *p);
+  if (!idx || !p) {
+    free(idx);
+    free(p);
+    return -1;
+  }
+  n = 0;
+  for (int i = 0; i < d->ncontact; i++) {
+    const ssContact *c = d->contact + i;
+    if ((c->type == SS_CONTACT_RIGID || c->type == SS_CONTACT_LIMIT) && c->nv > 0) idx[n++] = i;
+  }
+  /* the sweeps on a velocity of their own, from rest: d->qvel holds the
+   * push while they run, the step's velocity waits in qvel_push */
+  const size_t nv = (size_t)m->nv;
+  memcpy(d->qvel_push, d->qvel, nv * sizeof(double));
+  memset(d->qvel, 0, nv * sizeof(double));
+  const double erp_dt = m->opt.rigid_erp / m->opt.timestep;
+  for (int sweep = 0; sweep < PUSH_SWEEPS; sweep++) {
+    double dmax = 0, lmax = 0;
+    for (int k = 0; k < n; k++) {
+      ssContact *c = d->contact + idx[k];
+      if (!(c->G[0] > 0)) continue;
+      double v[3];
+      if (c->type == SS_CONTACT_LIMIT)
+        v[0] = row_velocity(d, c);
+      else
+        contact_velocity(m, d, c, v);
+      /* out by rigid_erp of the penetration; a contact not penetrating
+       * is not pushed into its support */
+      double target = c->g0 < 0 ? -erp_dt * c->g0 : 0;
+      double pn = p[k] + (target - v[0]) / c->G[0];
+      if (!(pn > 0)) pn = 0;
+      double dl[3] = {pn - p[k], 0, 0};
+      p[k] = pn;
+      if (dl[0] != 0) apply_impulse(m, d, c, dl);
+      dmax = fabs(dl[0]) > dmax ? fabs(dl[0]) : dmax;
+      lmax = pn > lmax ? pn : lmax;
+    }
+    if (!(dmax > PUSH_TOL * lmax)) break;
+  }
+  /* the push into qvel_push, the step's velocity back */
+  for (size_t k = 0; k < nv; k++) {
+    double t = d->qvel[k];
+    d->qvel[k] = d->qvel_push[k];
+    d->qvel_push[k] = t;
+  }
+  free(idx);
+  free(p);
+  return 1;
+}
+
 /* the soil beds' tables of powers (solver.h) */
 void ss_solver_pow_tables(const ssModel *m, ssData *d)
 {

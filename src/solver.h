@@ -233,6 +233,18 @@ void ss_solver_warm_apply(const ssModel *m, ssData *d);
  * points that stick at its start take their tangential impulses from it) */
 void ss_solver_warm_lambda(const ssModel *m, const ssData *d, int i, double lam[3]);
 ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err);
+/* The push out of penetrations (split impulse), after the solve: the
+ * velocity that moves the solve's rigid contacts and joint limits out of
+ * their supports by rigid_erp of their penetration in one step (and no
+ * other of them in), found by sweeps of normal impulses on a velocity of
+ * its own, from rest, into d->qvel_push; d->qvel is left as the solve
+ * left it.  The step moves the positions by d->qvel + d->qvel_push, and
+ * the push leaves no velocity behind: a body started inside the ground
+ * is moved out over a few steps instead of being thrown from it (the
+ * solve itself only stops a penetrating contact, and bounces it by its
+ * restitution).  Returns 1 with a push, 0 where nothing penetrates
+ * (qvel_push untouched), -1 out of memory (d->qvel as it was). */
+int ss_solver_push(const ssModel *m, ssData *d);
 
 /* The Newton phase (newton.c): when every contact is a soil point on an
  * articulated link or a PD row and every loaded point slips, solve the

@@ -103,9 +103,37 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
     goto fail;
   }
 
-  /* positions from the new velocities; loop-closure drift removed */
+  /* positions from the new velocities and the push out of penetrations,
+   * which moves them and leaves the velocities as they are; loop-closure
+   * drift removed */
+  int push = ss_solver_push(m, d);
+  if (push < 0) {
+    st = ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
+    goto fail;
+  }
+  /* a push is a velocity too, under the same limit (a body deep below a
+   * rigid support with rigid_erp = 1 would be moved by 1e12 m in a
+   * step) */
+  for (int s = 0; push && s < m->nsys; s++)
+    if (d->sys_active[s] && !ss_all_within(d->qvel_push + m->sys_vadr[s], m->sys_nv[s], SS_SPEED_MAX)) {
+      st = ss_error_set(err, SS_ERR_NUMERIC, NULL, 0,
+                        "step %ld (t = %.6g s): the push of '%s' out of its "
+                        "penetration became non-finite or absurd (above %g m/s "
+                        "or rad/s); the penetration is too deep for rigid_erp "
+                        "%g to remove in one step", d->step + 1,
+                        d->time + m->opt.timestep, m->sys_name[s], SS_SPEED_MAX,
+                        m->opt.rigid_erp);
+      goto fail;
+    }
   d->closure_error = 0;
+  if (push)
+    for (int k = 0; k < m->nv; k++) {
+      double u = d->qvel[k];
+      d->qvel[k] += d->qvel_push[k];
+      d->qvel_push[k] = u;
+    }
   ss_dyn_integrate(m, d);
+  if (push) memcpy(d->qvel, d->qvel_push, (size_t)m->nv * sizeof(double));
   ss_forward_step(m, d);
   t1 = now(); t[5] = t1 - t0; t0 = t1;
 

@@ -594,10 +594,11 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
     frame_from_normal(nw, c->frame);
     c->g0 = gap;
     c->mu = pair->friction;
-    /* lowest allowed end-of-step normal velocity: close a gap, remove a
-     * fraction of a penetration, or bounce */
+    /* lowest allowed end-of-step normal velocity: close a gap, stop in a
+     * penetration (the push moves it out, ss_solver_push, and leaves the
+     * velocity alone), or bounce */
     double dt = m->opt.timestep;
-    c->vn_target = gap >= 0 ? -gap / dt : -m->opt.rigid_erp * gap / dt;
+    c->vn_target = gap >= 0 ? -gap / dt : 0;
     if (njac > 0 && gap <= m->opt.contact_margin) {
       /* the approach before this step's loads (qvel_start): with
        * gravity's g dt in it, a body resting on the support met it at

@@ -941,6 +941,41 @@ static void test_limit(void)
   ss_urdf_free(u);
 }
 
+/* a pendulum started 0.2 rad past its lower limit is moved back by
+ * rigid_erp (0.2) of the violation a step, 0.2 * 0.8^k rad left after k
+ * steps, with no speed from it (the push out of penetrations moves
+ * positions only, ss_solver_push): gravity holds it on the limit.  The
+ * limit's row used to take the recovery as velocity, 0.2 * 0.2 / 1 ms =
+ * 40 rad/s, and threw the pendulum across its range onto the other
+ * limit.  Tolerances: one row's push is exact to round-off; the limit
+ * stops the joint to the solve's 1e-9. */
+static void test_limit_recover(void)
+{
+  int j;
+  ssUrdf *u = level_pendulum(&j);
+  u->joint[j].limited = 1;
+  u->joint[j].lower = -0.5;
+  u->joint[j].upper = 0.5;
+  const double q0 = -0.7;
+  World w = build_q(u, 1, NULL, &q0, 1);
+  finish(&w);
+  double worst = 0, vmax = 0, qmax = -INFINITY, left = 0.2;
+  int good = 1;
+  for (int k = 0; good && k < 1000; k++) {
+    good = steps(&w, 1);
+    left *= 0.8;
+    if (k < 60) worst = fmax(worst, fabs(w.d->qpos[0] - (-0.5 - left)));
+    vmax = fmax(vmax, fabs(w.d->qvel[0]));
+    qmax = fmax(qmax, w.d->qpos[0]);
+  }
+  ok(good && worst <= 1e-12 && vmax <= 1e-6 && qmax <= -0.5 + 1e-9,
+     "a joint started 0.2 rad past its limit: back by 0.2 of it a step (worst %.3g rad from "
+     "0.2 * 0.8^k over 60 steps), no speed from it (largest %.3g rad/s), never off the "
+     "limit (highest %.9f rad)", worst, vmax, qmax);
+  drop(&w);
+  ss_urdf_free(u);
+}
+
 /* a link whose collider is a triangle mesh (a 0.4 x 0.6 x 0.05 box made of
  * 12 triangles): the footprint (its corners' hull) and BVH depths give the
  * same analytic sinkage as the box */
@@ -1227,5 +1262,6 @@ int main(void)
   test_mesh_on_soil();
   test_distance_equality();
   test_limit();
+  test_limit_recover();
   return done_testing();
 }
