@@ -1236,9 +1236,23 @@ static int run(const Options *o)
       commit_output(&exp, &exp_open, &err) != SS_OK ||
       commit_output(&csv, &csv_open, &err) != SS_OK)
     goto fail;
-  if (!o->quiet)
-    print_summary(output_is_stdout(o) ? stderr : stdout, o, m, d, done, wall,
-                  nframes, unconverged, o->restore ? &restored : NULL);
+  if (!o->quiet) {
+    /* a summary that cannot be written (standard output on a full disk or
+     * a closed pipe) fails the run, as any output would; the files are
+     * complete by now, and the message says so */
+    FILE *out = output_is_stdout(o) ? stderr : stdout;
+    print_summary(out, o, m, d, done, wall, nframes, unconverged,
+                  o->restore ? &restored : NULL);
+    errno = 0;
+    if (fflush(out) != 0 || ferror(out)) {
+      ss_error_set(&err, SS_ERR_IO, NULL, 0,
+                   "the summary could not be written to standard %s (%s); "
+                   "the output files are complete", out == stdout ? "output" : "error",
+                   errno ? strerror(errno) : "write error");
+      report(&err);
+      goto cleanup;
+    }
+  }
   status = 0;
   goto cleanup;
 

@@ -290,9 +290,19 @@ if [ "$(id -u)" -eq 0 ]; then
   run "$PLATE" --steps 3 --rut-map "$tmp/full/r2.png" --export "$tmp/full/e.xml"
   check "an export that fails at the end: an existing rut map stays as it was" \
     'rc_is 1 && [ "$(cat "$tmp/full/r2.png")" = old ] && no_tmp "$tmp/full"'
+  # a summary that cannot be written fails the run (it exited 0)
+  mknod "$tmp/full/stdout" c 1 7
+  last_cmd="soilsim $PLATE --steps 3 --csv $tmp/full/s.csv >(a copy of /dev/full)"
+  CI='' $TIMEOUT "$SOILSIM" "$PLATE" --steps 3 --csv "$tmp/full/s.csv" \
+    >"$tmp/full/stdout" 2>"$tmp/err"
+  rc=$?
+  check "standard output full: exit 1, the summary not written, the CSV complete" \
+    'rc_is 1 && err_has "summary could not be written to standard output" &&
+     [ "$(wc -l <"$tmp/full/s.csv")" -eq 4 ]'
 else
   skip "an export that fails at the end (mknod needs root)"
   skip "an export that fails at the end: an existing rut map (mknod needs root)"
+  skip "standard output full (mknod needs root)"
 fi
 
 # A failed run never touches an existing output file.
