@@ -1755,15 +1755,13 @@ static void metres_label(char *buf, size_t len, double m)
   else snprintf(buf, len, "%g mm", m * 1000);
 }
 
-/* The rut map, written to png_path or, when af is given, into it (left
- * open for the caller to commit). */
-static ssStatus rut_map(const ssModel *m, const ssData *d, int hfield,
-                        int plastic, int width, int height,
-                        const char *png_path, ssAtomicFile *af, ssError *err)
+/* What a rut map of bed hfield (-1: the first soil bed) at width x height
+ * needs before any pixel: the bed (*h), its layout (*L) and the label
+ * font (*font, NULL where font is NULL: the check alone) */
+static ssStatus rut_map_setup(const ssModel *m, int hfield, int width, int height,
+                              const char *png_path, int *hout, ssRutMapLayout *Lout,
+                              ssFont **font, ssError *err)
 {
-  if (!m || !d)
-    return ss_error_set(err, SS_ERR_VALUE, png_path ? png_path : "", 0,
-                        "ss_render_rut_map: no model or data");
   int h = hfield;
   if (h < 0) {
     for (int k = 0; k < m->nhfield && h < 0; k++)
@@ -1787,13 +1785,48 @@ static ssStatus rut_map(const ssModel *m, const ssData *d, int hfield,
                         width, height, SS_RUT_MAP_MIN_WIDTH, SS_RENDER_MAX_SIDE,
                         SS_RUT_MAP_MIN_SIDE, SS_RENDER_MAX_SIDE);
   double xs = m->hfield_size[2 * h], ys = m->hfield_size[2 * h + 1];
-  ssRutMapLayout L;
-  if (ss_rut_map_layout(width, height, xs, ys, &L) != 0)
+  if (ss_rut_map_layout(width, height, xs, ys, Lout) != 0)
     return ss_error_set(err, SS_ERR_VALUE, png_path ? png_path : "", 0,
                         "invalid rut map size %d x %d: %d to %d pixels wide, "
                         "%d to %d high",
                         width, height, SS_RUT_MAP_MIN_WIDTH, SS_RENDER_MAX_SIDE,
                         SS_RUT_MAP_MIN_SIDE, SS_RENDER_MAX_SIDE);
+  ssFont *f = ss_font_new(Lout->font_px, err);
+  if (!f) return err ? err->code : SS_ERR_IO;
+  if (font)
+    *font = f;
+  else
+    ss_font_free(f);
+  *hout = h;
+  return SS_OK;
+}
+
+/* (render.h) */
+ssStatus ss_render_rut_map_check(const ssModel *m, int hfield, int width, int height,
+                                 const char *png_path, ssError *err)
+{
+  if (!m)
+    return ss_error_set(err, SS_ERR_VALUE, png_path ? png_path : "", 0,
+                        "ss_render_rut_map_check: no model");
+  int h = -1;
+  ssRutMapLayout L;
+  return rut_map_setup(m, hfield, width, height, png_path, &h, &L, NULL, err);
+}
+
+/* The rut map, written to png_path or, when af is given, into it (left
+ * open for the caller to commit). */
+static ssStatus rut_map(const ssModel *m, const ssData *d, int hfield,
+                        int plastic, int width, int height,
+                        const char *png_path, ssAtomicFile *af, ssError *err)
+{
+  if (!m || !d)
+    return ss_error_set(err, SS_ERR_VALUE, png_path ? png_path : "", 0,
+                        "ss_render_rut_map: no model or data");
+  int h = -1;
+  ssRutMapLayout L;
+  ssFont *font = NULL;
+  ssStatus st0 = rut_map_setup(m, hfield, width, height, png_path, &h, &L, &font, err);
+  if (st0) return st0;
 
   int nx = m->hfield_nx[h], ny = m->hfield_ny[h];
   size_t n = (size_t)nx * (size_t)ny;
@@ -1801,8 +1834,6 @@ static ssStatus rut_map(const ssModel *m, const ssData *d, int hfield,
   for (size_t k = 0; k < n; k++) vmax = fmax(vmax, soil_value(m, d, h, k, plastic));
   double fs = ss_nice_ceil(vmax);
 
-  ssFont *font = ss_font_new(L.font_px, err);
-  if (!font) return err ? err->code : SS_ERR_IO;
   unsigned char *px = malloc((size_t)width * (size_t)height * 4);
   if (!px) {
     ss_font_free(font);

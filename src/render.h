@@ -124,6 +124,9 @@ const char *ss_render_backend_name(const ssRenderer *r);
 typedef struct ssGLContext ssGLContext;
 
 #define SS_GL_ENV "SOILSIM_GL"
+/* the environment variable naming the label font file (ss_font_new): set,
+ * that file alone is tried; unset, the configured font, then DejaVu Sans */
+#define SS_FONT_ENV "SOILSIM_FONT"
 
 /* A context rendering width x height pixels (1 .. SS_RENDER_MAX_SIDE),
  * current on return.  NULL with err filled on failure. */

@@ -45,23 +45,36 @@ ssFont *ss_font_new(int pixel_size, ssError *err)
     ss_error_set(err, SS_ERR_UNSUPPORTED, "", 0, "cannot start FreeType");
     return NULL;
   }
+  /* SS_FONT_ENV names the font to use, and then it alone is tried (a
+   * failure says why); else the configured one, then DejaVu Sans */
+  const char *env = getenv(SS_FONT_ENV);
   const char *paths[2] = {SS_FONT_PATH, SS_FONT_FALLBACK};
+  int npath = 2;
+  if (env && *env) {
+    paths[0] = env;
+    npath = 1;
+  }
   FT_Error fe = 0;
-  for (int k = 0; k < 2 && !f->face; k++) {
+  for (int k = 0; k < npath && !f->face; k++) {
     if (k == 1 && strcmp(paths[0], paths[1]) == 0) break;
     fe = FT_New_Face(f->lib, paths[k], 0, &f->face);
     if (fe != 0) f->face = NULL;
   }
   if (!f->face) {
-    ss_error_set(err, SS_ERR_IO, SS_FONT_PATH, 0,
-                 "cannot load the label font (FreeType error %d); install "
-                 "fonts-dejavu-core or configure --with-font=FILE",
-                 (int)fe);
+    if (npath == 1)
+      ss_error_set(err, SS_ERR_IO, paths[0], 0,
+                   "cannot load the label font named by %s (FreeType error %d)",
+                   SS_FONT_ENV, (int)fe);
+    else
+      ss_error_set(err, SS_ERR_IO, SS_FONT_PATH, 0,
+                   "cannot load the label font (FreeType error %d); install "
+                   "fonts-dejavu-core or configure --with-font=FILE",
+                   (int)fe);
     ss_font_free(f);
     return NULL;
   }
   if (FT_Set_Pixel_Sizes(f->face, 0, (FT_UInt)pixel_size) != 0) {
-    ss_error_set(err, SS_ERR_UNSUPPORTED, SS_FONT_PATH, 0,
+    ss_error_set(err, SS_ERR_UNSUPPORTED, npath == 1 ? paths[0] : SS_FONT_PATH, 0,
                  "the label font has no %d-pixel size", pixel_size);
     ss_font_free(f);
     return NULL;

@@ -1098,6 +1098,11 @@ static int run(const Options *o)
     ropt.width = o->width;
     ropt.height = o->height;
   }
+  /* what the rut map needs but the soil's values (its label font, found
+   * only at the end of the run otherwise) */
+  if (o->rut_map && ss_render_rut_map_check(m, -1, ropt.width, ropt.height, o->rut_map,
+                                            &err) != SS_OK)
+    goto fail;
   /* a camera from the command line replaces the scene's <camera> */
   if (o->camera_pos_given) {
     ropt.camera_given = 1;

@@ -690,6 +690,12 @@ ssStatus ss_render_rut_map(const ssModel *m, const ssData *d, int hfield,
 ssStatus ss_render_rut_map_to(const ssModel *m, const ssData *d, int hfield,
                               int plastic, int width, int height,
                               struct ssAtomicFile *af, ssError *err);
+/* Whether that rut map could be drawn, all but the soil's values: the
+ * bed, the size and the label font, so that a program finds before a
+ * long run what would otherwise fail only at its end.  SS_OK, or the
+ * error the map would give. */
+ssStatus ss_render_rut_map_check(const ssModel *m, int hfield, int width, int height,
+                                 const char *png_path, ssError *err);
 
 /* ---------------------------------------------------------------------- */
 /* checkpoints (DESIGN 5)                                                  */

@@ -505,6 +505,23 @@ check "an existing --export file is replaced" \
 
 run "$PLATE" --steps 10 --rut-map "$tmp/rut.png" --size 200x150 --quiet
 check "--rut-map writes a PNG" 'rc_is 0 && is_png "$tmp/rut.png"'
+# the rut map's font is loaded before the first step: a missing one was
+# found only when the map was drawn, after every step had run
+export SOILSIM_FONT="$tmp/no-such-font.ttf"
+run "$PLATE" --steps 2000000000 --rut-map "$tmp/nofont.png" --csv "$tmp/nofont.csv"
+check "SOILSIM_FONT naming no file, --rut-map: exit 1 before stepping, naming it" \
+  'rc_is 1 && err_has "no-such-font.ttf" && err_has "SOILSIM_FONT" &&
+   no_file "$tmp/nofont.png" && no_file "$tmp/nofont.csv"'
+FONT_FILE=/usr/share/fonts/truetype/dejavu/DejaVuSans-Bold.ttf
+export SOILSIM_FONT="$FONT_FILE"
+run "$PLATE" --steps 3 --rut-map "$tmp/font.png" --size 200x150 --quiet
+if [ -r "$FONT_FILE" ]; then
+  check "SOILSIM_FONT naming a font: the rut map is written with it" \
+    'rc_is 0 && is_png "$tmp/font.png"'
+else
+  skip "SOILSIM_FONT naming a font (no $FONT_FILE here)"
+fi
+unset SOILSIM_FONT
 # the frames' folder is made before the other outputs are checked, so an
 # output may lie in it (it failed, "No such file or directory"); a run that
 # fails before its first frame takes the folders it made away again
