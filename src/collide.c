@@ -1,6 +1,7 @@
 /* collide.c -- footprints, exact vertical ray casts, contact candidates and
  * effective widths of box, sphere, cylinder and capsule colliders, and the
- * footprints of point sets (a mesh's vertices) (DESIGN 2.4, 2.6).  Pure
+ * footprints of point sets (a mesh's vertices) (DESIGN 2.4, 2.6), signed
+ * distances and the contact points of two shapes.  Pure
  * functions: no allocation, no printing (one constant table, the
  * footprints' circle, is formed at first use). */
 #include "collide.h"
@@ -1318,4 +1319,233 @@ double ss_shape_width(const ssShape *s, const double n[3])
   default:
     return 0;
   }
+}
+
+/* ---------------------------------------------------------------------- */
+/* signed distances and contacts between two shapes                        */
+
+double ss_shape_sdf(const ssShape *s, const double p[3], double n[3])
+{
+  const double *R = s->R;
+  double w[3], l[3], nl[3] = {0, 0, 0}, d;
+  ss_v3_sub(w, p, s->pos);
+  switch (s->type) {
+  case SS_GEOM_SPHERE: {
+    /* in the frame itself: no rotation to round through */
+    double len = ss_v3_norm(w);
+    if (len > 0) {
+      ss_v3_set(n, w[0] / len, w[1] / len, w[2] / len);
+    } else {
+      ss_v3_set(n, 0, 0, 1);
+    }
+    return len - s->size[0];
+  }
+  case SS_GEOM_BOX: {
+    ss_m3_mulvT(l, R, w);
+    /* outside: from the box's nearest point (l clamped to it) */
+    double e[3];
+    int outside = 0;
+    for (int k = 0; k < 3; k++) {
+      double h = 0.5 * s->size[k];
+      double c = l[k] < -h ? -h : (l[k] > h ? h : l[k]);
+      e[k] = l[k] - c;
+      outside |= e[k] != 0;
+    }
+    d = outside ? ss_v3_norm(e) : 0;
+    if (d > 0) {
+      /* division, not the reciprocal's product: the normal is then
+       * e / |e| rounded once per component */
+      ss_v3_set(nl, e[0] / d, e[1] / d, e[2] / d);
+    } else {
+      /* inside or on: the nearest face (the greatest |l_k| - h_k, <= 0),
+       * the first axis on ties and the positive face at l_k = 0, so that
+       * the same point always leaves by the same face */
+      int best = 0;
+      d = fabs(l[0]) - 0.5 * s->size[0];
+      for (int k = 1; k < 3; k++) {
+        double q = fabs(l[k]) - 0.5 * s->size[k];
+        if (q > d) {
+          d = q;
+          best = k;
+        }
+      }
+      nl[best] = l[best] >= 0 ? 1 : -1;
+    }
+    ss_m3_mulv(n, R, nl);
+    return d;
+  }
+  case SS_GEOM_CAPSULE: {
+    ss_m3_mulvT(l, R, w);
+    /* from the nearest point of the axis segment */
+    double hl = 0.5 * s->size[1];
+    double t = l[2] < -hl ? -hl : (l[2] > hl ? hl : l[2]);
+    double v[3] = {l[0], l[1], l[2] - t};
+    double len = ss_v3_norm(v);
+    if (len > 0) {
+      ss_v3_set(nl, v[0] / len, v[1] / len, v[2] / len);
+    } else {
+      nl[0] = 1; /* on the segment: every way out as near; local +x */
+    }
+    ss_m3_mulv(n, R, nl);
+    return len - s->size[0];
+  }
+  case SS_GEOM_CYLINDER: {
+    ss_m3_mulvT(l, R, w);
+    /* the 2-D problem in (radial distance q, axial z) against the
+     * rectangle [0, r] x [-h, h] */
+    double r = s->size[0], h = 0.5 * s->size[1];
+    double q = hypot(l[0], l[1]);
+    double rad[3] = {1, 0, 0}; /* on the axis: local +x */
+    if (q > 0) ss_v3_set(rad, l[0] / q, l[1] / q, 0);
+    double az = l[2] >= 0 ? 1 : -1;
+    double dr = q - r, dz = fabs(l[2]) - h;
+    if (dr > 0 && dz > 0) {
+      /* beyond the rim: from the rim's nearest point */
+      d = hypot(dr, dz);
+      ss_v3_set(nl, rad[0] * dr / d, rad[1] * dr / d, az * dz / d);
+    } else if (dr > 0 || (!(dz > 0) && dr > dz)) {
+      /* outside the side, or inside nearer the side than a cap */
+      d = dr;
+      ss_v3_copy(nl, rad);
+    } else {
+      /* outside a cap, or inside as near a cap as the side or nearer */
+      d = dz;
+      nl[2] = az;
+    }
+    ss_m3_mulv(n, R, nl);
+    return d;
+  }
+  default:
+    return NAN;
+  }
+}
+
+/* types ss_shape_pair_points takes */
+static int pair_type(int t)
+{
+  return t == SS_GEOM_BOX || t == SS_GEOM_SPHERE || t == SS_GEOM_CYLINDER ||
+         t == SS_GEOM_CAPSULE;
+}
+
+/* a shape's bounding radius about its centre: the scale of its
+ * coordinates, for ss_shape_pair_points' tolerance */
+static double shape_extent(const ssShape *s)
+{
+  switch (s->type) {
+  case SS_GEOM_BOX:
+    return 0.5 * ss_v3_norm(s->size);
+  case SS_GEOM_CYLINDER:
+    return hypot(s->size[0], 0.5 * s->size[1]);
+  case SS_GEOM_CAPSULE:
+    return s->size[0] + 0.5 * s->size[1];
+  default:
+    return s->size[0];
+  }
+}
+
+/* The sphere of radius r (0: the point) at c tested against o: with
+ * d = sdf_o(c) and o's normal m there, the point c - r m at gap d - r,
+ * normal m (flip: -m, for b's candidates tested against a).  Writes *out
+ * and returns 1 when the gap is within margin (NaN never is). */
+static int sphere_contact(const ssShape *o, const double c[3], double r, int flip, int id,
+                          double margin, ssPairPoint *out)
+{
+  double m[3];
+  double gap = ss_shape_sdf(o, c, m) - r;
+  if (!(gap <= margin)) return 0;
+  ss_v3_copy(out->pos, c);
+  if (r != 0) ss_v3_addscl(out->pos, m, -r);
+  if (flip) ss_v3_scale(out->n, m, -1);
+  else ss_v3_copy(out->n, m);
+  out->gap = gap;
+  out->id = id;
+  return 1;
+}
+
+/* The candidates of s against o within margin, into out (room for 16) in
+ * order of id (ids from base: 0 for a's, 16 for b's, whose normals are
+ * flipped to run from b towards a).  Returns the count. */
+static int side_contacts(const ssShape *s, const ssShape *o, int base, double margin,
+                         ssPairPoint *out)
+{
+  static const double up[3] = {0, 0, 1}; /* a box's corners need no n */
+  const double *R = s->R;
+  const int flip = base != 0;
+  double pts[16][3];
+  int k = 0;
+  switch (s->type) {
+  case SS_GEOM_SPHERE:
+    k += sphere_contact(o, s->pos, s->size[0], flip, base, margin, out + k);
+    break;
+  case SS_GEOM_CAPSULE: {
+    double a[3] = {R[2], R[5], R[8]}, c[3], len = s->size[1], hl = 0.5 * len;
+    for (int e = 0; e < 2; e++) {
+      ss_v3_copy(c, s->pos);
+      ss_v3_addscl(c, a, e ? hl : -hl);
+      k += sphere_contact(o, c, s->size[0], flip, base + e, margin, out + k);
+    }
+    /* the segment's point nearest o's centre, where it is not an end's:
+     * a capsule across a face touches it there, between two ends that may
+     * both hang free */
+    double w[3];
+    ss_v3_sub(w, o->pos, s->pos);
+    double t = ss_v3_dot(w, a), tol = 1e-9 * len;
+    if (t + hl > tol && hl - t > tol) {
+      ss_v3_copy(c, s->pos);
+      ss_v3_addscl(c, a, t);
+      k += sphere_contact(o, c, s->size[0], flip, base + 2, margin, out + k);
+    }
+    break;
+  }
+  case SS_GEOM_BOX:
+  case SS_GEOM_CYLINDER: {
+    /* a cylinder's rim placed from o's normal at its centre, towards o */
+    double m[3];
+    const double *dir = up;
+    if (s->type == SS_GEOM_CYLINDER) {
+      ss_shape_sdf(o, s->pos, m);
+      dir = m;
+    }
+    int np = ss_shape_candidates(s, dir, pts, 16);
+    for (int i = 0; i < np; i++)
+      k += sphere_contact(o, pts[i], 0, flip, base + i, margin, out + k);
+    break;
+  }
+  default:
+    break;
+  }
+  return k;
+}
+
+/* 1 when q (one of b's) lies at p (one of a's kept) with the same normal
+ * (tol: a length; normals to 1e-9): one contact found from both sides, as
+ * where the two touch at a point both sides' candidates give (a sphere
+ * resting on a box's corner) */
+static int same_contact(const ssPairPoint *p, const ssPairPoint *q, double tol)
+{
+  for (int k = 0; k < 3; k++)
+    if (!(fabs(p->n[k] - q->n[k]) <= 1e-9) || !(fabs(p->pos[k] - q->pos[k]) <= tol))
+      return 0;
+  return 1;
+}
+
+int ss_shape_pair_points(const ssShape *a, const ssShape *b, double margin,
+                         ssPairPoint *out, int max)
+{
+  if (max <= 0 || !pair_type(a->type) || !pair_type(b->type)) return 0;
+  ssPairPoint all[SS_PAIR_POINTS_MAX], bs[16];
+  int k = side_contacts(a, b, 0, margin, all), ka = k;
+  /* two spheres touch at one point, which a's candidate gives exactly */
+  if (!(a->type == SS_GEOM_SPHERE && b->type == SS_GEOM_SPHERE)) {
+    int nb = side_contacts(b, a, 16, margin, bs);
+    double tol = 1e-9 * (shape_extent(a) + shape_extent(b));
+    for (int j = 0; j < nb; j++) {
+      int dup = 0;
+      for (int i = 0; i < ka && !dup; i++) dup = same_contact(&all[i], &bs[j], tol);
+      if (!dup) all[k++] = bs[j];
+    }
+  }
+  if (k > max) k = max;
+  for (int i = 0; i < k; i++) out[i] = all[i];
+  return k;
 }

@@ -1,6 +1,7 @@
 /* collide.h -- geometry of colliders: footprints on a bed plane, exact
- * vertical ray casts (depth under a shape), rigid contact candidates and the
- * effective width b of DESIGN 2.4.
+ * vertical ray casts (depth under a shape), rigid contact candidates, the
+ * effective width b of DESIGN 2.4, signed distances and the contact points
+ * of two shapes.
  *
  * Everything here works in one Cartesian frame chosen by the caller,
  * normally a height map's local frame (bed normal = +z).  Pure functions:
@@ -251,6 +252,71 @@ static inline int ss_shape_cast_lowest_z(const ssShapeCast *c, const ssCastRow *
  * in turn).  Returns the count (<= max). */
 int ss_shape_candidates(const ssShape *s, const double n[3], double pts[][3],
                         int max);
+/* Signed distance of point p from the surface of shape s, both in the
+ * caller's frame: negative inside.  n: the unit outward normal of s at the
+ * nearest surface point (inside: the direction of the nearest way out).
+ * Box, sphere, capsule, cylinder (exact); any other type: NAN, n untouched.
+ * Where the nearest way out is not unique the choice is fixed: box --
+ * the face of the lowest axis index among the nearest, on an axis' mid
+ * plane its positive face; sphere at its centre -- +z of the frame;
+ * capsule on its axis segment, cylinder on its axis -- the shape's local
+ * +x as the radial direction; a cylinder point as near its cap as its
+ * side -- the cap (the upper one at mid length). */
+double ss_shape_sdf(const ssShape *s, const double p[3], double n[3]);
+
+/* One contact point between two shapes a and b (ss_shape_pair_points). */
+typedef struct ssPairPoint {
+  double pos[3];  /* the contact point: on the surface of the shape whose
+                     candidate it is */
+  double n[3];    /* unit normal from b towards a (a separates along +n) */
+  double gap;     /* signed separation along n, < 0 penetrating */
+  int id;         /* the feature: [0, 16) a's candidates, [16, 32) b's, the
+                     same number from step to step while the same feature
+                     touches */
+} ssPairPoint;
+#define SS_PAIR_POINTS_MAX 32
+/* Contacts of a with b (one frame): a's candidate points within margin of
+ * b's surface (or inside it), and b's within margin of a's.  Returns the
+ * count (<= max), in order of id; where there are more than max, the first
+ * max in that order (a's before b's).  Any type but box, sphere, cylinder
+ * and capsule (a mesh): 0.
+ *
+ * The candidates of a shape s against the other o (sdf_o: ss_shape_sdf of
+ * o; k below is the id, 16 + k for b's):
+ * - sphere (k = 0): its centre c, d = sdf_o(c) with o's normal m there:
+ *   the point c - r m at gap d - r, normal m.  Exact for a sphere against
+ *   anything.
+ * - capsule: its two end spheres as spheres (k = 0 at -size[1]/2 along
+ *   local z, k = 1 at +), and the point of its segment nearest o's centre
+ *   as a third sphere (k = 2) only where it lies strictly between the ends
+ *   (not within 1e-9 of the segment's length of either): a capsule lying
+ *   across something touches in the middle.
+ * - box: its 8 corners q (k = 0..7, ss_shape_candidates' order): gap
+ *   sdf_o(q), normal o's normal at q, the point q.
+ * - cylinder: ss_shape_candidates(s, m) with m o's normal at the
+ *   cylinder's centre (its rim points lowest towards o first, k = 0, 1),
+ *   each as a box's corner.
+ * a's candidates take b's outward normal; b's, tested against a, minus a's
+ * (still from b towards a).  Two spheres: a's candidate alone (b's is the
+ * same contact).  Otherwise both sides' are kept (a sphere against a
+ * capsule's end: each side's candidate lies on its own surface, so the two
+ * are one point only where the gap is 0), except that a candidate of b is
+ * dropped where it lies within 1e-9 of the shapes' size of one of a's kept
+ * ones with the same normal (to 1e-9): a point where the two touch that
+ * both sides give (a sphere resting on a box's corner at gap 0: one
+ * contact; the same sphere 2 mm into the corner: two, a's and the
+ * corner's, with one normal and one gap).  Kept: gap <= margin.  The same
+ * inputs give the same bits.
+ *
+ * Limits: only points (corners, rims, spheres) are tested, never edges
+ * against edges or faces against edges -- two boxes crossed edge on edge,
+ * or a box edge across a cylinder's side, find no contact until a corner
+ * reaches the other; a cylinder's rim is sampled at 8 points a cap (its
+ * side on a face it finds exactly, through the lowest rim points); a
+ * capsule's middle point is taken towards o's centre, not o's nearest
+ * point, exact on a large flat face under it but not across o's edge. */
+int ss_shape_pair_points(const ssShape *a, const ssShape *b, double margin,
+                         ssPairPoint *out, int max);
 /* Effective width b (DESIGN 2.4), measured in the shape's own frame so that
  * heading does not change it: box -> the shorter of its two edge lengths
  * whose axes are most nearly in the plane normal to n; cylinder with its

@@ -1288,6 +1288,429 @@ static void test_sort_runs(void)
   ok(sort_items(one, scratch, 1) == one && sort_items(one, scratch, 0) == one, "SS_SORT_RUNS: 0 and 1 elements stay in place");
 }
 
+/* ---------------------------------------------------------------------- */
+/* signed distances and pair contacts                                      */
+
+/* p = pos + R l */
+static void put_local(const ssShape *s, const double l[3], double p[3])
+{
+  ss_m3_mulv(p, s->R, l);
+  ss_v3_add(p, p, s->pos);
+}
+
+/* n + 1 evenly spaced values from a to b, ends included (the i-th) */
+static double lerp_n(double a, double b, int i, int n) { return a + (b - a) * i / n; }
+
+/* samples of the sphere of radius r about local (0, 0, zc), polar angle
+ * from t0 to t1, arc spacing at most h each way; returns the new count */
+static int sample_sphere(const ssShape *s, double r, double zc, double t0, double t1,
+                         double h, double (*v)[3], int k)
+{
+  int nt = (int)ceil((t1 - t0) * r / h);
+  for (int i = 0; i <= nt; i++) {
+    double t = lerp_n(t0, t1, i, nt), st = sin(t);
+    int np = (int)ceil(2 * PI * r * st / h);
+    if (np < 1) np = 1;
+    for (int j = 0; j < np; j++) {
+      double f = 2 * PI * j / np;
+      double l[3] = {r * st * cos(f), r * st * sin(f), zc + r * cos(t)};
+      put_local(s, l, v[k++]);
+    }
+  }
+  return k;
+}
+
+/* samples of a cylinder's side (radius r, |z| <= hl) and, when caps, its
+ * two discs; spacing at most h along the surface each way */
+static int sample_cylinder(const ssShape *s, double r, double hl, int caps, double h,
+                           double (*v)[3], int k)
+{
+  int nf = (int)ceil(2 * PI * r / h), nz = (int)ceil(2 * hl / h);
+  for (int i = 0; i <= nz; i++)
+    for (int j = 0; j < nf; j++) {
+      double f = 2 * PI * j / nf, l[3] = {r * cos(f), r * sin(f), lerp_n(-hl, hl, i, nz)};
+      put_local(s, l, v[k++]);
+    }
+  if (!caps) return k;
+  int nr = (int)ceil(r / h);
+  for (int e = -1; e <= 1; e += 2)
+    for (int i = 0; i <= nr; i++) {
+      double rho = r * i / nr;
+      int np = (int)ceil(2 * PI * rho / h);
+      if (np < 1) np = 1;
+      for (int j = 0; j < np; j++) {
+        double f = 2 * PI * j / np, l[3] = {rho * cos(f), rho * sin(f), e * hl};
+        put_local(s, l, v[k++]);
+      }
+    }
+  return k;
+}
+
+/* points on the surface of s, no two neighbours more than h apart along
+ * it (each way), in the frame; returns the count */
+static int surface_samples(const ssShape *s, double h, double (*v)[3])
+{
+  int k = 0;
+  switch (s->type) {
+  case SS_GEOM_BOX:
+    /* each face a grid with its edges, so that edges and corners are in */
+    for (int ax = 0; ax < 3; ax++) {
+      int u = (ax + 1) % 3, w = (ax + 2) % 3;
+      int nu = (int)ceil(s->size[u] / h), nw = (int)ceil(s->size[w] / h);
+      for (int e = -1; e <= 1; e += 2)
+        for (int i = 0; i <= nu; i++)
+          for (int j = 0; j <= nw; j++) {
+            double l[3];
+            l[ax] = e * 0.5 * s->size[ax];
+            l[u] = lerp_n(-0.5 * s->size[u], 0.5 * s->size[u], i, nu);
+            l[w] = lerp_n(-0.5 * s->size[w], 0.5 * s->size[w], j, nw);
+            put_local(s, l, v[k++]);
+          }
+    }
+    break;
+  case SS_GEOM_SPHERE:
+    k = sample_sphere(s, s->size[0], 0, 0, PI, h, v, k);
+    break;
+  case SS_GEOM_CYLINDER:
+    k = sample_cylinder(s, s->size[0], 0.5 * s->size[1], 1, h, v, k);
+    break;
+  case SS_GEOM_CAPSULE:
+    /* the side, and each end sphere's outer half only (the inner is not
+     * on the surface) */
+    k = sample_cylinder(s, s->size[0], 0.5 * s->size[1], 0, h, v, k);
+    k = sample_sphere(s, s->size[0], 0.5 * s->size[1], 0, 0.5 * PI, h, v, k);
+    k = sample_sphere(s, s->size[0], -0.5 * s->size[1], 0.5 * PI, PI, h, v, k);
+    break;
+  default:
+    break;
+  }
+  return k;
+}
+
+/* 1 when p is inside s or on it, tested in the local frame without the
+ * distance function */
+static int inside_shape(const ssShape *s, const double p[3])
+{
+  double w[3], l[3];
+  ss_v3_sub(w, p, s->pos);
+  ss_m3_mulvT(l, s->R, w);
+  double r = s->size[0], hl = 0.5 * s->size[1];
+  switch (s->type) {
+  case SS_GEOM_BOX:
+    return fabs(l[0]) <= 0.5 * s->size[0] && fabs(l[1]) <= 0.5 * s->size[1] &&
+           fabs(l[2]) <= 0.5 * s->size[2];
+  case SS_GEOM_SPHERE:
+    return ss_v3_dot(l, l) <= r * r;
+  case SS_GEOM_CYLINDER:
+    return l[0] * l[0] + l[1] * l[1] <= r * r && fabs(l[2]) <= hl;
+  case SS_GEOM_CAPSULE: {
+    double z = fabs(l[2]) > hl ? fabs(l[2]) - hl : 0;
+    return l[0] * l[0] + l[1] * l[1] + z * z <= r * r;
+  }
+  default:
+    return 0;
+  }
+}
+
+/* ss_shape_sdf of each shape type at a random pose against brute force:
+ * 2000 random points in and around it, |sdf| the distance to the nearest
+ * of dense surface samples (spacing h): no less than it (the samples are
+ * on the surface; 1e-12 for round-off) and no more than h beyond (every
+ * surface point lies within h / sqrt 2 of a sample); the sign as an inside
+ * test says; p - sdf n on the surface (its own sdf within 1e-12 of the
+ * size: a few roundings of coordinates near 1); n a unit vector */
+static double sdf_samples[40000][3];
+
+static void test_shape_sdf(void)
+{
+  static const double sizes[4][3] = {
+      [SS_GEOM_BOX] = {0.4, 0.3, 0.2},
+      [SS_GEOM_SPHERE] = {0.25, 0, 0},
+      [SS_GEOM_CYLINDER] = {0.2, 0.3, 0},
+      [SS_GEOM_CAPSULE] = {0.1, 0.3, 0},
+  };
+  static const char *names[4] = {"box", "sphere", "cylinder", "capsule"};
+  const double h = 0.01, tol = 1e-12;
+  for (int type = 0; type < 4; type++) {
+    double R[9];
+    rot_random(R);
+    ssShape s = make_shape(type, sizes[type][0], sizes[type][1], sizes[type][2],
+                           urand(-1, 1), urand(-1, 1), urand(-1, 1), R);
+    int ns = surface_samples(&s, h, sdf_samples);
+    /* the local half extents, 0.15 wider around */
+    double e[3];
+    if (type == SS_GEOM_BOX) {
+      for (int k = 0; k < 3; k++) e[k] = 0.5 * s.size[k];
+    } else {
+      e[0] = e[1] = s.size[0];
+      e[2] = type == SS_GEOM_SPHERE ? s.size[0]
+             : type == SS_GEOM_CYLINDER ? 0.5 * s.size[1]
+                                        : 0.5 * s.size[1] + s.size[0];
+    }
+    double ext = ss_v3_norm(e);
+    int bad_d = 0, bad_sign = 0, bad_surf = 0, bad_unit = 0, nin = 0;
+    double worst_d = 0, worst_surf = 0;
+    for (int i = 0; i < 2000; i++) {
+      double l[3], p[3], n[3];
+      for (int k = 0; k < 3; k++) l[k] = urand(-e[k] - 0.15, e[k] + 0.15);
+      put_local(&s, l, p);
+      double d = ss_shape_sdf(&s, p, n);
+      double dmin = INFINITY;
+      for (int j = 0; j < ns; j++) {
+        double w[3];
+        ss_v3_sub(w, p, sdf_samples[j]);
+        dmin = fmin(dmin, ss_v3_dot(w, w));
+      }
+      dmin = sqrt(dmin);
+      double ad = fabs(d);
+      if (!(dmin >= ad - tol && dmin <= ad + h)) bad_d++;
+      worst_d = fmax(worst_d, fabs(dmin - ad));
+      int in = inside_shape(&s, p);
+      nin += in;
+      if ((d < -tol && !in) || (d > tol && in) || !isfinite(d)) bad_sign++;
+      double q[3], nq[3];
+      ss_v3_copy(q, p);
+      ss_v3_addscl(q, n, -d);
+      double dq = fabs(ss_shape_sdf(&s, q, nq));
+      worst_surf = fmax(worst_surf, dq);
+      if (!(dq <= tol * ext)) bad_surf++;
+      if (!(fabs(ss_v3_norm(n) - 1) <= tol)) bad_unit++;
+    }
+    ok(bad_d == 0, "sdf %s: |sdf| within the sample spacing of the nearest of %d surface samples (%d of 2000 off, worst difference %.3g)",
+       names[type], ns, bad_d, worst_d);
+    ok(bad_sign == 0 && nin > 100 && nin < 1900, "sdf %s: negative inside, positive outside (%d inside, %d wrong)",
+       names[type], nin, bad_sign);
+    ok(bad_surf == 0, "sdf %s: p - sdf n on the surface (%d off, worst |sdf| %.3g)", names[type],
+       bad_surf, worst_surf);
+    ok(bad_unit == 0, "sdf %s: n a unit vector (%d not)", names[type], bad_unit);
+  }
+  /* where the way out is not unique: the documented choices */
+  double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, n[3], c[3] = {0, 0, 0};
+  ssShape sp = make_shape(SS_GEOM_SPHERE, 0.2, 0, 0, 0, 0, 0, I);
+  double d = ss_shape_sdf(&sp, c, n);
+  ok(d == -0.2 && n[0] == 0 && n[1] == 0 && n[2] == 1, "sdf: a sphere's centre leaves along +z at -r");
+  ssShape bx = make_shape(SS_GEOM_BOX, 0.4, 0.4, 0.4, 0, 0, 0, I);
+  d = ss_shape_sdf(&bx, c, n);
+  ok(d == -0.2 && n[0] == 1 && n[1] == 0 && n[2] == 0, "sdf: a cube's centre leaves by its +x face");
+  ssShape cy = make_shape(SS_GEOM_CYLINDER, 0.2, 1, 0, 0, 0, 0, I);
+  d = ss_shape_sdf(&cy, c, n);
+  ok(d == -0.2 && n[0] == 1 && n[1] == 0 && n[2] == 0, "sdf: a long cylinder's centre leaves along its local +x");
+  ssShape cp = make_shape(SS_GEOM_CAPSULE, 0.2, 1, 0, 0, 0, 0, I);
+  double pe[3] = {0, 0, 0.3};
+  d = ss_shape_sdf(&cp, pe, n);
+  ok(d == -0.2 && n[0] == 1 && n[1] == 0 && n[2] == 0, "sdf: a point of a capsule's segment leaves along its local +x");
+  ssShape me = make_shape(SS_GEOM_MESH, 1, 1, 1, 0, 0, 0, I);
+  double keep[3] = {7, 8, 9};
+  ok(isnan(ss_shape_sdf(&me, c, keep)) && keep[0] == 7 && keep[1] == 8 && keep[2] == 9,
+     "sdf: a mesh gives NaN and leaves n untouched");
+}
+
+/* the contact of id among out[0, n), or NULL */
+static const ssPairPoint *pair_find(const ssPairPoint *out, int n, int id)
+{
+  for (int i = 0; i < n; i++)
+    if (out[i].id == id) return &out[i];
+  return NULL;
+}
+
+static int near3(const double a[3], const double b[3], double tol)
+{
+  return fabs(a[0] - b[0]) <= tol && fabs(a[1] - b[1]) <= tol && fabs(a[2] - b[2]) <= tol;
+}
+
+/* 1 when p and q are the same bits, field by field (not memcmp of the
+ * structs: their padding after id is not theirs to set) */
+static int pair_same(const ssPairPoint *p, const ssPairPoint *q)
+{
+  return memcmp(p->pos, q->pos, sizeof p->pos) == 0 && memcmp(p->n, q->n, sizeof p->n) == 0 &&
+         memcmp(&p->gap, &q->gap, sizeof p->gap) == 0 && p->id == q->id;
+}
+
+/* the contacts of (a, b) and of (b, a): the same, each with its id moved
+ * to the other side, its normal negated, its gap and point the same bits;
+ * and a second call the same bits as the first */
+static int pair_swaps(const ssShape *a, const ssShape *b, double margin)
+{
+  ssPairPoint p[SS_PAIR_POINTS_MAX], q[SS_PAIR_POINTS_MAX], r[SS_PAIR_POINTS_MAX];
+  int np = ss_shape_pair_points(a, b, margin, p, SS_PAIR_POINTS_MAX);
+  int nq = ss_shape_pair_points(b, a, margin, q, SS_PAIR_POINTS_MAX);
+  int nr = ss_shape_pair_points(a, b, margin, r, SS_PAIR_POINTS_MAX);
+  if (np != nq || np != nr || np == 0) return 0;
+  for (int i = 0; i < np; i++) {
+    if (!pair_same(&p[i], &r[i])) return 0;
+    const ssPairPoint *o = pair_find(q, nq, p[i].id < 16 ? p[i].id + 16 : p[i].id - 16);
+    if (!o || o->gap != p[i].gap || memcmp(o->pos, p[i].pos, sizeof o->pos) != 0) return 0;
+    for (int k = 0; k < 3; k++)
+      if (o->n[k] != -p[i].n[k]) return 0;
+  }
+  return 1;
+}
+
+/* every contact's normal +z and gap want (to tol) */
+static int all_up_at(const ssPairPoint *out, int n, double want, double tol)
+{
+  const double up[3] = {0, 0, 1};
+  for (int i = 0; i < n; i++)
+    if (!near3(out[i].n, up, 1e-12) || !(fabs(out[i].gap - want) <= tol)) return 0;
+  return n > 0;
+}
+
+static void test_pair_points(void)
+{
+  const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, up[3] = {0, 0, 1}, tol = 1e-12;
+  ssPairPoint out[SS_PAIR_POINTS_MAX];
+  double R[9];
+
+  /* two spheres 0.05 into each other along a random direction */
+  double u[3] = {urand(-1, 1), urand(-1, 1), urand(-1, 1)};
+  ss_v3_normalize(u);
+  double cb[3] = {urand(-1, 1), urand(-1, 1), urand(-1, 1)}, ca[3];
+  ss_v3_copy(ca, cb);
+  ss_v3_addscl(ca, u, 0.45);
+  ssShape sa = make_shape(SS_GEOM_SPHERE, 0.3, 0, 0, ca[0], ca[1], ca[2], I);
+  ssShape sb = make_shape(SS_GEOM_SPHERE, 0.2, 0, 0, cb[0], cb[1], cb[2], I);
+  int n = ss_shape_pair_points(&sa, &sb, 0, out, SS_PAIR_POINTS_MAX);
+  double w[3];
+  if (n == 1) ss_v3_sub(w, out[0].pos, ca);
+  ok(n == 1 && out[0].id == 0 && fabs(out[0].gap + 0.05) <= tol && near3(out[0].n, u, tol) &&
+         fabs(ss_v3_norm(w) - 0.3) <= tol && fabs(ss_v3_dot(w, u) + 0.3) <= tol,
+     "pair: two spheres 0.05 into each other: one contact, gap %.12g, along the centre line, on a's surface",
+     n ? out[0].gap : NAN);
+
+  /* a sphere of r 0.1 over a 1 x 1 x 0.2 box's top face (at z = 0) */
+  ssShape slab = make_shape(SS_GEOM_BOX, 1, 1, 0.2, 0, 0, -0.1, I);
+  ssShape ball = make_shape(SS_GEOM_SPHERE, 0.1, 0, 0, 0, 0, 0.095, I);
+  n = ss_shape_pair_points(&ball, &slab, 0.01, out, SS_PAIR_POINTS_MAX);
+  double want_pos[3] = {0, 0, -0.005};
+  ok(n == 1 && out[0].id == 0 && all_up_at(out, n, -0.005, tol) && near3(out[0].pos, want_pos, tol),
+     "pair: a ball 5 mm into a box's face: one contact (the ball's), gap -0.005, n +z");
+  ok(pair_swaps(&ball, &slab, 0.01), "pair: ball and box swapped: the same contact, id 16, n -z");
+  /* over the box's edge (x = 0.5, z = 0), 0.09 from it along (0.6, 0, 0.8) */
+  ball.pos[0] = 0.5 + 0.054;
+  ball.pos[2] = 0.072;
+  n = ss_shape_pair_points(&ball, &slab, 0.01, out, SS_PAIR_POINTS_MAX);
+  double ne[3] = {0.6, 0, 0.8};
+  ok(n == 1 && out[0].id == 0 && fabs(out[0].gap + 0.01) <= tol && near3(out[0].n, ne, tol),
+     "pair: a ball over a box's edge: gap %.12g = 0.09 - 0.1 from the edge, n along the way to the edge",
+     n ? out[0].gap : NAN);
+  /* over its corner (0.5, 0.5, 0), 0.098 from it along (2, 3, 6) / 7:
+   * the ball's contact and the corner's (id 16 + 7), one normal and gap */
+  double nc[3] = {2.0 / 7, 3.0 / 7, 6.0 / 7};
+  ss_v3_set(ball.pos, 0.5, 0.5, 0);
+  ss_v3_addscl(ball.pos, nc, 0.098);
+  n = ss_shape_pair_points(&ball, &slab, 0.01, out, SS_PAIR_POINTS_MAX);
+  const ssPairPoint *pc = pair_find(out, n, 23);
+  ok(n == 2 && out[0].id == 0 && fabs(out[0].gap + 0.002) <= tol && near3(out[0].n, nc, tol) &&
+         pc && fabs(pc->gap + 0.002) <= tol && near3(pc->n, nc, tol),
+     "pair: a ball 2 mm into a box's corner: gap %.12g from the corner, the corner's own contact the same gap and normal",
+     n ? out[0].gap : NAN);
+  /* resting on the corner (gap 0): the two are one point, the corner's
+   * dropped */
+  ss_v3_set(ball.pos, 0.5, 0.5, 0);
+  ss_v3_addscl(ball.pos, nc, 0.1);
+  n = ss_shape_pair_points(&ball, &slab, 0.01, out, SS_PAIR_POINTS_MAX);
+  ok(n == 1 && out[0].id == 0 && fabs(out[0].gap) <= tol,
+     "pair: a ball resting on a box's corner: one contact (the corner's the same point, dropped)");
+
+  /* a 0.2 x 0.2 x 0.1 box 1 mm into the slab's top face, aligned */
+  ssShape top = make_shape(SS_GEOM_BOX, 0.2, 0.2, 0.1, 0.1, -0.05, 0.049, I);
+  n = ss_shape_pair_points(&top, &slab, 0.01, out, SS_PAIR_POINTS_MAX);
+  ok(n == 4 && out[0].id == 0 && out[1].id == 1 && out[2].id == 2 && out[3].id == 3 &&
+         all_up_at(out, n, -0.001, tol),
+     "pair: a box 1 mm into another's face: its 4 bottom corners (ids 0-3), gap -0.001, n +z, none of the big box's");
+  rot_z(R, 30 * PI / 180);
+  memcpy(top.R, R, sizeof R);
+  n = ss_shape_pair_points(&top, &slab, 0.01, out, SS_PAIR_POINTS_MAX);
+  int at_corner = n == 4;
+  for (int i = 0; i < n && at_corner; i++) at_corner = fabs(out[i].pos[2] + 0.001) <= tol && out[i].id < 4;
+  ok(at_corner && all_up_at(out, n, -0.001, tol),
+     "pair: turned 30 degrees about z: the same 4 bottom corners at gap -0.001, n +z");
+  ok(pair_swaps(&top, &slab, 0.01), "pair: the two boxes swapped: the same corners, ids 16-19, n -z, same gaps");
+  /* a random heading and a 3-degree tilt, the lowest corner 1 mm in:
+   * every contact's gap its corner's height over the face */
+  rot_tilt(R, 3 * PI / 180, urand(0, 2 * PI));
+  memcpy(top.R, R, sizeof R);
+  top.pos[2] = 0;
+  double cn[8][3], zlo = INFINITY;
+  ss_shape_candidates(&top, up, cn, 8);
+  for (int i = 0; i < 8; i++) zlo = fmin(zlo, cn[i][2]);
+  top.pos[2] = -0.001 - zlo;
+  ss_shape_candidates(&top, up, cn, 8);
+  int want_n = 0, lowest = -1;
+  zlo = INFINITY;
+  for (int i = 0; i < 8; i++) {
+    want_n += cn[i][2] <= 0.005;
+    if (cn[i][2] < zlo) {
+      zlo = cn[i][2];
+      lowest = i;
+    }
+  }
+  n = ss_shape_pair_points(&top, &slab, 0.005, out, SS_PAIR_POINTS_MAX);
+  int heights = n == want_n;
+  for (int i = 0; i < n && heights; i++)
+    heights = out[i].id < 8 && fabs(out[i].gap - out[i].pos[2]) <= tol &&
+              near3(out[i].pos, cn[out[i].id], 0) && near3(out[i].n, up, tol);
+  pc = pair_find(out, n, lowest);
+  ok(heights && pc && fabs(pc->gap + 0.001) <= tol,
+     "pair: a box tilted 3 degrees: %d corners within the margin, each gap its height over the face, the lowest's %.12g",
+     n, pc ? pc->gap : NAN);
+
+  /* a capsule (r 0.05, 0.4 long) lying flat across the slab, 2 mm in:
+   * both ends and the middle */
+  rot_wheel(R, urand(0, 2 * PI), 0);
+  ssShape cap = make_shape(SS_GEOM_CAPSULE, 0.05, 0.4, 0, 0.1, 0.05, 0.048, R);
+  n = ss_shape_pair_points(&cap, &slab, 0.01, out, SS_PAIR_POINTS_MAX);
+  ok(n == 3 && out[0].id == 0 && out[1].id == 1 && out[2].id == 2 && all_up_at(out, n, -0.002, tol),
+     "pair: a capsule lying across a box: both ends and the middle, gap -0.002, n +z");
+  ok(pair_swaps(&cap, &slab, 0.01), "pair: capsule and box swapped: the same three, ids 16-18, n -z");
+
+  /* a cylinder (r 0.3, 0.2 long) on its side, 3 mm in: its rim's lowest
+   * points, one per cap, at the cylinder's lowest point's height */
+  rot_wheel(R, urand(0, 2 * PI), urand(0, 2 * PI));
+  ssShape wheel = make_shape(SS_GEOM_CYLINDER, 0.3, 0.2, 0, -0.1, 0.1, 0.297, R);
+  n = ss_shape_pair_points(&wheel, &slab, 0.01, out, SS_PAIR_POINTS_MAX);
+  ok(n == 2 && out[0].id == 0 && out[1].id == 1 && all_up_at(out, n, 0.297 - 0.3, tol),
+     "pair: a cylinder on its side: its two lowest rim points (ids 0, 1), gap %.12g = its lowest point's height",
+     n ? out[0].gap : NAN);
+  ok(pair_swaps(&wheel, &slab, 0.01), "pair: cylinder on its side and box swapped: the same, n -z");
+  /* standing on its end, 2 mm in: the 8 rim points of its bottom cap */
+  rot_z(R, urand(0, 2 * PI));
+  ssShape post = make_shape(SS_GEOM_CYLINDER, 0.3, 0.2, 0, 0.05, 0, 0.098, R);
+  n = ss_shape_pair_points(&post, &slab, 0.01, out, SS_PAIR_POINTS_MAX);
+  int rim = n == 8 && out[0].id == 0;
+  for (int i = 1; i < n && rim; i++) rim = out[i].id == i + 1;
+  ok(rim && all_up_at(out, n, -0.002, tol),
+     "pair: a cylinder standing on its end: its bottom cap's 8 rim points (ids 0, 2-8), gap -0.002");
+  ok(pair_swaps(&post, &slab, 0.01), "pair: standing cylinder and box swapped: the same, n -z");
+
+  /* the margin: a gap of half the margin kept, of 1.5 margins dropped */
+  memcpy(top.R, I, sizeof I);
+  top.pos[2] = 0.051; /* 1 mm above */
+  n = ss_shape_pair_points(&top, &slab, 0.002, out, SS_PAIR_POINTS_MAX);
+  ok(n == 4 && all_up_at(out, n, 0.001, tol), "pair: gaps of half the margin kept (%d)", n);
+  n = ss_shape_pair_points(&top, &slab, 0.001 / 1.5, out, SS_PAIR_POINTS_MAX);
+  ok(n == 0, "pair: gaps of 1.5 margins dropped (%d)", n);
+
+  /* max: the first in id order; nothing past max written */
+  top.pos[2] = 0.049;
+  ssPairPoint all[SS_PAIR_POINTS_MAX];
+  int na = ss_shape_pair_points(&top, &slab, 0.01, all, SS_PAIR_POINTS_MAX);
+  memset(out, 0x5a, sizeof out);
+  ssPairPoint fill;
+  memset(&fill, 0x5a, sizeof fill);
+  n = ss_shape_pair_points(&top, &slab, 0.01, out, 2);
+  ok(na == 4 && n == 2 && pair_same(&out[0], &all[0]) && pair_same(&out[1], &all[1]) &&
+         memcmp(&out[2], &fill, sizeof fill) == 0 &&
+         ss_shape_pair_points(&top, &slab, 0.01, out, 0) == 0,
+     "pair: max 2 of 4: count 2, the first two in id order, nothing more written; max 0: none");
+
+  /* a mesh: no contacts */
+  ssShape me = make_shape(SS_GEOM_MESH, 1, 1, 1, 0, 0, 0, I);
+  ok(ss_shape_pair_points(&me, &ball, 1, out, SS_PAIR_POINTS_MAX) == 0 &&
+         ss_shape_pair_points(&ball, &me, 1, out, SS_PAIR_POINTS_MAX) == 0,
+     "pair: a mesh on either side: no contacts");
+}
+
 int main(void)
 {
   test_plate_quadrature();
@@ -1306,5 +1729,7 @@ int main(void)
   test_aabb();
   test_low_bounds();
   test_sort_runs();
+  test_shape_sdf();
+  test_pair_points();
   return done_testing();
 }
