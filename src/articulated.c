@@ -2354,6 +2354,7 @@ ssStatus ss_art_rows(const ssModel *m, ssData *d, ssError *err)
       c->vertex = -1;
       c->dof = m->body_dofadr[b];
       c->g0 = gap;
+      d->contact_deep += gap < 0;
       /* (past the limit: stop there; the push moves it back,
        * ss_solver_push) */
       c->vn_target = gap >= 0 ? -gap / dt : 0;

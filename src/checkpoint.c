@@ -922,8 +922,9 @@ static uint64_t newton_max(const ssModel *m)
  * support and candidate point, the joint rows */
 static uint64_t warm_max(const ssModel *m)
 {
-  return ((uint64_t)m->nhfielddata + ((uint64_t)m->nhfield + (uint64_t)m->nplane) *
-                                         SS_RIGID_CANDIDATES) *
+  return ((uint64_t)m->nhfielddata +
+          ((uint64_t)m->nhfield + (uint64_t)m->nplane + (uint64_t)m->ngeom) *
+              SS_RIGID_CANDIDATES) *
              (uint64_t)m->ngeom +
          (uint64_t)m->npd + 2 * (uint64_t)m->nv;
 }
@@ -1054,15 +1055,18 @@ static ssStatus read_doubles(const Parsed *f, int s, size_t n, double *out,
 }
 
 /* Whether cache entry e, keyed as a rigid contact's (vertex < 0), names a
- * rigid support (a rigid height map or a ground plane) and a candidate
- * point, and holds what the solver stores for one: a positive normal
- * force and no rate */
+ * rigid support (a rigid height map, a ground plane, or another collider:
+ * ss_rigid_feature) and a candidate point, and holds what the solver
+ * stores for one: a positive normal force and no rate */
 static int rigid_entry(const ssModel *m, const ssWarmEntry *e)
 {
   int support, k;
   ss_rigid_feature_split(e->vertex, &support, &k);
   (void)k; /* any of SS_RIGID_CANDIDATES */
-  int ok = support < m->nhfield + m->nplane && (support >= m->nhfield || !m->hfield_soil[support]);
+  int other = support - m->nhfield - m->nplane; /* a collider's index */
+  int ok = support < m->nhfield + m->nplane
+               ? support >= m->nhfield || !m->hfield_soil[support]
+               : other < m->ngeom && other != e->geom && e->geom >= 0;
   return ok && e->traction[0] > 0 && e->rate[0] == 0 && e->rate[1] == 0 && e->rate[2] == 0;
 }
 

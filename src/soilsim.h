@@ -558,6 +558,11 @@ typedef struct ssData {
                              (ss_solver_warm_apply; internal, solver.c) */
   int warm_creep_rates;   /* the pending warm start extrapolates creeping
                              colliders too (internal) */
+  int contact_deep;       /* the step's rigid contacts, pair contacts and
+                             joint limits that penetrate or pass their
+                             limit (g0 < 0), counted as they are made:
+                             none, and ss_solver_push has nothing to do
+                             (internal) */
   struct ssNewtonWork *newton; /* the Newton phase's workspace (internal) */
   ssStepStats stats;
 } ssData;

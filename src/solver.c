@@ -141,10 +141,78 @@ body_point_velocity(const ssContact *c, const double com[3], const double u[6], 
   ss_contact_frame_mulv(c, v, w);
 }
 
+/* One body of a contact at its point and frame, from the full velocity:
+ * the link's (link >= 0, of system sys) or the free body's of collider
+ * geom (velocities at vadr) */
+static void side_velocity(const ssModel *m, const ssData *d, const ssContact *c, int link,
+                          int sys, int vadr, int geom, double v[3])
+{
+  if (link >= 0) {
+    double V[6];
+    ss_art_link_velocity(m, d, link, V);
+    link_point_velocity(ss_art_origin(d, sys), c, V, v);
+    return;
+  }
+  body_point_velocity(c, d->body_xipos + 3 * m->geom_body[geom], d->qvel + vadr, v);
+}
+
+/* u += W dl on one body of a contact: a link's (its block's Y), or a free
+ * body's (W, nv x 3, after its J at jadr) */
+static void side_apply(const ssModel *m, ssData *d, const ssContact *c, int link, int sys,
+                       int vadr, int nv, long jadr, const double dl[3])
+{
+  double *u = d->qvel + vadr;
+  if (link >= 0) {
+    const double *Y, *Lam;
+    double w[6];
+    ss_art_link_block(m, d, link, &Y, &Lam);
+    link_impulse(ss_art_origin(d, sys), c, dl, w);
+    for (int k = 0; k < nv; k++) {
+      const double *y = Y + 6 * k;
+      u[k] += y[0] * w[0] + y[1] * w[1] + y[2] * w[2] + y[3] * w[3] + y[4] * w[4] + y[5] * w[5];
+    }
+    return;
+  }
+  const double *W = d->jac + jadr + 3 * nv;
+  for (int i = 0; i < nv; i++)
+    u[i] += W[3 * i] * dl[0] + W[3 * i + 1] * dl[1] + W[3 * i + 2] * dl[2];
+}
+
+/* a pair contact's velocity: its first body's less its second's */
+static void pair_velocity(const ssModel *m, const ssData *d, const ssContact *c, double v[3])
+{
+  double v2[3];
+  side_velocity(m, d, c, c->link, c->sys, c->vadr, c->geom, v);
+  side_velocity(m, d, c, c->link2, c->sys2, c->vadr2, c->geom2, v2);
+  ss_v3_sub(v, v, v2);
+}
+
+/* One body's rows and response of a pair contact, for the sweeps: a
+ * link's X and LX (J, 36 values), or a free body's J and W (6 nv), and its
+ * G (3 x 3) */
+static void pair_side_rows(const ssModel *m, ssData *d, const ssContact *c, int link, int sys,
+                           int geom, int nv, double *J, double G[9])
+{
+  if (link >= 0) {
+    double p[3];
+    ss_v3_sub(p, c->pos, ss_art_origin(d, sys));
+    ss_art_contact_rows(p, c->frame, J);
+    ss_art_contact_response(m, d, link, J, J + 18, G);
+    return;
+  }
+  int b = m->geom_body[geom];
+  ss_dyn_contact_jacobian(d, b, c->pos, c->frame, J);
+  ss_dyn_contact_response(m, d, b, J, J + 3 * nv, G);
+}
+
 /* the contact's velocity J u, from the full velocity */
 static inline __attribute__((always_inline)) void
 contact_velocity(const ssModel *m, const ssData *d, const ssContact *c, double v[3])
 {
+  if (c->type == SS_CONTACT_PAIR) {
+    pair_velocity(m, d, c, v);
+    return;
+  }
   if (c->link >= 0) {
     double V[6];
     ss_art_link_velocity(m, d, c->link, V);
@@ -198,6 +266,13 @@ static void row_apply(ssData *d, ssContact *c, double dl)
 static void apply_impulse(const ssModel *m, ssData *d, ssContact *c,
                           const double dl[3])
 {
+  if (c->type == SS_CONTACT_PAIR) {
+    /* dl on the first body, -dl on the second */
+    const double ml[3] = {-dl[0], -dl[1], -dl[2]};
+    side_apply(m, d, c, c->link, c->sys, c->vadr, c->nv, c->jadr, dl);
+    side_apply(m, d, c, c->link2, c->sys2, c->vadr2, c->nv2, c->jadr2, ml);
+    return;
+  }
   if (c->link >= 0) {
     const double *Y, *Lam;
     double w[6];
@@ -426,7 +501,7 @@ warm_impulse(const ssModel *m, const ssContact *c, const ssWarmEntry *e, int cre
     lam[0] = l > c->row_bound ? c->row_bound : l < -c->row_bound ? -c->row_bound : l;
   } else if (c->type == SS_CONTACT_LIMIT) {
     lam[0] = e->traction[0] > 0 ? e->traction[0] * dt : 0;
-  } else if (c->type == SS_CONTACT_RIGID) {
+  } else if (c->type == SS_CONTACT_RIGID || c->type == SS_CONTACT_PAIR) {
     rigid_warm_impulse(c, e, dt, lam);
   } else {
     warm_soil_impulse(m->hfield_soilmat, dt, c, e, creep_rates, lam);
@@ -460,6 +535,22 @@ static inline void body_run_open(const ssModel *m, ssData *d, WarmApply *a, int 
   }
 }
 
+/* One body's warm impulse lam of pair contact c: a link's through its
+ * block (Y), a free body's as J^T lam (ss_dyn_body_impulse), neither
+ * from the rows in ssData.jac, which the warm start comes before */
+static void warm_side(const ssModel *m, ssData *d, const ssContact *c, int link, int sys,
+                      int vadr, int nv, int geom, const double lam[3])
+{
+  if (link >= 0) {
+    side_apply(m, d, c, link, sys, vadr, nv, -1, lam);
+    return;
+  }
+  int b = m->geom_body[geom];
+  double F[6] = {0};
+  body_run_add(c, d->body_xipos + 3 * b, lam, F);
+  ss_dyn_body_impulse(m, d, b, F);
+}
+
 /* contact c's warm impulse, and its velocity change into a */
 static inline __attribute__((always_inline)) void
 warm_one(const ssModel *m, ssData *d, ssContact *c, const ssWarmEntry *e, int creep_rates,
@@ -469,7 +560,16 @@ warm_one(const ssModel *m, ssData *d, ssContact *c, const ssWarmEntry *e, int cr
   if (!c->nv) return;
   Group *g = &a->g;
   BodyRun *br = &a->br;
-  if (c->link < 0 && (c->type == SS_CONTACT_SOIL || c->type == SS_CONTACT_RIGID)) {
+  if (c->type == SS_CONTACT_PAIR) {
+    /* on two bodies, each from the contact's point and frame (its rows
+     * and responses are formed only for the sweeps, after the warm
+     * start): lambda on the first, -lambda on the second */
+    group_close(d, g);
+    body_run_close(m, d, br);
+    const double ml[3] = {-c->lambda[0], -c->lambda[1], -c->lambda[2]};
+    warm_side(m, d, c, c->link, c->sys, c->vadr, c->nv, c->geom, c->lambda);
+    warm_side(m, d, c, c->link2, c->sys2, c->vadr2, c->nv2, c->geom2, ml);
+  } else if (c->link < 0 && (c->type == SS_CONTACT_SOIL || c->type == SS_CONTACT_RIGID)) {
     /* a rigid body's run likewise, as J^T lambda (its J and W are formed
      * only for the sweeps, after the warm start) */
     int b = m->geom_body[c->geom];
@@ -801,8 +901,9 @@ store_entries(const ssModel *m, const ssData *d, ssWarmEntry *next, const double
           g[2] += fabs(c->lambda[1]) + fabs(c->lambda[2]);
         }
       }
-    } else if (c->type == SS_CONTACT_RIGID) {
-      /* its force, to be scaled by the next step's dt; no rate */
+    } else if (c->type != SS_CONTACT_PD && c->type != SS_CONTACT_LIMIT) {
+      /* a rigid or pair contact: its force, to be scaled by the next
+       * step's dt; no rate */
       geom = c->geom;
       vertex = c->vertex;
       for (int k = 0; k < 3; k++) {
@@ -969,7 +1070,8 @@ static void visit(const ssModel *m, ssData *d, ssContact *c, Group *g,
   case SS_CONTACT_SOIL:
     ss_point_soil(c, v0, stol);
     break;
-  case SS_CONTACT_RIGID: ss_point_rigid(c, v0, stol); break;
+  case SS_CONTACT_RIGID:
+  case SS_CONTACT_PAIR: ss_point_rigid(c, v0, stol); break;
   case SS_CONTACT_PD: pd_row(c, v0); break;
   default: limit_row(c, v0); break;
   }
@@ -1027,7 +1129,7 @@ static ssContact *link_run_end(const ssModel *m, const ssData *d, ssContact *c,
   ss_art_link_velocity(m, d, link, S);
   const double V[6] = {S[0], S[1], S[2], S[3], S[4], S[5]};
   const double *org = ss_art_origin(d, c->sys), o[3] = {org[0], org[1], org[2]};
-  for (; c < end && c->link == link; c++) {
+  for (; c < end && c->link == link && c->type != SS_CONTACT_PAIR; c++) {
     double v[3];
     link_point_velocity(o, c, V, v);
     contact_end(c, v, dt);
@@ -1036,10 +1138,12 @@ static ssContact *link_run_end(const ssModel *m, const ssData *d, ssContact *c,
 }
 
 /* Whether contact b joins rigid contact a's block: a rigid contact of the
- * same collider (next to it in the contacts, on the same link or body) */
+ * same collider (next to it in the contacts, on the same link or body),
+ * or a pair contact of the same two colliders */
 static inline int same_block(const ssContact *a, const ssContact *b)
 {
-  return b->type == SS_CONTACT_RIGID && b->geom == a->geom;
+  return b->type == a->type && b->geom == a->geom &&
+         (a->type == SS_CONTACT_RIGID || (a->type == SS_CONTACT_PAIR && b->geom2 == a->geom2));
 }
 
 /* Visits contacts lo..hi once, backwards where back is set */
@@ -1080,9 +1184,44 @@ enum { RIGID_PASSES = 64, BLOCK_MAX = 16, BLOCK_TRIES = 6 };
 /* G_ab, the response of contact a's velocity to contact b's impulse (3 x 3,
  * row-major), both on one link (X_a Lam X_b^T = X_a . LX_b) or one free
  * body (J_a W_b), from the rows the sweeps' set-up formed */
+/* One body's part of the response between two pair contacts of the same
+ * two colliders: the same link's X_a LX_b (link >= 0), or the same free
+ * body's J_a W_b, from the rows at ja and jb (pair_side_rows) */
+static void pair_side_response(const ssData *d, int link, int nv, long ja, long jb,
+                               double G[9])
+{
+  const double *Xa = d->jac + ja;
+  if (link >= 0) {
+    const double *LXb = d->jac + jb + 18;
+    for (int r = 0; r < 3; r++)
+      for (int k = 0; k < 3; k++) {
+        const double *x = Xa + 6 * r, *y = LXb + 6 * k;
+        G[3 * r + k] = x[0] * y[0] + x[1] * y[1] + x[2] * y[2] + x[3] * y[3] + x[4] * y[4] +
+                       x[5] * y[5];
+      }
+    return;
+  }
+  const double *Wb = d->jac + jb + 3 * nv;
+  for (int r = 0; r < 3; r++)
+    for (int k = 0; k < 3; k++) {
+      double s = 0;
+      for (int i = 0; i < nv; i++) s += Xa[r * nv + i] * Wb[3 * i + k];
+      G[3 * r + k] = s;
+    }
+}
+
 static void block_response(const ssData *d, const ssContact *a, const ssContact *b,
                            const double *P, double G[9])
 {
+  if (a->type == SS_CONTACT_PAIR) {
+    /* both bodies' parts (b's impulse moves each as a's does, the second
+     * with the sign that its velocity counts with) */
+    double G2[9];
+    pair_side_response(d, a->link, a->nv, a->jadr, b->jadr, G);
+    pair_side_response(d, a->link2, a->nv2, a->jadr2, b->jadr2, G2);
+    for (int k = 0; k < 9; k++) G[k] += G2[k];
+    return;
+  }
   const double *Xa = d->jac + a->jadr;
   if (a->link >= 0) {
     const double *LXb = d->jac + b->jadr + 18;
@@ -1154,6 +1293,8 @@ static int block_linear(double *A, double *b, const double *xc, int n)
  * of G zero. */
 typedef struct Block {
   int n;
+  int island;  /* free bodies' contacts joined by pair contacts
+                  (island_blocks): responses by island_response */
   ssContact *c[BLOCK_MAX];
   double G[3 * BLOCK_MAX][3 * BLOCK_MAX], v0[3 * BLOCK_MAX];
   int kind[BLOCK_MAX];
@@ -1401,6 +1542,45 @@ static int block_row_responses(const ssModel *m, ssData *d, Block *B, const Grou
   return 1;
 }
 
+/* The bodies of a free body's contact (rigid or pair): each one's body,
+ * its rows J (3 x 6) and response W (6 x 3) at jadr and jadr + 18 in the
+ * contact's storage, and the sign its impulse takes there */
+typedef struct Side {
+  int body;
+  long jadr;
+  double sign;
+} Side;
+
+static int contact_sides(const ssModel *m, const ssContact *c, Side s[2])
+{
+  s[0] = (Side){m->geom_body[c->geom], c->jadr, 1};
+  if (c->type != SS_CONTACT_PAIR) return 1;
+  s[1] = (Side){m->geom_body[c->geom2], c->jadr2, -1};
+  return 2;
+}
+
+/* G_ab between two contacts of free bodies (an island's, island_blocks):
+ * over the bodies they share, J_a W_b with their signs */
+static void island_response(const ssModel *m, const ssContact *a, const ssContact *b,
+                            const double *jac, double G[9])
+{
+  Side sa[2], sb[2];
+  int na = contact_sides(m, a, sa), nb = contact_sides(m, b, sb);
+  memset(G, 0, 9 * sizeof(double));
+  for (int p = 0; p < na; p++)
+    for (int q = 0; q < nb; q++) {
+      if (sa[p].body != sb[q].body) continue;
+      const double *J = jac + sa[p].jadr, *W = jac + sb[q].jadr + 18;
+      const double s = sa[p].sign * sb[q].sign;
+      for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++) {
+          double t = 0;
+          for (int i = 0; i < 6; i++) t += J[6 * r + i] * W[3 * i + k];
+          G[3 * r + k] += s * t;
+        }
+    }
+}
+
 /* One solve of block B's contacts (B->n and B->c set), every other contact
  * held: the linear system of their states (block_impulses), from the
  * states their impulses show, the states corrected and the sliding
@@ -1444,7 +1624,9 @@ static int block_solve(const ssModel *m, ssData *d, Block *B, Group *g)
     for (int j = 0; j < n; j++) {
       /* (a row's entries: block_row_responses) */
       double Gij[9] = {0};
-      if (!row[i] && !row[j]) {
+      if (B->island) {
+        island_response(m, B->c[i], B->c[j], d->jac, Gij);
+      } else if (!row[i] && !row[j]) {
         const double *Pij = NULL;
         if (B->c[i]->link >= 0 && li[i] != li[j]) {
           int q = li[i] * LINKS + li[j];
@@ -1592,6 +1774,7 @@ static void system_blocks(const ssModel *m, ssData *d, int first_row, double *dm
     Block B;
     int sys = c->sys, ngeom = 0, lastg = -1, k = i;
     B.n = 0;
+    B.island = 0;
     for (; k < first_row; k++) {
       ssContact *e = d->contact + k;
       if (e->sys != sys) break;
@@ -1634,11 +1817,95 @@ static void system_blocks(const ssModel *m, ssData *d, int first_row, double *dm
   }
 }
 
+/* Every SYSTEM_EVERY sweeps, after the sweep (with system_blocks): the
+ * contacts of each island of free bodies that pair contacts join (a box
+ * on a box on the ground, a ball against a cylinder on a slope) solved
+ * together as one block, as system_blocks solves an articulated
+ * system's: their rigid contacts and the pair contacts between them, those
+ * that carry load or lie within 0.1 mm; the answer kept only where it
+ * lowers their measure.  The collider blocks settle each body on its
+ * supports and each pair's contacts; what stays slow is the load passed
+ * along the chain of bodies, which Gauss-Seidel moves a step a sweep.
+ * An island of more than ISLAND_BODIES bodies or BLOCK_MAX such contacts
+ * keeps the sweeps alone; so does one that holds a link. */
+enum { ISLAND_BODIES = 8, ISLAND_PAIRS = 64 };
+
+static int in_list(const int *v, int n, int x)
+{
+  for (int k = 0; k < n; k++)
+    if (v[k] == x) return 1;
+  return 0;
+}
+
+static void island_blocks(const ssModel *m, ssData *d, int first_row, double *dmax,
+                          double *lmax)
+{
+  Group none = {NULL, NULL, NULL, {0}, {0}, {0}};
+  int done[ISLAND_PAIRS], ndone = 0;
+  for (int i = 0; i < first_row; i++) {
+    ssContact *c = d->contact + i;
+    if (c->type != SS_CONTACT_PAIR || c->link >= 0 || c->link2 >= 0 || in_list(done, ndone, i))
+      continue;
+    /* the island: the bodies (systems) pair contacts join to c's */
+    int sys[ISLAND_BODIES] = {c->sys, c->sys2}, nsys = 2, grown = 1, whole = 1;
+    while (grown && whole) {
+      grown = 0;
+      for (int k = 0; k < first_row && whole; k++) {
+        const ssContact *e = d->contact + k;
+        if (e->type != SS_CONTACT_PAIR) continue;
+        int a = in_list(sys, nsys, e->sys), b = in_list(sys, nsys, e->sys2);
+        if (a == b) continue;
+        if (e->link >= 0 || e->link2 >= 0 || nsys == ISLAND_BODIES) {
+          whole = 0;
+          break;
+        }
+        sys[nsys++] = a ? e->sys2 : e->sys;
+        grown = 1;
+      }
+    }
+    /* its contacts: the bodies' rigid contacts, the pairs between them */
+    Block B;
+    B.n = 0;
+    B.island = 1;
+    for (int k = 0; k < first_row && whole; k++) {
+      ssContact *e = d->contact + k;
+      int in = e->type == SS_CONTACT_PAIR ? in_list(sys, nsys, e->sys)
+               : e->type == SS_CONTACT_RIGID ? e->link < 0 && in_list(sys, nsys, e->sys)
+                                             : 0;
+      if (!in) continue;
+      if (e->type == SS_CONTACT_PAIR && ndone < ISLAND_PAIRS) done[ndone++] = k;
+      if (e->lambda[0] == 0 && e->g0 > 1e-4) continue;
+      if (B.n == BLOCK_MAX) whole = 0;
+      else B.c[B.n++] = e;
+    }
+    if (!whole || B.n < 2) continue;
+    double keep[3 * BLOCK_MAX], u0[6 * ISLAND_BODIES];
+    for (int j = 0; j < B.n; j++) memcpy(keep + 3 * j, B.c[j]->lambda, sizeof B.c[j]->lambda);
+    for (int s = 0; s < nsys; s++)
+      memcpy(u0 + 6 * s, d->qvel + m->sys_vadr[sys[s]], 6 * sizeof(double));
+    double before = rigid_residual(m, d, B.c, B.n);
+    if (!block_solve(m, d, &B, &none)) continue;
+    double after = rigid_residual(m, d, B.c, B.n);
+    if (!(after < before)) {
+      for (int j = 0; j < B.n; j++) memcpy(B.c[j]->lambda, keep + 3 * j, sizeof B.c[j]->lambda);
+      for (int s = 0; s < nsys; s++)
+        memcpy(d->qvel + m->sys_vadr[sys[s]], u0 + 6 * s, 6 * sizeof(double));
+      continue;
+    }
+    for (int j = 0; j < B.n; j++) {
+      double dl[3];
+      ss_v3_sub(dl, B.c[j]->lambda, keep + 3 * j);
+      measure_add(dl, B.c[j]->lambda, dmax, lmax);
+    }
+  }
+}
+
 static void rigid_block(const ssModel *m, ssData *d, int lo, int hi, int back, Group *g,
                         double *dmax, double *lmax)
 {
   const double tol = m->opt.solver_tolerance;
   Block B;
+  B.island = 0;
   B.n = hi - lo + 1 <= BLOCK_MAX ? hi - lo + 1 : 0;
   for (int i = 0; i < B.n; i++) B.c[i] = d->contact + lo + i;
   visit_span(m, d, lo, hi, back, g, dmax, lmax);
@@ -1660,7 +1927,7 @@ static void visit_piece(const ssModel *m, ssData *d, int i, int end, int back, G
   for (int n = 0; n <= end - i;) {
     int k = back ? end - n : i + n, lo = k, hi = k;
     ssContact *c = d->contact + k;
-    if (c->type == SS_CONTACT_RIGID) {
+    if (c->type == SS_CONTACT_RIGID || c->type == SS_CONTACT_PAIR) {
       /* k is the block's first contact in this direction */
       if (back)
         while (lo > i && same_block(c, d->contact + lo - 1)) lo--;
@@ -1737,14 +2004,26 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   for (int i = first_row - 1; i >= 0 && sweeps > 0; i--) {
     ssContact *c = d->contact + i;
     c->run = 1;
-    if (c->link >= 0 && i + 1 < first_row && c[1].link == c->link) c->run += c[1].run;
+    /* (a pair contact is visited alone: it moves two bodies) */
+    if (c->link >= 0 && i + 1 < first_row && c[1].link == c->link &&
+        c->type != SS_CONTACT_PAIR && c[1].type != SS_CONTACT_PAIR)
+      c->run += c[1].run;
   }
   int link_rigid = 0; /* rigid contacts on articulated links (system_blocks) */
+  int free_pairs = 0; /* pair contacts between free bodies (island_blocks) */
   for (int i = 0; i < d->ncontact && sweeps > 0; i++) {
     ssContact *c = d->contact + i;
     double *J = d->jac + c->jadr;
     link_rigid |= c->type == SS_CONTACT_RIGID && c->link >= 0;
-    if (c->link >= 0) {
+    free_pairs |= c->type == SS_CONTACT_PAIR && c->link < 0 && c->link2 < 0;
+    if (c->type == SS_CONTACT_PAIR) {
+      /* each body's rows and response; G their sum (the second body
+       * takes -lambda and its velocity counts negative) */
+      double G2[9];
+      pair_side_rows(m, d, c, c->link, c->sys, c->geom, c->nv, J, c->G);
+      pair_side_rows(m, d, c, c->link2, c->sys2, c->geom2, c->nv2, d->jac + c->jadr2, G2);
+      for (int k = 0; k < 9; k++) c->G[k] += G2[k];
+    } else if (c->link >= 0) {
       double p[3];
       ss_v3_sub(p, c->pos, ss_art_origin(d, c->sys));
       ss_art_contact_rows(p, c->frame, J);
@@ -1770,12 +2049,14 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
          * what is left the same way) */
         int pieces = rows ? (c->run + PIECE - 1) / PIECE : 1;
         end = i + (c->run + pieces - 1) / pieces - 1;
-      } else if (c->type == SS_CONTACT_RIGID) {
-        /* a free body's rigid contacts on one collider: one block */
+      } else if (c->type == SS_CONTACT_RIGID || c->type == SS_CONTACT_PAIR) {
+        /* a free body's rigid contacts on one collider, or the pair
+         * contacts of two colliders: one block */
         while (end + 1 < first_row && same_block(c, d->contact + end + 1)) end++;
       }
       if (end > i) {
-        if (pack && c->link >= 0) group_open(m, d, &g, c);
+        /* (a pair's block moves two bodies: never in a link's group) */
+        if (pack && c->link >= 0 && c->type != SS_CONTACT_PAIR) group_open(m, d, &g, c);
         /* symmetric Gauss-Seidel within a piece: every other sweep visits
          * it backwards, so a correction travels across the contact patch
          * both ways; the same order packed or not */
@@ -1801,6 +2082,8 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
     group_close(d, &g);
     if (link_rigid && sweep % SYSTEM_EVERY == SYSTEM_EVERY - 1)
       system_blocks(m, d, first_row, &dmax, &lmax);
+    if (free_pairs && sweep % SYSTEM_EVERY == SYSTEM_EVERY - 1)
+      island_blocks(m, d, first_row, &dmax, &lmax);
     st->sweeps = sweep + 1;
     st->residual = lmax > 0 ? dmax / lmax : 0;
     if (st->residual <= tol) break;
@@ -1813,6 +2096,12 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   const ssContact *end = d->ncontact ? d->contact + d->ncontact : d->contact;
   for (ssContact *c = d->contact; c < end;) {
     double v[3] = {0, 0, 0};
+    if (c->type == SS_CONTACT_PAIR) {
+      pair_velocity(m, d, c, v);
+      contact_end(c, v, dt);
+      c++;
+      continue;
+    }
     if (c->link >= 0) {
       /* one spatial velocity per link run */
       c = link_run_end(m, d, c, end);
@@ -1854,12 +2143,15 @@ enum { PUSH_SWEEPS = 50 };
 /* (solver.h) */
 int ss_solver_push(const ssModel *m, ssData *d)
 {
+  /* (none penetrating: nothing to look at, as most steps on soil) */
+  if (!d->contact_deep) return 0;
   /* a moving system's rigid contacts and joint limits, any of them
    * penetrating */
   int n = 0, deep = 0;
   for (int i = 0; i < d->ncontact; i++) {
     const ssContact *c = d->contact + i;
-    if ((c->type == SS_CONTACT_RIGID || c->type == SS_CONTACT_LIMIT) && c->nv > 0) {
+    if ((c->type == SS_CONTACT_RIGID || c->type == SS_CONTACT_PAIR ||
+         c->type == SS_CONTACT_LIMIT) && c->nv > 0) {
       n++;
       deep |= c->g0 < 0;
     }
@@ -1875,7 +2167,9 @@ int ss_solver_push(const ssModel *m, ssData *d)
   n = 0;
   for (int i = 0; i < d->ncontact; i++) {
     const ssContact *c = d->contact + i;
-    if ((c->type == SS_CONTACT_RIGID || c->type == SS_CONTACT_LIMIT) && c->nv > 0) idx[n++] = i;
+    if ((c->type == SS_CONTACT_RIGID || c->type == SS_CONTACT_PAIR ||
+         c->type == SS_CONTACT_LIMIT) && c->nv > 0)
+      idx[n++] = i;
   }
   /* the sweeps on a velocity of their own, from rest: d->qvel holds the
    * push while they run, the step's velocity waits in qvel_push */

@@ -29,7 +29,12 @@ typedef enum ssContactType {
   SS_CONTACT_SOIL = 0, /* one soil quadrature point (DESIGN 3.1) */
   SS_CONTACT_RIGID,    /* Coulomb cone with restitution */
   SS_CONTACT_PD,       /* joint PD controller: one bounded implicit row */
-  SS_CONTACT_LIMIT     /* joint limit: one unilateral row */
+  SS_CONTACT_LIMIT,    /* joint limit: one unilateral row */
+  SS_CONTACT_PAIR      /* Coulomb cone between two moving bodies: the
+                          first (geom, sys, link, ...) takes lambda, the
+                          second (geom2, sys2, link2, ...) -lambda; the
+                          frame's normal points from the second into the
+                          first */
 } ssContactType;
 
 struct ssContact {
@@ -75,7 +80,8 @@ struct ssContact {
    * bodies), by attach (terrain.c) for a static body's, by the joint rows'
    * creators; v: by the solve's end, for every contact; warm_t: by the
    * warm start, and read only where warm_trend says it was; cache: by
-   * ss_point_setup, read only where cache_ready says it was. */
+   * ss_point_setup, read only where cache_ready says it was; the second
+   * body's fields: by a pair contact's creator, read only for those. */
   double pos[3];     /* contact point, world */
   double frame[9];   /* rows n, t1, t2 (world); n = bed +z / surface normal */
   double G[9];       /* impulse response J W (3 x 3) */
@@ -83,6 +89,12 @@ struct ssContact {
   double warm_t[3];  /* soil: the cached traction its warm start came from */
   ssPointCache cache;/* soil: the point solve's law and reused values
                         (empty while cache_ready is 0) */
+  /* a pair contact's second body, written by its creator and read only
+   * for SS_CONTACT_PAIR: its collider, system, velocity block, link (-1:
+   * a free body) and Jacobian storage, which follows the first body's in
+   * ssData.jac (jadr2 = jadr + the first's length; jlen covers both) */
+  int geom2, sys2, vadr2, nv2, link2;
+  long jadr2;
 };
 
 /* A cached traction from the previous step (warm start).  The next step
@@ -117,7 +129,9 @@ struct ssWarmEntry {
 };
 
 /* A rigid contact's key in the warm-start cache, in place of a soil
- * vertex: its support s (rigid height map h, or ground plane nhfield + p)
+ * vertex: its support s (rigid height map h, ground plane nhfield + p, or
+ * another collider nhfield + nplane + g: a static body's, or a pair
+ * contact's second body's)
  * and its collider's candidate point k (ss_shape_candidates' order, k <
  * SS_RIGID_CANDIDATES) as INT_MIN + s SS_RIGID_CANDIDATES + k: negative,
  * so never a soil vertex, and ascending in the order a collider's rigid

@@ -593,6 +593,7 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
     ss_m3_mulv(nw, R, nl);
     frame_from_normal(nw, c->frame);
     c->g0 = gap;
+    d->contact_deep += gap < 0;
     c->mu = pair->friction;
     /* lowest allowed end-of-step normal velocity: close a gap, stop in a
      * penetration (the push moves it out, ss_solver_push, and leaves the
@@ -618,9 +619,163 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
   return SS_OK;
 }
 
+/* ---------------------------------------------------------------------- */
+/* contacts between bodies                                                 */
+
+/* A collider in the broad phase: its box in the world, widened by how
+ * far it can move in the step (geom_margin's reach) */
+typedef struct PairBox {
+  double lo[3], hi[3];
+  int g;
+} PairBox;
+
+static int pair_box_cmp(const void *pa, const void *pb)
+{
+  const PairBox *a = pa, *b = pb;
+  if (a->lo[0] != b->lo[0]) return a->lo[0] < b->lo[0] ? -1 : 1;
+  return a->g < b->g ? -1 : a->g > b->g;
+}
+
+/* The contacts of colliders ga (moving) and gb (another system's, static
+ * or moving) from ss_shape_pair_points: against a static body a rigid
+ * contact of ga's with gb as its support, between two moving bodies a
+ * pair contact (ga takes lambda, gb -lambda).  Keys as a rigid contact's
+ * (ss_rigid_feature), with gb's support number nhfield + nplane + gb and
+ * the point's feature. */
+static ssStatus pair_contacts(const ssModel *m, ssData *d, int ga, int gb, ssError *err)
+{
+  static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, o[3] = {0, 0, 0};
+  int sa = m->body_sys[m->geom_body[ga]], sb = m->body_sys[m->geom_body[gb]];
+  int dynb = m->sys_nv[sb] > 0;
+  long support = (long)m->nhfield + m->nplane + gb;
+  /* (the keys' room: ss_rigid_feature) */
+  if (support >= (1L << 26) - 1) return SS_OK;
+  ssShape A, B;
+  shape_in_frame(m, d, ga, I3, o, &A);
+  shape_in_frame(m, d, gb, I3, o, &B);
+  double margin = geom_margin(m, d, ga, sa, NULL);
+  if (dynb) margin += geom_margin(m, d, gb, sb, NULL) - m->opt.contact_margin;
+  ssPairPoint pts[SS_PAIR_POINTS_MAX];
+  int npt = ss_shape_pair_points(&A, &B, margin, pts, SS_PAIR_POINTS_MAX);
+  if (!npt) return SS_OK;
+  const ssMaterialPair *pair =
+      ss_model_pair(m, m->geom_material[ga], m->geom_material[gb]);
+  long ja = contact_jlen(m, sa), jb = dynb ? contact_jlen(m, sb) : 0;
+  const Attach at = attach_of(m, ga, sa), bt = attach_of(m, gb, dynb ? sb : -1);
+  const double dt = m->opt.timestep;
+  for (int k = 0; k < npt; k++) {
+    const ssPairPoint *q = pts + k;
+    if (q->gap > margin) continue;
+    ssContact *c = ss_contact_new(d, ja + jb);
+    if (!c) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
+    c->type = dynb ? SS_CONTACT_PAIR : SS_CONTACT_RIGID;
+    c->geom = ga;
+    c->hfield = -1;
+    c->vertex = ss_rigid_feature((int)support, q->id);
+    ss_v3_copy(c->pos, q->pos);
+    frame_from_normal(q->n, c->frame);
+    c->g0 = q->gap;
+    d->contact_deep += q->gap < 0;
+    c->mu = pair->friction;
+    /* as a rigid contact's (rigid_contacts): close a gap, stop in a
+     * penetration (the push moves it out), or bounce */
+    c->vn_target = q->gap >= 0 ? -q->gap / dt : 0;
+    attach_head(&at, c);
+    attach_response(&at, c);
+    if (dynb) {
+      c->geom2 = gb;
+      c->sys2 = bt.sys;
+      c->vadr2 = bt.vadr;
+      c->nv2 = bt.nv;
+      c->link2 = bt.link;
+      c->jadr2 = c->jadr + ja;
+    }
+    if (q->gap <= m->opt.contact_margin && pair->restitution > 0) {
+      /* the approach before this step's loads (qvel_start), as a rigid
+       * contact's */
+      double v[3], vb[3] = {0, 0, 0};
+      ss_dyn_point_velocity_of(m, d, d->qvel_start, m->geom_body[ga], c->pos, v);
+      if (dynb) ss_dyn_point_velocity_of(m, d, d->qvel_start, m->geom_body[gb], c->pos, vb);
+      double vn = (v[0] - vb[0]) * q->n[0] + (v[1] - vb[1]) * q->n[1] + (v[2] - vb[2]) * q->n[2];
+      if (vn < -pair->restitution_threshold && -pair->restitution * vn > c->vn_target)
+        c->vn_target = -pair->restitution * vn;
+    }
+  }
+  return SS_OK;
+}
+
+/* Contacts between the colliders of different systems, at least one of
+ * them moving: a sweep over their boxes along x (sorted by their lower
+ * ends, then index: the same order every run), each overlapping pair's
+ * points from ss_shape_pair_points.  Meshes take no part (their shape
+ * has no signed distance here); nor do two colliders of one system (an
+ * articulated system's links do not collide with each other). */
+static ssStatus body_contacts(const ssModel *m, ssData *d, ssError *err)
+{
+  /* nothing to do where the colliders are all one system's (the buggy's:
+   * no boxes formed a step) */
+  int n = 0, first = -1, several = 0;
+  for (int g = 0; g < m->ngeom; g++) {
+    int s = m->body_sys[m->geom_body[g]];
+    if (d->sys_active[s] && (m->geom_group[g] & 1) && m->geom_type[g] != SS_GEOM_MESH) {
+      n++;
+      if (first < 0) first = s;
+      several |= s != first;
+    }
+  }
+  if (!several) return SS_OK;
+  PairBox *box = malloc((size_t)n * sizeof *box);
+  if (!box) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
+  static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, o[3] = {0, 0, 0};
+  int nmoving = 0;
+  n = 0;
+  for (int g = 0; g < m->ngeom; g++) {
+    int s = m->body_sys[m->geom_body[g]];
+    if (!(d->sys_active[s] && (m->geom_group[g] & 1) && m->geom_type[g] != SS_GEOM_MESH))
+      continue;
+    ssShape sh;
+    shape_in_frame(m, d, g, I3, o, &sh);
+    PairBox *b = box + n++;
+    ss_shape_aabb(&sh, b->lo, b->hi);
+    double reach = geom_margin(m, d, g, m->sys_nv[s] > 0 ? s : -1, NULL);
+    for (int k = 0; k < 3; k++) {
+      b->lo[k] -= reach;
+      b->hi[k] += reach;
+    }
+    b->g = g;
+    nmoving += m->sys_nv[s] > 0;
+  }
+  ssStatus st = SS_OK;
+  if (nmoving > 0) {
+    qsort(box, (size_t)n, sizeof *box, pair_box_cmp);
+    for (int i = 0; i < n && !st; i++)
+      for (int j = i + 1; j < n && !st && box[j].lo[0] <= box[i].hi[0]; j++) {
+        const PairBox *a = box + i, *b = box + j;
+        if (a->lo[1] > b->hi[1] || b->lo[1] > a->hi[1] || a->lo[2] > b->hi[2] ||
+            b->lo[2] > a->hi[2])
+          continue;
+        int ga = a->g, gb = b->g;
+        int sa = m->body_sys[m->geom_body[ga]], sb = m->body_sys[m->geom_body[gb]];
+        if (sa == sb) continue;
+        int da = m->sys_nv[sa] > 0, db = m->sys_nv[sb] > 0;
+        if (!da && !db) continue;
+        /* the moving one first; of two moving ones the lower index */
+        if (!da || (db && gb < ga)) {
+          int t = ga;
+          ga = gb;
+          gb = t;
+        }
+        st = pair_contacts(m, d, ga, gb, err);
+      }
+  }
+  free(box);
+  return st;
+}
+
 ssStatus ss_terrain_contacts(const ssModel *m, ssData *d, ssError *err)
 {
   d->ncontact = 0;
+  d->contact_deep = 0;
   for (int g = 0; g < m->ngeom; g++) {
     int sys = m->body_sys[m->geom_body[g]];
     if (!d->sys_active[sys] || !(m->geom_group[g] & 1)) continue;
@@ -642,7 +797,7 @@ ssStatus ss_terrain_contacts(const ssModel *m, ssData *d, ssError *err)
     for (int pl = 0; pl < m->nplane; pl++)
       if ((st = rigid_contacts(m, d, -1, pl, g, sys, err))) return st;
   }
-  return SS_OK;
+  return body_contacts(m, d, err);
 }
 
 ssStatus ss_terrain_reserve(ssData *d, ssError *err)
@@ -751,7 +906,7 @@ update_points(const ssModel *m, ssData *d, int *loaded, int *run, const int coll
   for (int i = 0; i < ncontact; i++) {
     const ssContact *c = contact + i;
     if (c->type != SS_CONTACT_SOIL) {
-      if (c->type == SS_CONTACT_RIGID) nrigid++;
+      if (c->type == SS_CONTACT_RIGID || c->type == SS_CONTACT_PAIR) nrigid++;
       continue;
     }
     nsoil++;

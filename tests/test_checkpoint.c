@@ -683,6 +683,9 @@ static void test_damage(void)
 static void test_rigid_cache(void)
 {
   replay_straight("buggy_rigid.xml", 600, 450, 4);
+  /* bodies on bodies: the cache's entries of contacts between bodies
+   * (a static table's and pair contacts) restore with the rest */
+  replay_straight("stack.xml", 700, 450, 12);
 
   ssModel *m;
   ssError e;

@@ -1,0 +1,193 @@
+/* test_bodies.c -- contacts between bodies (DESIGN 3: rigid contacts
+ * between bodies, a Coulomb cone solved in the sweeps): a body on a static
+ * one, a stack, two balls meeting in free space, sliding on a static
+ * body, a link against a static body.  Numbers from closed forms: rest
+ * heights from the shapes' sizes, momentum and restitution for the balls,
+ * mu g for sliding.  Before these contacts existed every body passed
+ * through every other. */
+#include "soilsim.h"
+#include "tap.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+/* a world from a scene text (the rest of the scene's defaults) */
+static int load(const char *xml, ssModel **m, ssData **d)
+{
+  ssError e;
+  *m = NULL;
+  *d = NULL;
+  if (ss_scene_load_buffer(xml, strlen(xml), "bodies.xml", m, d, &e) != SS_OK) {
+    diag("load failed: %s", e.message);
+    return 0;
+  }
+  return 1;
+}
+
+static int steps(const ssModel *m, ssData *d, int n)
+{
+  ssError e;
+  for (int k = 0; k < n; k++)
+    if (ss_step(m, d, &e) != SS_OK) {
+      diag("step %ld failed: %s", d->step + 1, e.message);
+      return 0;
+    }
+  return 1;
+}
+
+static void drop(ssModel *m, ssData *d)
+{
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
+/* the largest speed of the free body whose velocities start at v */
+static double speed(const double *v)
+{
+  double s = 0;
+  for (int k = 0; k < 6; k++) s = fmax(s, fabs(v[k]));
+  return s;
+}
+
+/* A box dropped onto a static table rests on it: its centre half its
+ * height above the table's top (0.5 + 0.05 m).  It fell through the table
+ * onto the ground (z = 0.05).  Tolerance: the solve stops the contacts at
+ * its 1e-9 and the push leaves a penetration of 0.8^k of what the landing
+ * made; after 2 s both are far below 1e-6 m. */
+static void test_on_static(void)
+{
+  const char *xml =
+      "<raisim version=\"1.0\"><timeStep value=\"0.001\"/><objects>"
+      "<ground name=\"g\" height=\"0\"/>"
+      "<box name=\"table\" body_type=\"static\"><dim x=\"1\" y=\"1\" z=\"0.5\"/>"
+      "<state pos=\"0 0 0.25\"/></box>"
+      "<box name=\"b\" mass=\"2\"><dim x=\"0.2\" y=\"0.3\" z=\"0.1\"/>"
+      "<state pos=\"0.1 -0.2 0.8\"/></box></objects></raisim>";
+  ssModel *m;
+  ssData *d;
+  if (!load(xml, &m, &d)) {
+    ok(0, "box on a static table: loads");
+    return;
+  }
+  int sys = ss_model_find_sys(m, "b");
+  int good = sys >= 0 && steps(m, d, 2000);
+  const double *q = d->qpos + m->sys_qadr[sys], *v = d->qvel + m->sys_vadr[sys];
+  ok(good && fabs(q[2] - 0.55) <= 1e-6 && speed(v) <= 1e-6,
+     "a box dropped on a static table rests on it: z %.9f m (0.55), speed %.3g", q[2], speed(v));
+  drop(m, d);
+}
+
+/* Two boxes stacked on the ground: the lower one (5 kg, 0.2 m high)
+ * rests at z = 0.1, the upper one (1 kg, 0.1 m) dropped onto it at 0.25.
+ * The upper one fell through the lower one to the ground. */
+static void test_stack(void)
+{
+  const char *xml =
+      "<raisim version=\"1.0\"><timeStep value=\"0.001\"/><objects>"
+      "<ground name=\"g\" height=\"0\"/>"
+      "<box name=\"low\" mass=\"5\"><dim x=\"0.4\" y=\"0.4\" z=\"0.2\"/>"
+      "<state pos=\"0 0 0.1\"/></box>"
+      "<box name=\"up\" mass=\"1\"><dim x=\"0.2\" y=\"0.2\" z=\"0.1\"/>"
+      "<state pos=\"0.05 0.02 0.4\" quat=\"0.9961947 0 0 0.0871557\"/></box>"
+      "</objects></raisim>";
+  ssModel *m;
+  ssData *d;
+  if (!load(xml, &m, &d)) {
+    ok(0, "a stack of two boxes: loads");
+    return;
+  }
+  int lo = ss_model_find_sys(m, "low"), up = ss_model_find_sys(m, "up");
+  int good = lo >= 0 && up >= 0 && steps(m, d, 3000);
+  const double *ql = d->qpos + m->sys_qadr[lo], *qu = d->qpos + m->sys_qadr[up];
+  double sl = speed(d->qvel + m->sys_vadr[lo]), su = speed(d->qvel + m->sys_vadr[up]);
+  ok(good && fabs(ql[2] - 0.1) <= 1e-6 && fabs(qu[2] - 0.25) <= 1e-6 && sl <= 1e-6 &&
+         su <= 1e-6,
+     "a box dropped on a box on the ground: both rest, at z %.9f (0.1) and %.9f (0.25) m, "
+     "speeds %.3g and %.3g", ql[2], qu[2], sl, su);
+  drop(m, d);
+}
+
+/* Two equal balls in free space (no gravity, no ground), one at 1 m/s
+ * along the line of centres onto the other at rest.  Momentum is kept
+ * (the pair's impulses are equal and opposite) and the restitution e
+ * sets the parting speed: with e = 1 they exchange velocities, with e = 0
+ * they go on together at 0.5 m/s.  Tolerance: the sweeps' 1e-9 of the
+ * impulse (1 N s). */
+static void balls(double e, double want_a, double want_b)
+{
+  char xml[1024];
+  snprintf(xml, sizeof xml,
+           "<raisim version=\"1.0\"><timeStep value=\"0.001\"/>"
+           "<gravity value=\"0 0 0\"/><objects>"
+           "<sphere name=\"a\" mass=\"1\"><dim radius=\"0.1\"/>"
+           "<state pos=\"-0.5 0 1\" lin_vel=\"1 0 0\"/></sphere>"
+           "<sphere name=\"b\" mass=\"1\"><dim radius=\"0.1\"/>"
+           "<state pos=\"0 0 1\"/></sphere></objects>"
+           "<material><default friction=\"0.5\" restitution=\"%g\" "
+           "restitution_threshold=\"0\"/></material></raisim>",
+           e);
+  ssModel *m;
+  ssData *d;
+  if (!load(xml, &m, &d)) {
+    ok(0, "two balls, restitution %g: loads", e);
+    return;
+  }
+  int a = ss_model_find_sys(m, "a"), b = ss_model_find_sys(m, "b");
+  int good = a >= 0 && b >= 0 && steps(m, d, 1000);
+  const double *va = d->qvel + m->sys_vadr[a], *vb = d->qvel + m->sys_vadr[b];
+  double p = va[0] + vb[0], side = fabs(va[1]) + fabs(va[2]) + fabs(vb[1]) + fabs(vb[2]);
+  ok(good && fabs(p - 1) <= 1e-9 && fabs(va[0] - want_a) <= 1e-9 &&
+         fabs(vb[0] - want_b) <= 1e-9 && side <= 1e-12,
+     "two equal balls meeting at 1 m/s, restitution %g: %.12f and %.12f m/s after (%g and "
+     "%g), momentum %.12f (1)", e, va[0], vb[0], want_a, want_b, p);
+  /* they never pass through each other */
+  const double *xa = d->qpos + m->sys_qadr[a], *xb = d->qpos + m->sys_qadr[b];
+  ok(good && xb[0] - xa[0] >= 0.2 - 1e-6,
+     "  and stay apart: centres %.9f m apart (at least 0.2)", xb[0] - xa[0]);
+  drop(m, d);
+}
+
+static void test_balls(void)
+{
+  balls(1, 0, 1);
+  balls(0, 0.5, 0.5);
+}
+
+/* A box sliding at 1 m/s on a static table with friction 0.5 decelerates
+ * at mu g: its speed after 0.1 s is 1 - 0.5 g 0.1.  Tolerance: the
+ * sweeps' 1e-9 of the impulse over 100 steps. */
+static void test_slide(void)
+{
+  const char *xml =
+      "<raisim version=\"1.0\"><timeStep value=\"0.001\"/><gravity value=\"0 0 -9.81\"/>"
+      "<objects><box name=\"table\" body_type=\"static\"><dim x=\"4\" y=\"1\" z=\"0.5\"/>"
+      "<state pos=\"0 0 0.25\"/></box>"
+      "<box name=\"b\" mass=\"2\"><dim x=\"0.2\" y=\"0.2\" z=\"0.1\"/>"
+      "<state pos=\"-1 0 0.55\" lin_vel=\"1 0 0\"/></box></objects>"
+      "<material><default friction=\"0.5\" restitution=\"0\" restitution_threshold=\"0\"/>"
+      "</material></raisim>";
+  ssModel *m;
+  ssData *d;
+  if (!load(xml, &m, &d)) {
+    ok(0, "a box sliding on a static table: loads");
+    return;
+  }
+  int sys = ss_model_find_sys(m, "b");
+  int good = sys >= 0 && steps(m, d, 100);
+  const double *v = d->qvel + m->sys_vadr[sys], *q = d->qpos + m->sys_qadr[sys];
+  double want = 1 - 0.5 * 9.81 * 0.1;
+  ok(good && fabs(v[0] - want) <= 1e-7 && fabs(q[2] - 0.55) <= 1e-9,
+     "a box sliding on a static table at 1 m/s, friction 0.5: %.10f m/s after 0.1 s "
+     "(1 - mu g t = %.10f), height %.10f m (0.55)", v[0], want, q[2]);
+  drop(m, d);
+}
+
+int main(void)
+{
+  test_on_static();
+  test_stack();
+  test_balls();
+  test_slide();
+  return done_testing();
+}
