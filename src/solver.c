@@ -1181,24 +1181,25 @@ static void visit_span(const ssModel *m, ssData *d, int lo, int hi, int back, Gr
  * 60 KB at BLOCK_MAX. */
 enum { RIGID_PASSES = 64, BLOCK_MAX = 16, BLOCK_TRIES = 6 };
 
-/* G_ab, the response of contact a's velocity to contact b's impulse (3 x 3,
- * row-major), both on one link (X_a Lam X_b^T = X_a . LX_b) or one free
- * body (J_a W_b), from the rows the sweeps' set-up formed */
-/* One body's part of the response between two pair contacts of the same
- * two colliders: the same link's X_a LX_b (link >= 0), or the same free
- * body's J_a W_b, from the rows at ja and jb (pair_side_rows) */
-static void pair_side_response(const ssData *d, int link, int nv, long ja, long jb,
-                               double G[9])
+/* X_a LX_b^T, the 3 x 3 of two link contacts' rows (6 wide each) */
+static void rows_product(const double *Xa, const double *LXb, double G[9])
+{
+  for (int r = 0; r < 3; r++)
+    for (int k = 0; k < 3; k++) {
+      const double *x = Xa + 6 * r, *y = LXb + 6 * k;
+      G[3 * r + k] = x[0] * y[0] + x[1] * y[1] + x[2] * y[2] + x[3] * y[3] + x[4] * y[4] +
+                     x[5] * y[5];
+    }
+}
+
+/* The response of contact a's velocity to contact b's impulse through one
+ * body both act on, from their rows at ja and jb: the same link's X_a LX_b
+ * (link >= 0), or the same free body's J_a W_b (nv velocities) */
+static void side_response(const ssData *d, int link, int nv, long ja, long jb, double G[9])
 {
   const double *Xa = d->jac + ja;
   if (link >= 0) {
-    const double *LXb = d->jac + jb + 18;
-    for (int r = 0; r < 3; r++)
-      for (int k = 0; k < 3; k++) {
-        const double *x = Xa + 6 * r, *y = LXb + 6 * k;
-        G[3 * r + k] = x[0] * y[0] + x[1] * y[1] + x[2] * y[2] + x[3] * y[3] + x[4] * y[4] +
-                       x[5] * y[5];
-      }
+    rows_product(Xa, d->jac + jb + 18, G);
     return;
   }
   const double *Wb = d->jac + jb + 3 * nv;
@@ -1210,49 +1211,37 @@ static void pair_side_response(const ssData *d, int link, int nv, long ja, long 
     }
 }
 
+/* G_ab, the response of contact a's velocity to contact b's impulse (3 x 3,
+ * row-major), both on one link (X_a Lam X_b^T = X_a . LX_b), on two links
+ * of a system (through P, their pair block), on one free body (J_a W_b),
+ * or two pair contacts of the same colliders, from the rows the sweeps'
+ * set-up formed */
 static void block_response(const ssData *d, const ssContact *a, const ssContact *b,
                            const double *P, double G[9])
 {
   if (a->type == SS_CONTACT_PAIR) {
-    /* both bodies' parts (b's impulse moves each as a's does, the second
-     * with the sign that its velocity counts with) */
+    /* two pair contacts of the same two colliders: both bodies' parts
+     * (the second's with the sign its velocity counts with, twice) */
     double G2[9];
-    pair_side_response(d, a->link, a->nv, a->jadr, b->jadr, G);
-    pair_side_response(d, a->link2, a->nv2, a->jadr2, b->jadr2, G2);
+    side_response(d, a->link, a->nv, a->jadr, b->jadr, G);
+    side_response(d, a->link2, a->nv2, a->jadr2, b->jadr2, G2);
     for (int k = 0; k < 9; k++) G[k] += G2[k];
     return;
   }
-  const double *Xa = d->jac + a->jadr;
-  if (a->link >= 0) {
-    const double *LXb = d->jac + b->jadr + 18;
+  if (a->link >= 0 && a->link != b->link) {
+    /* X_a (J_a Y_b) X_b^T, P = J_a Y_b the links' pair block */
+    const double *Xb = d->jac + b->jadr;
     double LX[18];
-    if (a->link != b->link) {
-      /* X_a (J_a Y_b) X_b^T, P = J_a Y_b the links' pair block */
-      const double *Xb = d->jac + b->jadr;
-      for (int k = 0; k < 3; k++)
-        for (int r = 0; r < 6; r++) {
-          const double *p = P + 6 * r, *x = Xb + 6 * k;
-          LX[6 * k + r] = p[0] * x[0] + p[1] * x[1] + p[2] * x[2] + p[3] * x[3] + p[4] * x[4] +
-                          p[5] * x[5];
-        }
-      LXb = LX;
-    }
-    for (int r = 0; r < 3; r++)
-      for (int k = 0; k < 3; k++) {
-        const double *x = Xa + 6 * r, *y = LXb + 6 * k;
-        G[3 * r + k] = x[0] * y[0] + x[1] * y[1] + x[2] * y[2] + x[3] * y[3] + x[4] * y[4] +
-                       x[5] * y[5];
+    for (int k = 0; k < 3; k++)
+      for (int r = 0; r < 6; r++) {
+        const double *p = P + 6 * r, *x = Xb + 6 * k;
+        LX[6 * k + r] = p[0] * x[0] + p[1] * x[1] + p[2] * x[2] + p[3] * x[3] + p[4] * x[4] +
+                        p[5] * x[5];
       }
+    rows_product(d->jac + a->jadr, LX, G);
     return;
   }
-  const int nv = a->nv;
-  const double *Wb = d->jac + b->jadr + 3 * nv;
-  for (int r = 0; r < 3; r++)
-    for (int k = 0; k < 3; k++) {
-      double s = 0;
-      for (int i = 0; i < nv; i++) s += Xa[r * nv + i] * Wb[3 * i + k];
-      G[3 * r + k] = s;
-    }
+  side_response(d, a->link, a->nv, a->jadr, b->jadr, G);
 }
 
 /* Solves the n x n system A x = b in place (row-major, n <= 3 BLOCK_MAX),
