@@ -544,9 +544,130 @@ static void round_on_slope(const ssModel *m, int h, const ssShape *s,
     }
 }
 
+/* A rigid contact of geom g (attached as at, njac Jacobian values) on
+ * support h (-1: a plane) at point pl with the support's unit normal nl
+ * (both in the support's frame R, p), gap along it, cache key key; 0 out
+ * of memory. */
+static int rigid_add(const ssModel *m, ssData *d, int g, int h, int key, const double R[9],
+                     const double p[3], const double pl[3], const double nl[3], double gap,
+                     const ssMaterialPair *pair, long njac, const Attach *at)
+{
+  ssContact *c = ss_contact_new(d, njac);
+  if (!c) return 0;
+  c->type = SS_CONTACT_RIGID;
+  c->geom = g;
+  c->hfield = h;
+  c->vertex = key;
+  ss_m3_mulv(c->pos, R, pl);
+  ss_v3_add(c->pos, c->pos, p);
+  double nw[3];
+  ss_m3_mulv(nw, R, nl);
+  frame_from_normal(nw, c->frame);
+  c->g0 = gap;
+  d->contact_deep += gap < 0;
+  c->mu = pair->friction;
+  /* lowest allowed end-of-step normal velocity: close a gap, stop in a
+   * penetration (the push moves it out, ss_solver_push, and leaves the
+   * velocity alone), or bounce */
+  double dt = m->opt.timestep;
+  c->vn_target = gap >= 0 ? -gap / dt : 0;
+  if (njac > 0 && gap <= m->opt.contact_margin) {
+    /* the approach before this step's loads (qvel_start): with
+     * gravity's g dt in it, a body resting on the support met it at
+     * g dt every step and bounced by restitution times that, hopping
+     * for ever (a box with restitution 0.5 and threshold 0 between
+     * 51.99 and 52.00 mm instead of resting at 50) */
+    double v[3];
+    ss_dyn_point_velocity_of(m, d, d->qvel_start, m->geom_body[g], c->pos, v);
+    double vn = ss_v3_dot(v, nw);
+    if (pair->restitution > 0 && vn < -pair->restitution_threshold &&
+        -pair->restitution * vn > c->vn_target)
+      c->vn_target = -pair->restitution * vn;
+  }
+  attach_head(at, c);
+  attach_response(at, c);
+  return 1;
+}
+
+/* A rigid height map's vertex that reaches into a collider: a peak or a
+ * ridge the collider's own candidate points (its corners, rims) cannot
+ * see, such as a rock under a slab's middle.  The vertex p (map frame),
+ * the collider's outward normal n nearest it and its signed distance
+ * gap (ss_shape_sdf). */
+typedef struct MapPoint {
+  double p[3], n[3], gap;
+  long v;
+} MapPoint;
+/* Most such vertices a collider takes on one map (the deepest), and the
+ * first candidate number their cache keys take (ss_rigid_feature: the
+ * collider's own candidates take fewer than 16) */
+enum { MAP_POINTS = 8, MAP_POINT_KEY = 16 };
+_Static_assert(MAP_POINT_KEY + MAP_POINTS <= SS_RIGID_CANDIDATES,
+               "the map's points' keys fit beside the collider's candidates");
+
+/* The interior vertices of rigid map h inside the box [lo, hi] (map frame,
+ * widened by margin) that stand above the mean of their four neighbours
+ * (a peak or a ridge: on a flat or evenly sloped map none does, so a box
+ * resting on one gets no contact at every vertex under it), lie within
+ * margin of shape s (its signed distance) and farther than a grid spacing
+ * from each of the nmade points where the collider's own candidates made
+ * contacts (made: x, y), which hold it there already (a ball on a hilltop
+ * touches it at its tangent point, a box's corner beside a peak): the
+ * MAP_POINTS deepest, ties to the lower vertex index, in order of vertex
+ * index (their cache keys, MAP_POINT_KEY on).  Returns their count. */
+static int map_points(const ssModel *m, int h, const ssShape *s, const double lo[3],
+                      const double hi[3], double margin, const double (*made)[2],
+                      int nmade, MapPoint out[MAP_POINTS])
+{
+  int nx = m->hfield_nx[h], ny = m->hfield_ny[h];
+  double xs = m->hfield_size[2 * h], ys = m->hfield_size[2 * h + 1];
+  double dx = xs / (nx - 1), dy = ys / (ny - 1);
+  double x0 = m->hfield_center[2 * h] - 0.5 * xs, y0 = m->hfield_center[2 * h + 1] - 0.5 * ys;
+  /* (clamped in double before the conversion, as soil_contacts does) */
+  double fi0 = ceil((lo[0] - margin - x0) / dx), fi1 = floor((hi[0] + margin - x0) / dx);
+  double fj0 = ceil((lo[1] - margin - y0) / dy), fj1 = floor((hi[1] + margin - y0) / dy);
+  if (!(fi1 >= 1 && fj1 >= 1 && fi0 <= nx - 2 && fj0 <= ny - 2)) return 0;
+  int i0 = fi0 > 1 ? (int)fi0 : 1, i1 = fi1 < nx - 2 ? (int)fi1 : nx - 2;
+  int j0 = fj0 > 1 ? (int)fj0 : 1, j1 = fj1 < ny - 2 ? (int)fj1 : ny - 2;
+  const double *z = m->hfield_data + m->hfield_adr[h];
+  /* above the neighbours' mean by more than round-off on an even slope */
+  const double bump = 1e-9 * (dx < dy ? dx : dy);
+  int n = 0;
+  for (int j = j0; j <= j1; j++)
+    for (int i = i0; i <= i1; i++) {
+      long v = (long)j * nx + i;
+      double zv = z[v];
+      if (zv < lo[2] - margin) continue;
+      double mean = 0.25 * ((z[v - 1] + z[v + 1]) + (z[v - nx] + z[v + nx]));
+      if (!(zv - mean > bump)) continue;
+      MapPoint q = {{x0 + i * dx, y0 + j * dy, zv}, {0, 0, 0}, 0, v};
+      int near = 0;
+      for (int k = 0; k < nmade && !near; k++)
+        near = fabs(made[k][0] - q.p[0]) <= dx && fabs(made[k][1] - q.p[1]) <= dy;
+      if (near) continue;
+      q.gap = ss_shape_sdf(s, q.p, q.n);
+      if (!(q.gap <= margin)) continue;
+      /* into the deepest MAP_POINTS so far (ties: the earlier vertex) */
+      int k = n < MAP_POINTS ? n++ : MAP_POINTS;
+      if (k == MAP_POINTS && !(q.gap < out[MAP_POINTS - 1].gap)) continue;
+      if (k == MAP_POINTS) k = MAP_POINTS - 1;
+      for (; k > 0 && q.gap < out[k - 1].gap; k--) out[k] = out[k - 1];
+      out[k] = q;
+    }
+  /* the kept ones in vertex order */
+  for (int a = 1; a < n; a++) {
+    MapPoint q = out[a];
+    int k = a;
+    for (; k > 0 && out[k - 1].v > q.v; k--) out[k] = out[k - 1];
+    out[k] = q;
+  }
+  return n;
+}
+
 /* Coulomb contacts of geom g against a rigid surface: candidate points of
  * the collider (a mesh's: mesh_candidates) tested against the surface
- * (plane when h < 0). */
+ * (plane when h < 0), and on a rigid height map its peaks and ridges
+ * inside the collider (map_points). */
 static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
                                int g, int sys, ssError *err)
 {
@@ -576,45 +697,30 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
   const ssMaterialPair *pair = ss_model_pair(m, m->geom_material[g], mat);
   long njac = contact_jlen(m, sys);
   const Attach at = attach_of(m, g, sys);
+  int nmade = 0;
+  double made[SS_RIGID_CANDIDATES][2];
   for (int k = 0; k < npt; k++) {
     double zs = 0, nl[3] = {0, 0, 1};
     if (h >= 0 && !hfield_sample(m, h, pts[k][0], pts[k][1], &zs, nl)) continue;
     double gap = (pts[k][2] - zs) * nl[2];
     if (gap > margin) continue;
-    ssContact *c = ss_contact_new(d, njac);
-    if (!c) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
-    c->type = SS_CONTACT_RIGID;
-    c->geom = g;
-    c->hfield = h;
-    c->vertex = ss_rigid_feature(support, k);
-    ss_m3_mulv(c->pos, R, pts[k]);
-    ss_v3_add(c->pos, c->pos, p);
-    double nw[3];
-    ss_m3_mulv(nw, R, nl);
-    frame_from_normal(nw, c->frame);
-    c->g0 = gap;
-    d->contact_deep += gap < 0;
-    c->mu = pair->friction;
-    /* lowest allowed end-of-step normal velocity: close a gap, stop in a
-     * penetration (the push moves it out, ss_solver_push, and leaves the
-     * velocity alone), or bounce */
-    double dt = m->opt.timestep;
-    c->vn_target = gap >= 0 ? -gap / dt : 0;
-    if (njac > 0 && gap <= m->opt.contact_margin) {
-      /* the approach before this step's loads (qvel_start): with
-       * gravity's g dt in it, a body resting on the support met it at
-       * g dt every step and bounced by restitution times that, hopping
-       * for ever (a box with restitution 0.5 and threshold 0 between
-       * 51.99 and 52.00 mm instead of resting at 50) */
-      double v[3];
-      ss_dyn_point_velocity_of(m, d, d->qvel_start, m->geom_body[g], c->pos, v);
-      double vn = ss_v3_dot(v, nw);
-      if (pair->restitution > 0 && vn < -pair->restitution_threshold &&
-          -pair->restitution * vn > c->vn_target)
-        c->vn_target = -pair->restitution * vn;
+    made[nmade][0] = pts[k][0];
+    made[nmade++][1] = pts[k][1];
+    if (!rigid_add(m, d, g, h, ss_rigid_feature(support, k), R, p, pts[k], nl, gap, pair,
+                   njac, &at))
+      return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
+  }
+  /* the map's own peaks and ridges inside the collider (a rigid height
+   * map only; a mesh has no signed distance here) */
+  if (h >= 0 && m->geom_type[g] != SS_GEOM_MESH) {
+    MapPoint mp[MAP_POINTS];
+    int nmp = map_points(m, h, &s, lo, hi, margin, made, nmade, mp);
+    for (int k = 0; k < nmp; k++) {
+      const double nl[3] = {-mp[k].n[0], -mp[k].n[1], -mp[k].n[2]};
+      if (!rigid_add(m, d, g, h, ss_rigid_feature(support, MAP_POINT_KEY + k), R, p, mp[k].p,
+                     nl, mp[k].gap, pair, njac, &at))
+        return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
     }
-    attach_head(&at, c);
-    attach_response(&at, c);
   }
   return SS_OK;
 }

@@ -982,6 +982,39 @@ static void test_penetration_push(void)
   ss_model_free(m);
 }
 
+/* A 1 x 1 x 0.1 m slab dropped onto a rigid height map (2 x 2 m, 0.1 m
+ * spacing) that is flat but for a 0.2 m mesa in its middle (3 x 3
+ * vertices at 0.2, its sides sloping to 0 over one spacing) rests on the
+ * mesa, its bottom at 0.2 m (centre z = 0.25).  Only the slab's corners
+ * were tested against the map: they landed on the flat ground around the
+ * mesa, which passed through the slab (centre z = 0.05).  Tolerance: the
+ * solve stops the contacts to its 1e-9 and the push leaves what the
+ * landing made times 0.8^k, far below 1e-6 m after 2 s. */
+static void test_mesa_box(void)
+{
+  char xml[8192], *q = xml;
+  q += sprintf(q, "<raisim version=\"1.0\"><timeStep value=\"0.001\"/><objects>"
+                  "<heightmap name=\"h\" x_size=\"2\" y_size=\"2\" x_sample=\"21\" "
+                  "y_sample=\"21\" center_x=\"0\" center_y=\"0\" height=\"");
+  for (int j = 0; j < 21; j++)
+    for (int i = 0; i < 21; i++)
+      q += sprintf(q, "%s%s", i || j ? " " : "", abs(i - 10) <= 1 && abs(j - 10) <= 1 ? "0.2" : "0");
+  sprintf(q, "\"/><box name=\"slab\" mass=\"10\"><dim x=\"1\" y=\"1\" z=\"0.1\"/>"
+             "<state pos=\"0 0 0.5\"/></box></objects></raisim>");
+  ssModel *m = NULL;
+  ssData *d = NULL;
+  ssError e;
+  int good = ss_scene_load_buffer(xml, strlen(xml), "mesa.xml", &m, &d, &e) == SS_OK;
+  for (int t = 0; good && t < 2000; t++) good = ss_step(m, d, &e) == SS_OK;
+  double z = good ? d->qpos[2] : NAN, v = 0;
+  for (int k = 0; good && k < 6; k++) v = fmax(v, fabs(d->qvel[k]));
+  ok(good && fabs(z - 0.25) <= 1e-6 && v <= 1e-6,
+     "a slab dropped onto a rigid mesa rests on it: centre z %.9f m (0.25), speed %.3g%s%s", z,
+     v, good ? "" : ": ", good ? "" : e.message);
+  ss_data_free(d);
+  ss_model_free(m);
+}
+
 /* ss_quat_normalize keeps the direction of a quaternion whose squares
  * overflow or underflow: (1e300, 1e300, 0, 0) came out as zeros (its norm
  * inf) and (1e-200, 1e-200, 0, 0) as the identity (its squares 0); an
@@ -1724,6 +1757,7 @@ int main(void)
   test_ball_on_slope();
   test_restitution_rest();
   test_penetration_push();
+  test_mesa_box();
   test_quat_normalize();
   test_width();
   test_aabb();
