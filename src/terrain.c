@@ -545,16 +545,19 @@ static void round_on_slope(const ssModel *m, int h, const ssShape *s,
 }
 
 /* A rigid contact of geom g (attached as at, njac Jacobian values) on
- * support h (-1: a plane) at point pl with the support's unit normal nl
- * (both in the support's frame R, p), gap along it, cache key key; 0 out
+ * support h (-1: a plane or a collider) at point pl with the support's
+ * unit normal nl (both in the support's frame R, p), gap along it, cache
+ * key key; with gb >= 0 a pair contact whose second body is collider gb
+ * (attached as bt, jb Jacobian values after the first body's).  0 out
  * of memory. */
 static int rigid_add(const ssModel *m, ssData *d, int g, int h, int key, const double R[9],
                      const double p[3], const double pl[3], const double nl[3], double gap,
-                     const ssMaterialPair *pair, long njac, const Attach *at)
+                     const ssMaterialPair *pair, long njac, const Attach *at, int gb,
+                     const Attach *bt, long jb)
 {
-  ssContact *c = ss_contact_new(d, njac);
+  ssContact *c = ss_contact_new(d, njac + jb);
   if (!c) return 0;
-  c->type = SS_CONTACT_RIGID;
+  c->type = gb >= 0 ? SS_CONTACT_PAIR : SS_CONTACT_RIGID;
   c->geom = g;
   c->hfield = h;
   c->vertex = key;
@@ -579,6 +582,12 @@ static int rigid_add(const ssModel *m, ssData *d, int g, int h, int key, const d
      * 51.99 and 52.00 mm instead of resting at 50) */
     double v[3];
     ss_dyn_point_velocity_of(m, d, d->qvel_start, m->geom_body[g], c->pos, v);
+    if (gb >= 0) {
+      /* (a pair's approach: the first body's less the second's) */
+      double vb[3];
+      ss_dyn_point_velocity_of(m, d, d->qvel_start, m->geom_body[gb], c->pos, vb);
+      ss_v3_sub(v, v, vb);
+    }
     double vn = ss_v3_dot(v, nw);
     if (pair->restitution > 0 && vn < -pair->restitution_threshold &&
         -pair->restitution * vn > c->vn_target)
@@ -586,6 +595,14 @@ static int rigid_add(const ssModel *m, ssData *d, int g, int h, int key, const d
   }
   attach_head(at, c);
   attach_response(at, c);
+  if (gb >= 0) {
+    c->geom2 = gb;
+    c->sys2 = bt->sys;
+    c->vadr2 = bt->vadr;
+    c->nv2 = bt->nv;
+    c->link2 = bt->link;
+    c->jadr2 = c->jadr + njac;
+  }
   return 1;
 }
 
@@ -707,7 +724,7 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
     made[nmade][0] = pts[k][0];
     made[nmade++][1] = pts[k][1];
     if (!rigid_add(m, d, g, h, ss_rigid_feature(support, k), R, p, pts[k], nl, gap, pair,
-                   njac, &at))
+                   njac, &at, -1, NULL, 0))
       return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
   }
   /* the map's own peaks and ridges inside the collider (a rigid height
@@ -718,7 +735,7 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
     for (int k = 0; k < nmp; k++) {
       const double nl[3] = {-mp[k].n[0], -mp[k].n[1], -mp[k].n[2]};
       if (!rigid_add(m, d, g, h, ss_rigid_feature(support, MAP_POINT_KEY + k), R, p, mp[k].p,
-                     nl, mp[k].gap, pair, njac, &at))
+                     nl, mp[k].gap, pair, njac, &at, -1, NULL, 0))
         return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
     }
   }
@@ -768,44 +785,12 @@ static ssStatus pair_contacts(const ssModel *m, ssData *d, int ga, int gb, ssErr
       ss_model_pair(m, m->geom_material[ga], m->geom_material[gb]);
   long ja = contact_jlen(m, sa), jb = dynb ? contact_jlen(m, sb) : 0;
   const Attach at = attach_of(m, ga, sa), bt = attach_of(m, gb, dynb ? sb : -1);
-  const double dt = m->opt.timestep;
   for (int k = 0; k < npt; k++) {
     const ssPairPoint *q = pts + k;
     if (q->gap > margin) continue;
-    ssContact *c = ss_contact_new(d, ja + jb);
-    if (!c) return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
-    c->type = dynb ? SS_CONTACT_PAIR : SS_CONTACT_RIGID;
-    c->geom = ga;
-    c->hfield = -1;
-    c->vertex = ss_rigid_feature((int)support, q->id);
-    ss_v3_copy(c->pos, q->pos);
-    frame_from_normal(q->n, c->frame);
-    c->g0 = q->gap;
-    d->contact_deep += q->gap < 0;
-    c->mu = pair->friction;
-    /* as a rigid contact's (rigid_contacts): close a gap, stop in a
-     * penetration (the push moves it out), or bounce */
-    c->vn_target = q->gap >= 0 ? -q->gap / dt : 0;
-    attach_head(&at, c);
-    attach_response(&at, c);
-    if (dynb) {
-      c->geom2 = gb;
-      c->sys2 = bt.sys;
-      c->vadr2 = bt.vadr;
-      c->nv2 = bt.nv;
-      c->link2 = bt.link;
-      c->jadr2 = c->jadr + ja;
-    }
-    if (q->gap <= m->opt.contact_margin && pair->restitution > 0) {
-      /* the approach before this step's loads (qvel_start), as a rigid
-       * contact's */
-      double v[3], vb[3] = {0, 0, 0};
-      ss_dyn_point_velocity_of(m, d, d->qvel_start, m->geom_body[ga], c->pos, v);
-      if (dynb) ss_dyn_point_velocity_of(m, d, d->qvel_start, m->geom_body[gb], c->pos, vb);
-      double vn = (v[0] - vb[0]) * q->n[0] + (v[1] - vb[1]) * q->n[1] + (v[2] - vb[2]) * q->n[2];
-      if (vn < -pair->restitution_threshold && -pair->restitution * vn > c->vn_target)
-        c->vn_target = -pair->restitution * vn;
-    }
+    if (!rigid_add(m, d, ga, -1, ss_rigid_feature((int)support, q->id), I3, o, q->pos, q->n,
+                   q->gap, pair, ja, &at, dynb ? gb : -1, &bt, jb))
+      return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
   }
   return SS_OK;
 }
