@@ -187,10 +187,10 @@ static void pair_velocity(const ssModel *m, const ssData *d, const ssContact *c,
   ss_v3_sub(v, v, v2);
 }
 
-/* One body's rows and response of a pair contact, for the sweeps: a
- * link's X and LX (J, 36 values), or a free body's J and W (6 nv), and its
- * G (3 x 3) */
-static void pair_side_rows(const ssModel *m, ssData *d, const ssContact *c, int link, int sys,
+/* One body's rows and response of a contact (of a pair contact, either
+ * body), for the sweeps: a link's X and LX (J, 36 values), or a free
+ * body's J and W (6 nv), and its G (3 x 3) */
+static void side_rows(const ssModel *m, ssData *d, const ssContact *c, int link, int sys,
                            int geom, int nv, double *J, double G[9])
 {
   if (link >= 0) {
@@ -2009,18 +2009,12 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
       /* each body's rows and response; G their sum (the second body
        * takes -lambda and its velocity counts negative) */
       double G2[9];
-      pair_side_rows(m, d, c, c->link, c->sys, c->geom, c->nv, J, c->G);
-      pair_side_rows(m, d, c, c->link2, c->sys2, c->geom2, c->nv2, d->jac + c->jadr2, G2);
+      side_rows(m, d, c, c->link, c->sys, c->geom, c->nv, J, c->G);
+      side_rows(m, d, c, c->link2, c->sys2, c->geom2, c->nv2, d->jac + c->jadr2, G2);
       for (int k = 0; k < 9; k++) c->G[k] += G2[k];
-    } else if (c->link >= 0) {
-      double p[3];
-      ss_v3_sub(p, c->pos, ss_art_origin(d, c->sys));
-      ss_art_contact_rows(p, c->frame, J);
-      ss_art_contact_response(m, d, c->link, J, J + 18, c->G);
-    } else if (c->nv > 0 && (c->type == SS_CONTACT_SOIL || c->type == SS_CONTACT_RIGID)) {
-      int b = m->geom_body[c->geom];
-      ss_dyn_contact_jacobian(d, b, c->pos, c->frame, J);
-      ss_dyn_contact_response(m, d, b, J, J + 3 * c->nv, c->G);
+    } else if (c->link >= 0 ||
+               (c->nv > 0 && (c->type == SS_CONTACT_SOIL || c->type == SS_CONTACT_RIGID))) {
+      side_rows(m, d, c, c->link, c->sys, c->geom, c->nv, J, c->G);
     }
     if (c->type == SS_CONTACT_SOIL)
       ss_point_setup(&m->hfield_soilmat[c->hfield], ss_solver_pow_table(m, d, c->hfield), dt, c);
