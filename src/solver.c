@@ -2122,6 +2122,14 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
  * makes the rest. */
 enum { PUSH_SWEEPS = 50 };
 #define PUSH_TOL 1e-6
+/* The fastest a penetration is pushed out (m/s, or rad/s for a revolute
+ * joint past its limit), Box2D's default contactPushMaxVelocity: a deep
+ * one is moved out over many steps, never in one.  Unbounded, a buggy
+ * started 5 m under a ground plane took rigid_erp of it in one step
+ * (1000 m/s), which moved its wheels through their suspension's travel
+ * before any joint limit had a row to hold them, and its linkage threw
+ * it upwards at 2000 m/s^2. */
+#define PUSH_SPEED_MAX 3.0
 
 /* (solver.h) */
 int ss_solver_push(const ssModel *m, ssData *d)
@@ -2173,6 +2181,7 @@ int ss_solver_push(const ssModel *m, ssData *d)
       /* out by rigid_erp of the penetration; a contact not penetrating
        * is not pushed into its support */
       double target = c->g0 < 0 ? -erp_dt * c->g0 : 0;
+      if (target > PUSH_SPEED_MAX) target = PUSH_SPEED_MAX;
       double pn = p[k] + (target - v[0]) / c->G[0];
       if (!(pn > 0)) pn = 0;
       double dl[3] = {pn - p[k], 0, 0};

@@ -253,8 +253,9 @@ ssStatus ss_solver_store_warm(const ssModel *m, ssData *d, ssError *err);
  * other of them in), found by sweeps of normal impulses on a velocity of
  * its own, from rest, into d->qvel_push; d->qvel is left as the solve
  * left it.  The step moves the positions by d->qvel + d->qvel_push, and
- * the push leaves no velocity behind: a body started inside the ground
- * is moved out over a few steps instead of being thrown from it (the
+ * the push (at most 3 m/s at a contact) leaves no velocity behind: a body
+ * started inside the ground is moved out over a few steps instead of
+ * being thrown from it (the
  * solve itself only stops a penetrating contact, and bounces it by its
  * restitution).  Returns 1 with a push, 0 where nothing penetrates
  * (qvel_push untouched), -1 out of memory (d->qvel as it was). */

@@ -111,9 +111,8 @@ ssStatus ss_step(const ssModel *m, ssData *d, ssError *err)
     st = ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "out of memory");
     goto fail;
   }
-  /* a push is a velocity too, under the same limit (a body deep below a
-   * rigid support with rigid_erp = 1 would be moved by 1e12 m in a
-   * step) */
+  /* a push is a velocity too, under the same limit (its contacts' targets
+   * are bounded, ss_solver_push; a light body between them is not) */
   for (int s = 0; push && s < m->nsys; s++)
     if (d->sys_active[s] && !ss_all_within(d->qvel_push + m->sys_vadr[s], m->sys_nv[s], SS_SPEED_MAX)) {
       st = ss_error_set(err, SS_ERR_NUMERIC, NULL, 0,
