@@ -1529,12 +1529,147 @@ static int same_contact(const ssPairPoint *p, const ssPairPoint *q, double tol)
   return 1;
 }
 
+/* Box edges: e = 4 i + bits, i the local axis the edge runs along, bit 0
+ * the sign of its place on axis (i + 1) % 3, bit 1 on axis (i + 2) % 3
+ * (set: +).  Its start p0 (at -size[i]/2 along i) and its vector d (to
+ * its other end), in the frame. */
+static void box_edge(const ssShape *s, int e, double p0[3], double d[3])
+{
+  int i = e >> 2, j = (i + 1) % 3, k = (i + 2) % 3;
+  double l[3];
+  l[i] = -0.5 * s->size[i];
+  l[j] = (e & 1 ? 0.5 : -0.5) * s->size[j];
+  l[k] = (e & 2 ? 0.5 : -0.5) * s->size[k];
+  ss_m3_mulv(p0, s->R, l);
+  ss_v3_add(p0, p0, s->pos);
+  ss_v3_set(d, s->size[i] * s->R[i], s->size[i] * s->R[3 + i], s->size[i] * s->R[6 + i]);
+}
+
+/* a box's half extent along the unit u: sum of h_k |u . axis_k| */
+static double box_radius(const ssShape *s, const double u[3])
+{
+  const double *R = s->R;
+  double r = 0;
+  for (int k = 0; k < 3; k++)
+    r += 0.5 * s->size[k] * fabs(u[0] * R[k] + u[1] * R[3 + k] + u[2] * R[6 + k]);
+  return r;
+}
+
+/* A colour 0..3 of each box edge (box_edge's numbering) such that the 4
+ * edges of every face have 4 different colours: with the crossing's side
+ * (below) it tells apart the up to 8 edge crossings of two faces. */
+static const int edge_colour[12] = {0, 1, 2, 3, 2, 1, 3, 0, 3, 1, 0, 2};
+
+/* The edge-edge contacts of two boxes (ss_shape_pair_points' rule), into
+ * out (room for 8) in order of id (8..15).  Returns the count. */
+static int edge_contacts(const ssShape *a, const ssShape *b, double margin, double eps,
+                         ssPairPoint *out)
+{
+  const double tol = 1e-9; /* of an edge's length: its ends are corners' */
+  double dc[3];
+  ss_v3_sub(dc, a->pos, b->pos);
+  /* the best separation S of the two along the 15 axes of the separating
+   * axis test (the 6 face normals, the 9 cross products of an edge of
+   * each): an edge pair is a contact only where it separates them within
+   * eps as well as the best axis */
+  double S = -INFINITY;
+  for (int side = 0; side < 2; side++) {
+    const ssShape *s = side ? b : a;
+    for (int k = 0; k < 3; k++) {
+      double u[3] = {s->R[k], s->R[3 + k], s->R[6 + k]};
+      double sep = fabs(ss_v3_dot(dc, u)) - box_radius(a, u) - box_radius(b, u);
+      if (sep > S) S = sep;
+    }
+  }
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      double ua[3] = {a->R[i], a->R[3 + i], a->R[6 + i]};
+      double ub[3] = {b->R[j], b->R[3 + j], b->R[6 + j]}, u[3];
+      ss_v3_cross(u, ua, ub);
+      double len = ss_v3_norm(u);
+      if (!(len > 1e-6)) continue; /* parallel: the face axes cover it */
+      ss_v3_set(u, u[0] / len, u[1] / len, u[2] / len);
+      double sep = fabs(ss_v3_dot(dc, u)) - box_radius(a, u) - box_radius(b, u);
+      if (sep > S) S = sep;
+    }
+  ssPairPoint slot[8];
+  int used[8] = {0};
+  for (int ea = 0; ea < 12; ea++) {
+    double pa0[3], da[3];
+    box_edge(a, ea, pa0, da);
+    for (int eb = 0; eb < 12; eb++) {
+      double pb0[3], db[3], c[3], r[3];
+      box_edge(b, eb, pb0, db);
+      ss_v3_cross(c, da, db);
+      double A = ss_v3_dot(da, da), E = ss_v3_dot(db, db), cc = ss_v3_dot(c, c);
+      /* parallel (sine under 1e-6): no edge-edge normal; faces and
+       * corners meet there */
+      if (!(cc > 1e-12 * A * E)) continue;
+      /* the closest points of the two lines; a pair counts only where
+       * both lie strictly inside their edges, where the clamped
+       * segments' closest points are these same points */
+      ss_v3_sub(r, pa0, pb0);
+      double B = ss_v3_dot(da, db), C = ss_v3_dot(da, r), F = ss_v3_dot(db, r);
+      double den = A * E - B * B;
+      if (!(den > 0)) continue;
+      double s = (B * F - C * E) / den, t = (A * F - B * C) / den;
+      if (!(s > tol && s < 1 - tol && t > tol && t < 1 - tol)) continue;
+      double pa[3], pb[3], n[3];
+      ss_v3_copy(pa, pa0);
+      ss_v3_addscl(pa, da, s);
+      ss_v3_copy(pb, pb0);
+      ss_v3_addscl(pb, db, t);
+      double cn = sqrt(cc);
+      ss_v3_set(n, c[0] / cn, c[1] / cn, c[2] / cn);
+      if (ss_v3_dot(dc, n) < 0) ss_v3_scale(n, n, -1);
+      double w[3];
+      ss_v3_sub(w, pa, pb);
+      double gap = ss_v3_dot(w, n);
+      if (!(gap <= margin)) continue;
+      /* each edge within margin of its box's extreme along the normal:
+       * a's lowest along n, b's highest */
+      if (!(ss_v3_dot(pa, n) - (ss_v3_dot(a->pos, n) - box_radius(a, n)) <= margin + eps) ||
+          !(ss_v3_dot(b->pos, n) + box_radius(b, n) - ss_v3_dot(pb, n) <= margin + eps))
+        continue;
+      /* no axis separates them better */
+      if (!(gap >= S - eps)) continue;
+      /* the midpoint within margin of both boxes: the two points meet */
+      double mid[3], m[3];
+      ss_v3_add(mid, pa, pb);
+      ss_v3_scale(mid, mid, 0.5);
+      if (!(ss_shape_sdf(a, mid, m) <= margin + eps) || !(ss_shape_sdf(b, mid, m) <= margin + eps))
+        continue;
+      /* the side of b's edge a's edge crosses it from: b's outward
+       * direction at its edge across the normal, o = db x n turned away
+       * from b's centre, against a's edge direction */
+      double o[3], q[3];
+      ss_v3_cross(o, db, n);
+      ss_v3_sub(q, pb, b->pos);
+      if (ss_v3_dot(o, q) < 0) ss_v3_scale(o, o, -1);
+      int k = edge_colour[ea] + (ss_v3_dot(da, o) > 0 ? 4 : 0);
+      if (used[k] && !(gap < slot[k].gap)) continue;
+      used[k] = 1;
+      ss_v3_copy(slot[k].pos, mid);
+      ss_v3_copy(slot[k].n, n);
+      slot[k].gap = gap;
+      slot[k].id = 8 + k;
+    }
+  }
+  int cnt = 0;
+  for (int k = 0; k < 8; k++)
+    if (used[k]) out[cnt++] = slot[k];
+  return cnt;
+}
+
 int ss_shape_pair_points(const ssShape *a, const ssShape *b, double margin,
                          ssPairPoint *out, int max)
 {
   if (max <= 0 || !pair_type(a->type) || !pair_type(b->type)) return 0;
   ssPairPoint all[SS_PAIR_POINTS_MAX], bs[16];
   int k = side_contacts(a, b, 0, margin, all), ka = k;
+  /* two boxes: their edges' crossings (ids 8..15, after a's corners) */
+  if (a->type == SS_GEOM_BOX && b->type == SS_GEOM_BOX)
+    k += edge_contacts(a, b, margin, 1e-9 * (shape_extent(a) + shape_extent(b)), all + k);
   /* two spheres touch at one point, which a's candidate gives exactly */
   if (!(a->type == SS_GEOM_SPHERE && b->type == SS_GEOM_SPHERE)) {
     int nb = side_contacts(b, a, 16, margin, bs);

@@ -270,9 +270,10 @@ typedef struct ssPairPoint {
                      candidate it is */
   double n[3];    /* unit normal from b towards a (a separates along +n) */
   double gap;     /* signed separation along n, < 0 penetrating */
-  int id;         /* the feature: [0, 16) a's candidates, [16, 32) b's, the
-                     same number from step to step while the same feature
-                     touches */
+  int id;         /* the feature: [0, 16) a's candidates, [16, 32) b's
+                     (two boxes: 0..7 a's corners, 8..15 edge crossings,
+                     16..23 b's corners), the same number from step to
+                     step while the same feature touches */
 } ssPairPoint;
 #define SS_PAIR_POINTS_MAX 32
 /* Contacts of a with b (one frame): a's candidate points within margin of
@@ -308,10 +309,49 @@ typedef struct ssPairPoint {
  * corner's, with one normal and one gap).  Kept: gap <= margin.  The same
  * inputs give the same bits.
  *
- * Limits: only points (corners, rims, spheres) are tested, never edges
- * against edges or faces against edges -- two boxes crossed edge on edge,
- * or a box edge across a cylinder's side, find no contact until a corner
- * reaches the other; a cylinder's rim is sampled at 8 points a cap (its
+ * Two boxes: also their edges' crossings (ids 8..15, between a's corners
+ * and b's).  An edge ea of a and an edge eb of b (12 each) are a contact
+ * where all of these hold (eps = 1e-9 of the sum of the two boxes'
+ * half diagonals):
+ * - not parallel (the sine of their angle over 1e-6): the closest points
+ *   of their lines, pa on ea and pb on eb, both strictly inside their
+ *   edges (over 1e-9 of the edge's length from either end; at an end the
+ *   corner's own candidate holds it) -- there the clamped segments'
+ *   closest points are these;
+ * - n = the unit ea x eb, turned so that (a.pos - b.pos) . n >= 0; the
+ *   gap (pa - pb) . n <= margin;
+ * - each edge within margin + eps of its box's extreme along n (pa of a's
+ *   least points along n, pb of b's greatest): a contact along n is
+ *   between the two boxes' nearest parts along it;
+ * - gap >= S - eps, S the best separation of the boxes along the 15 axes
+ *   of the separating axis test (6 face normals, 9 edge cross products):
+ *   the edges meet along the axis the boxes meet along, not along one
+ *   they overlap deeper on (a bar 1 mm into another's top: its end's
+ *   vertical edges through the other's top edges overlap it sideways by
+ *   most of a width: no contact there, the deepest pair would be wrong);
+ * - the point midway, pos = (pa + pb) / 2, within margin + eps of both
+ *   boxes (ss_shape_sdf): the two points meet there, not merely in
+ *   projection.
+ * The contact: pos, n, gap as above.  Its id: 8 + c + 4 s, c a colour of
+ * a's edge (0..3, chosen so that the 4 edges of every face differ) and s
+ * the side of eb's box ea crosses eb from (1 where ea's direction leaves
+ * it, o = eb x n turned away from b's centre, ea . o > 0): fixed while
+ * the same pair touches.  Two faces flat on each other meet in a convex
+ * polygon whose vertices are corners and crossings, at most 8 of them:
+ * every such crossing passes (its gap is S along the common normal) and
+ * each has its own id (the crossings on one edge of a are one entering b's
+ * face and one leaving it), so a bar across a bar stands on the 4 corners
+ * of their overlap, a slab turned 45 degrees on a slab on the 8 of their
+ * octagon.  Edge pairs on the same id otherwise (deep overlaps): the
+ * deepest (least gap) kept, the first in order (ea, eb) on ties.
+ *
+ * Limits: boxes against anything but a box test only points (corners,
+ * rims, spheres), never edges -- a box edge across a cylinder's side
+ * finds no contact until a corner reaches the other; the crossings of two
+ * boxes go by the separating axis test's best axis, so where two boxes
+ * overlap deeply in every direction they are where the least overlap's
+ * axis says, not every place edges cross, and their ids may collide there
+ * (one kept); a cylinder's rim is sampled at 8 points a cap (its
  * side on a face it finds exactly, through the lowest rim points); a
  * capsule's middle point is taken towards o's centre, not o's nearest
  * point, exact on a large flat face under it but not across o's edge. */

@@ -1744,6 +1744,231 @@ static void test_pair_points(void)
      "pair: a mesh on either side: no contacts");
 }
 
+
+/* the edge contacts (ids 8..15) of out[0..n): their count; ids rising */
+static int edge_count(const ssPairPoint *out, int n)
+{
+  int c = 0, last = -1;
+  for (int i = 0; i < n; i++) {
+    if (out[i].id < last) return -1;
+    last = out[i].id;
+    c += out[i].id >= 8 && out[i].id < 16;
+  }
+  return c;
+}
+
+/* (a, b) and (b, a) give the same edge contacts: same count, each with the
+ * same point and gap (to tol) and the negated normal */
+static int edge_swaps(const ssShape *a, const ssShape *b, double margin, double tol)
+{
+  ssPairPoint p[SS_PAIR_POINTS_MAX], q[SS_PAIR_POINTS_MAX];
+  int np = ss_shape_pair_points(a, b, margin, p, SS_PAIR_POINTS_MAX);
+  int nq = ss_shape_pair_points(b, a, margin, q, SS_PAIR_POINTS_MAX);
+  if (edge_count(p, np) != edge_count(q, nq) || edge_count(p, np) <= 0) return 0;
+  for (int i = 0; i < np; i++) {
+    if (p[i].id < 8 || p[i].id >= 16) continue;
+    int found = 0;
+    for (int j = 0; j < nq && !found; j++) {
+      double mn[3];
+      ss_v3_scale(mn, q[j].n, -1);
+      found = q[j].id >= 8 && q[j].id < 16 && fabs(q[j].gap - p[i].gap) <= tol &&
+              near3(q[j].pos, p[i].pos, tol) && near3(mn, p[i].n, tol);
+    }
+    if (!found) return 0;
+  }
+  return 1;
+}
+
+static void test_pair_edges(void)
+{
+  const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, up[3] = {0, 0, 1}, tol = 1e-12;
+  ssPairPoint out[SS_PAIR_POINTS_MAX];
+  double R[9];
+
+  /* two 1 x 0.2 x 0.2 bars crossed at 90 degrees, the upper 1 mm into the
+   * lower's top (z = 0): no corner of either lies over the other (each
+   * 0.4 beyond it), so the corners alone gave nothing; now the square where
+   * the two faces overlap is held at its 4 corners, each a crossing of an
+   * edge of each bar: 4 edge contacts at (+-0.1, +-0.1, -0.0005), gap
+   * -0.001, n +z, ids 8 + (a's edge's colour 0, 1) + (4 by the side) */
+  ssShape lo = make_shape(SS_GEOM_BOX, 1, 0.2, 0.2, 0, 0, -0.1, I);
+  rot_z(R, 0.5 * PI);
+  ssShape hi = make_shape(SS_GEOM_BOX, 1, 0.2, 0.2, 0, 0, 0.099, R);
+  int n = ss_shape_pair_points(&hi, &lo, 0.01, out, SS_PAIR_POINTS_MAX);
+  int sq = n == 4 && edge_count(out, n) == 4 && all_up_at(out, n, -0.001, tol);
+  for (int i = 0; i < n && sq; i++)
+    sq = fabs(fabs(out[i].pos[0]) - 0.1) <= tol && fabs(fabs(out[i].pos[1]) - 0.1) <= tol &&
+         fabs(out[i].pos[2] + 0.0005) <= tol;
+  for (int i = 1; i < n && sq; i++)
+    sq = out[i].pos[0] != out[0].pos[0] || out[i].pos[1] != out[0].pos[1];
+  ok(sq && out[0].id == 8 && out[1].id == 9 && out[2].id == 12 && out[3].id == 13,
+     "pair edges: two bars crossed at 90 degrees, 1 mm in: the overlap square's 4 corners, edge crossings, gap -0.001, n +z (%d)",
+     n);
+  ok(edge_swaps(&hi, &lo, 0.01, tol), "pair edges: the crossed bars swapped: the same 4, n -z");
+  /* two 1 x 1 x 0.2 slabs, the upper turned 45 degrees: their faces
+   * overlap in an octagon, no corner over the other: its 8 vertices,
+   * ids 8..15 each once */
+  ssShape sl = make_shape(SS_GEOM_BOX, 1, 1, 0.2, 0, 0, -0.1, I);
+  rot_z(R, 0.25 * PI);
+  ssShape oc = make_shape(SS_GEOM_BOX, 1, 1, 0.2, 0, 0, 0.099, R);
+  n = ss_shape_pair_points(&oc, &sl, 0.01, out, SS_PAIR_POINTS_MAX);
+  int octo = n == 8 && edge_count(out, n) == 8 && all_up_at(out, n, -0.001, tol);
+  for (int i = 0; i < n && octo; i++)
+    octo = out[i].id == 8 + i &&
+           fabs(fmax(fabs(out[i].pos[0]), fabs(out[i].pos[1])) - 0.5) <= tol &&
+           fabs((fabs(out[i].pos[0]) + fabs(out[i].pos[1])) - 0.5 * sqrt(2.0)) <= tol;
+  ok(octo, "pair edges: two slabs turned 45 degrees: the overlap octagon's 8 vertices, ids 8-15 (%d)", n);
+
+  /* true edge on edge: a (1 x 0.2 x 0.2) turned 45 degrees about x, its
+   * lowest edge along x at z = za - 0.1 sqrt 2; b (0.2 x 1 x 0.2) turned 45
+   * degrees about y, its highest along y at z = 0.1 sqrt 2; 3 mm into each
+   * other: one contact at the crossing, gap -0.003, n +z, the point midway */
+  const double d = 0.003, h = 0.1 * sqrt(2.0);
+  rot_x(R, 0.25 * PI);
+  ssShape ea = make_shape(SS_GEOM_BOX, 1, 0.2, 0.2, 0, 0, 2 * h - d, R);
+  rot_y(R, 0.25 * PI);
+  ssShape eb = make_shape(SS_GEOM_BOX, 0.2, 1, 0.2, 0, 0, 0, R);
+  n = ss_shape_pair_points(&ea, &eb, 0.01, out, SS_PAIR_POINTS_MAX);
+  double wp[3] = {0, 0, h - 0.5 * d};
+  ok(n == 1 && out[0].id >= 8 && out[0].id < 16 && fabs(out[0].gap + d) <= tol &&
+         near3(out[0].n, up, tol) && near3(out[0].pos, wp, tol),
+     "pair edges: two edges crossed 3 mm into each other: one contact, gap %.12g, n +z, at the crossing",
+     n ? out[0].gap : NAN);
+  ok(edge_swaps(&ea, &eb, 0.01, 1e-15), "pair edges: the two swapped: the same contact, n -z, same gap");
+  /* moved along the edges (a by 0.2 along x, b by -0.3 along y): still
+   * one contact, now at (0, 0, ...) of the frame: the crossing moves
+   * with neither (both edges run through the origin's vertical) */
+  ea.pos[0] = 0.2;
+  eb.pos[1] = -0.3;
+  n = ss_shape_pair_points(&ea, &eb, 0.01, out, SS_PAIR_POINTS_MAX);
+  ok(n == 1 && out[0].id >= 8 && fabs(out[0].gap + d) <= tol && near3(out[0].pos, wp, tol),
+     "pair edges: slid along their edges: the same crossing (%d)", n);
+  /* separated by 0.02: none at margin 0.01; at margin 0.03 the one, gap 0.02 */
+  ea.pos[2] = 2 * h + 0.02;
+  n = ss_shape_pair_points(&ea, &eb, 0.01, out, SS_PAIR_POINTS_MAX);
+  ok(n == 0, "pair edges: 0.02 apart, margin 0.01: none (%d)", n);
+  n = ss_shape_pair_points(&ea, &eb, 0.03, out, SS_PAIR_POINTS_MAX);
+  ok(n == 1 && out[0].id >= 8 && fabs(out[0].gap - 0.02) <= tol && near3(out[0].n, up, tol),
+     "pair edges: 0.02 apart, margin 0.03: one at gap %.12g", n ? out[0].gap : NAN);
+  /* slid until a's edge ends where it crosses b's (the crossing at an end
+   * of a's edge: a corner's place, left to the corners), and a little
+   * further: no edge contact */
+  ea.pos[2] = 2 * h - d;
+  ea.pos[0] = 0.5;
+  n = ss_shape_pair_points(&ea, &eb, 0.01, out, SS_PAIR_POINTS_MAX);
+  int ne0 = edge_count(out, n);
+  ea.pos[0] = 0.5 + 1e-6;
+  n = ss_shape_pair_points(&ea, &eb, 0.01, out, SS_PAIR_POINTS_MAX);
+  ok(ne0 == 0 && edge_count(out, n) == 0,
+     "pair edges: the crossing at an edge's end, and past it: no edge contact (corners' place)");
+  /* the crossed bars with the upper's end face at the lower's side face
+   * (y = 0.1): its bottom edges meet the lower's top edges only at their
+   * ends (none of those); what touches is the end face's two vertical
+   * edges across the lower's top edge, at gap 0 along +y, the axis that
+   * separates the bars best (by 0 against 0.001 down): 2 edge contacts
+   * at (+-0.1, 0.1, 0), n +y, gap 0 */
+  hi.pos[1] = 0.6;
+  n = ss_shape_pair_points(&hi, &lo, 0.01, out, SS_PAIR_POINTS_MAX);
+  const double ey[3] = {0, 1, 0};
+  int ends = edge_count(out, n) == 2;
+  for (int i = 0; i < n && ends; i++)
+    if (out[i].id >= 8 && out[i].id < 16)
+      ends = near3(out[i].n, ey, tol) && fabs(out[i].gap) <= tol &&
+             fabs(fabs(out[i].pos[0]) - 0.1) <= tol && fabs(out[i].pos[1] - 0.1) <= tol &&
+             fabs(out[i].pos[2]) <= tol;
+  ok(ends, "pair edges: a bar's end at the other's side: not its bottom edges (ends); its end's vertical edges across the top edge, gap 0, n +y");
+
+  /* random poses: every edge contact's two points pos -+ gap n / 2 lie on
+   * the two boxes' edges (sdf 0 to 1e-12 of the size), its normal is unit
+   * and across both edges, gap <= margin, the point within margin of both */
+  const double margin = 0.01;
+  int pairs = 0, with = 0, total = 0, good = 1, sym = 1;
+  for (int it = 0; it < 2000; it++) {
+    double Ra[9], Rb[9];
+    rot_random(Ra);
+    rot_random(Rb);
+    ssShape a = make_shape(SS_GEOM_BOX, urand(0.1, 1), urand(0.1, 1), urand(0.1, 1), 0, 0, 0, Ra);
+    ssShape b = make_shape(SS_GEOM_BOX, urand(0.1, 1), urand(0.1, 1), urand(0.1, 1),
+                           urand(-0.4, 0.4), urand(-0.4, 0.4), urand(-0.4, 0.4), Rb);
+    double sz = ss_v3_norm(a.size) + ss_v3_norm(b.size);
+    /* overlapping: a's centre pushed out of b along a random direction to
+     * near the touching distance */
+    double u[3] = {urand(-1, 1), urand(-1, 1), urand(-1, 1)};
+    ss_v3_normalize(u);
+    double lo_t = 0, hi_t = 2 * sz, w[3], m[3];
+    for (int k = 0; k < 60; k++) {
+      /* bisect for the distance where a's nearest corner leaves b */
+      double t = 0.5 * (lo_t + hi_t);
+      ss_v3_copy(a.pos, b.pos);
+      ss_v3_addscl(a.pos, u, t);
+      double lo3[3], hi3[3];
+      ss_shape_aabb(&a, lo3, hi3);
+      ss_shape_aabb(&b, w, m);
+      int apart = lo3[0] > m[0] || hi3[0] < w[0] || lo3[1] > m[1] || hi3[1] < w[1] ||
+                  lo3[2] > m[2] || hi3[2] < w[2];
+      if (apart) hi_t = t;
+      else lo_t = t;
+    }
+    ss_v3_copy(a.pos, b.pos);
+    ss_v3_addscl(a.pos, u, lo_t * urand(0.5, 1));
+    n = ss_shape_pair_points(&a, &b, margin, out, SS_PAIR_POINTS_MAX);
+    int ne = edge_count(out, n);
+    pairs++;
+    if (ne < 0 || ne > 8) good = 0;
+    if (ne > 0) with++;
+    total += ne > 0 ? ne : 0;
+    for (int i = 0; i < n; i++) {
+      if (out[i].id < 8 || out[i].id >= 16) continue;
+      const ssPairPoint *c = &out[i];
+      double pa[3], pb[3];
+      ss_v3_copy(pa, c->pos);
+      ss_v3_addscl(pa, c->n, 0.5 * c->gap);
+      ss_v3_copy(pb, c->pos);
+      ss_v3_addscl(pb, c->n, -0.5 * c->gap);
+      /* on an edge: on the surface, and on 2 faces: the local point's
+       * two coordinates at their faces */
+      double la[3], lb[3];
+      ss_v3_sub(w, pa, a.pos);
+      ss_m3_mulvT(la, a.R, w);
+      ss_v3_sub(w, pb, b.pos);
+      ss_m3_mulvT(lb, b.R, w);
+      int fa = 0, fb = 0;
+      for (int k = 0; k < 3; k++) {
+        fa += fabs(fabs(la[k]) - 0.5 * a.size[k]) <= 1e-12 * sz;
+        fb += fabs(fabs(lb[k]) - 0.5 * b.size[k]) <= 1e-12 * sz;
+      }
+      if (!(fabs(ss_v3_norm(c->n) - 1) <= 1e-12) || !(c->gap <= margin) ||
+          !(fabs(ss_shape_sdf(&a, pa, m)) <= 1e-12 * sz) ||
+          !(fabs(ss_shape_sdf(&b, pb, m)) <= 1e-12 * sz) || fa != 2 || fb != 2 ||
+          !(ss_shape_sdf(&a, c->pos, m) <= margin + 1e-9 * sz) ||
+          !(ss_shape_sdf(&b, c->pos, m) <= margin + 1e-9 * sz)) {
+        if (good) diag("it %d id %d gap %g fa %d fb %d", it, c->id, c->gap, fa, fb);
+        good = 0;
+      }
+      /* the normal across both edges: the edge's axis is the local one
+       * not at a face */
+      for (int k = 0; k < 3; k++) {
+        if (!(fabs(fabs(la[k]) - 0.5 * a.size[k]) <= 1e-12 * sz)) {
+          double ax[3] = {a.R[k], a.R[3 + k], a.R[6 + k]};
+          if (!(fabs(ss_v3_dot(ax, c->n)) <= 1e-9)) good = 0;
+        }
+        if (!(fabs(fabs(lb[k]) - 0.5 * b.size[k]) <= 1e-12 * sz)) {
+          double ax[3] = {b.R[k], b.R[3 + k], b.R[6 + k]};
+          if (!(fabs(ss_v3_dot(ax, c->n)) <= 1e-9)) good = 0;
+        }
+      }
+    }
+    if (ne > 0 && !edge_swaps(&a, &b, margin, 1e-12 * sz)) {
+      if (sym) diag("swapped pair %d: not the same edge contacts", it);
+      sym = 0;
+    }
+  }
+  ok(good && with >= 100,
+     "pair edges: %d random overlapping box pairs, %d with edge contacts (%d): points on both edges, unit normals across both, gaps within margin",
+     pairs, with, total);
+  ok(sym, "pair edges: random pairs swapped: the same edge contacts, normals negated");
+}
+
 int main(void)
 {
   test_plate_quadrature();
@@ -1765,5 +1990,6 @@ int main(void)
   test_sort_runs();
   test_shape_sdf();
   test_pair_points();
+  test_pair_edges();
   return done_testing();
 }
