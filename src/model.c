@@ -59,10 +59,223 @@ ssHfieldDef ss_hfield_def_default(void)
   return d;
 }
 
+/* ---------------------------------------------------------------------- */
+/* the builder's look-up tables                                            */
+
+/* Open-addressing hash tables (linear probing, at most half full) of
+ * indices into the model's own arrays, so that building n objects is
+ * linear: the duplicate-name check, ss_model_material and the pair table
+ * scanned every earlier object, and 20 000 bodies or <pair_prop>s took
+ * seconds.  A slot holds 1 + an entry's code (0: empty); the keys stay in
+ * the model (names, pairs), so the tables hold no copies.
+ *
+ * The tables are a cache of the arrays.  Objects are only ever appended,
+ * so each table remembers the counts it has seen and enters the tail
+ * before it is used; a rollback (ss_model_rollback) or counts that went
+ * down behind the builder's back rebuild it from the arrays.  Look-ups on
+ * a const model (ss_model_find_sys, ss_model_pair) only read a table that
+ * is up to date, and otherwise scan as before: a model shared read-only
+ * between threads is never written. */
+typedef struct idxTab {
+  int *slot;
+  int cap;  /* a power of two, or 0 */
+  int n;
+} idxTab;
+
+typedef struct modelIndex {
+  /* names of systems, grounds and height maps (unique together): codes
+   * 3 i + kind, kind 0 system, 1 ground, 2 height map */
+  idxTab name;
+  int nsys, nplane, nhfield;  /* entered so far */
+  idxTab mat;                 /* material names: code = material index */
+  int nmat;
+  idxTab pair;                /* pairs by (mat1, mat2): code = pair index */
+  int npair;
+} modelIndex;
+
+/* The model and its tables in one allocation (ss_model_new is the only
+ * place a model is made), so that the public struct stays as it is. */
+typedef struct modelBox {
+  ssModel m;  /* first: a model's address is its box's */
+  modelIndex ix;
+} modelBox;
+
+static modelIndex *index_of(const ssModel *m)
+{
+  return &((modelBox *)(uintptr_t)m)->ix;
+}
+
+static uint64_t hash_str(const char *s)
+{
+  uint64_t h = 1469598103934665603ULL; /* FNV-1a */
+  for (; *s; s++) h = (h ^ (unsigned char)*s) * 1099511628211ULL;
+  return h;
+}
+
+static uint64_t hash_pair(int a, int b)
+{
+  uint64_t h = ((uint64_t)(unsigned)a << 32 | (unsigned)b) * 0x9E3779B97F4A7C15ULL;
+  return h ^ (h >> 29);
+}
+
+/* the key of an entry, for probing and for regrowing */
+static const char *name_of_code(const ssModel *m, int code)
+{
+  int i = code / 3;
+  switch (code % 3) {
+  case 0: return m->sys_name[i];
+  case 1: return m->plane_name[i];
+  default: return m->hfield_name[i];
+  }
+}
+
+static uint64_t code_hash(const ssModel *m, const idxTab *t, const modelIndex *ix,
+                          int code)
+{
+  if (t == &ix->name) return hash_str(name_of_code(m, code));
+  if (t == &ix->mat) return hash_str(m->material_name[code]);
+  return hash_pair(m->pair[code].mat1, m->pair[code].mat2);
+}
+
+/* The slot of the entry whose key is `name` (or the pair a, b when name
+ * is NULL) in t, or the empty slot it would take. */
+static int tab_slot(const ssModel *m, const idxTab *t, const modelIndex *ix,
+                    uint64_t h, const char *name, int a, int b)
+{
+  unsigned mask = (unsigned)t->cap - 1, k = (unsigned)h & mask;
+  for (; t->slot[k]; k = (k + 1) & mask) {
+    int code = t->slot[k] - 1;
+    if (t == &ix->pair) {
+      if (m->pair[code].mat1 == a && m->pair[code].mat2 == b) break;
+    } else if (!strcmp(t == &ix->name ? name_of_code(m, code)
+                                      : m->material_name[code], name)) {
+      break;
+    }
+  }
+  return (int)k;
+}
+
+/* The code of the entry with this key, or -1. */
+static int tab_find(const ssModel *m, const idxTab *t, const modelIndex *ix,
+                    uint64_t h, const char *name, int a, int b)
+{
+  return t->cap ? t->slot[tab_slot(m, t, ix, h, name, a, b)] - 1 : -1;
+}
+
+/* Enter an entry (its key already in the model) unless its key is there
+ * already: the first of equal keys is the one found, as a scan finds it.
+ * 0, or -1 out of memory. */
+static int tab_add(const ssModel *m, idxTab *t, const modelIndex *ix, int code,
+                   const char *name, int a, int b)
+{
+  if (2 * (t->n + 1) > t->cap) {
+    if (t->cap > INT_MAX / 4) return -1;
+    idxTab g = {NULL, t->cap ? 2 * t->cap : 64, 0};
+    g.slot = calloc((size_t)g.cap, sizeof *g.slot);
+    if (!g.slot) return -1;
+    for (int k = 0; k < t->cap; k++)
+      if (t->slot[k]) {
+        int c = t->slot[k] - 1;
+        unsigned mask = (unsigned)g.cap - 1;
+        unsigned s = (unsigned)code_hash(m, t, ix, c) & mask;
+        while (g.slot[s]) s = (s + 1) & mask;
+        g.slot[s] = t->slot[k];
+      }
+    g.n = t->n;
+    free(t->slot);
+    *t = g;
+  }
+  uint64_t h = name ? hash_str(name) : hash_pair(a, b);
+  int k = tab_slot(m, t, ix, h, name, a, b);
+  if (!t->slot[k]) {
+    t->slot[k] = code + 1;
+    t->n++;
+  }
+  return 0;
+}
+
+static void tab_clear(idxTab *t)
+{
+  if (t->slot) memset(t->slot, 0, (size_t)t->cap * sizeof *t->slot);
+  t->n = 0;
+}
+
+static void index_free(modelIndex *ix)
+{
+  free(ix->name.slot);
+  free(ix->mat.slot);
+  free(ix->pair.slot);
+}
+
+/* 1 if the name table holds exactly the model's names */
+static int names_current(const ssModel *m)
+{
+  const modelIndex *ix = index_of(m);
+  return ix->nsys == m->nsys && ix->nplane == m->nplane && ix->nhfield == m->nhfield;
+}
+
+/* Bring the name table up to the model's arrays; 0, or -1 out of memory
+ * (the table is then left for a rebuild, and callers scan). */
+static int names_sync(ssModel *m)
+{
+  modelIndex *ix = index_of(m);
+  if (ix->nsys > m->nsys || ix->nplane > m->nplane || ix->nhfield > m->nhfield) {
+    tab_clear(&ix->name);
+    ix->nsys = ix->nplane = ix->nhfield = 0;
+  }
+  int *have[3] = {&ix->nsys, &ix->nplane, &ix->nhfield};
+  const int want[3] = {m->nsys, m->nplane, m->nhfield};
+  for (int kind = 0; kind < 3; kind++)
+    for (; *have[kind] < want[kind]; ++*have[kind]) {
+      int code = 3 * *have[kind] + kind;
+      if (tab_add(m, &ix->name, ix, code, name_of_code(m, code), 0, 0)) {
+        tab_clear(&ix->name);
+        ix->nsys = ix->nplane = ix->nhfield = 0;
+        return -1;
+      }
+    }
+  return 0;
+}
+
+static int mats_sync(ssModel *m)
+{
+  modelIndex *ix = index_of(m);
+  if (ix->nmat > m->nmaterial) {
+    tab_clear(&ix->mat);
+    ix->nmat = 0;
+  }
+  for (; ix->nmat < m->nmaterial; ix->nmat++)
+    if (tab_add(m, &ix->mat, ix, ix->nmat, m->material_name[ix->nmat], 0, 0)) {
+      tab_clear(&ix->mat);
+      ix->nmat = 0;
+      return -1;
+    }
+  return 0;
+}
+
+static int pairs_sync(ssModel *m)
+{
+  modelIndex *ix = index_of(m);
+  if (ix->npair > m->npair) {
+    tab_clear(&ix->pair);
+    ix->npair = 0;
+  }
+  for (; ix->npair < m->npair; ix->npair++) {
+    const ssMaterialPair *p = &m->pair[ix->npair];
+    if (tab_add(m, &ix->pair, ix, ix->npair, NULL, p->mat1, p->mat2)) {
+      tab_clear(&ix->pair);
+      ix->npair = 0;
+      return -1;
+    }
+  }
+  return 0;
+}
+
 ssModel *ss_model_new(void)
 {
-  ssModel *m = calloc(1, sizeof *m);
-  if (!m) return NULL;
+  modelBox *box = calloc(1, sizeof *box);
+  if (!box) return NULL;
+  ssModel *m = &box->m;
   m->opt = ss_option_default();
   m->material_default.friction = 0.8;
   m->camera_fov_deg = 45;
@@ -120,7 +333,8 @@ void ss_model_free(ssModel *m)
   free(m->pair);
   free(m->xforce_body); free(m->xforce_force); free(m->xforce_torque);
   free(m->xforce_time);
-  free(m);
+  index_free(index_of(m));
+  free((modelBox *)m);
 }
 
 /* grow an array of n items of size sz to hold `need` items (doubling) */
@@ -161,8 +375,11 @@ static char *dupstr(const char *s)
   return r;
 }
 
-static int name_taken(const ssModel *m, const char *name)
+static int name_taken(ssModel *m, const char *name)
 {
+  if (names_sync(m) == 0)
+    return tab_find(m, &index_of(m)->name, index_of(m), hash_str(name), name, 0, 0) >= 0;
+  /* out of memory for the table: the scan still answers */
   for (int i = 0; i < m->nsys; i++)
     if (!strcmp(m->sys_name[i], name)) return 1;
   for (int i = 0; i < m->nplane; i++)
@@ -172,7 +389,7 @@ static int name_taken(const ssModel *m, const char *name)
   return 0;
 }
 
-static ssStatus check_name(const ssModel *m, const char *name, int line,
+static ssStatus check_name(ssModel *m, const char *name, int line,
                            ssError *err)
 {
   if (!name || !*name)
@@ -192,8 +409,13 @@ static ssStatus check_name(const ssModel *m, const char *name, int line,
 int ss_model_material(ssModel *m, const char *name)
 {
   if (!name || !*name) name = "default";
-  for (int i = 0; i < m->nmaterial; i++)
-    if (!strcmp(m->material_name[i], name)) return i;
+  if (mats_sync(m) == 0) {
+    int i = tab_find(m, &index_of(m)->mat, index_of(m), hash_str(name), name, 0, 0);
+    if (i >= 0) return i;
+  } else {
+    for (int i = 0; i < m->nmaterial; i++)
+      if (!strcmp(m->material_name[i], name)) return i;
+  }
   if (grow_field((void **)&m->material_name, m->cap_material,
                  m->nmaterial + 1, sizeof(char *)) != 0)
     return -1;
@@ -228,11 +450,18 @@ ssStatus ss_model_set_pair(ssModel *m, const char *name1, const char *name2,
     return ss_error_set(err, SS_ERR_NOMEM, m->source_path, 0, "out of memory");
   p.mat1 = a < b ? a : b;
   p.mat2 = a < b ? b : a;
-  for (int i = 0; i < m->npair; i++)
-    if (m->pair[i].mat1 == p.mat1 && m->pair[i].mat2 == p.mat2) {
-      m->pair[i] = p;
-      return SS_OK;
-    }
+  int i = -1;
+  if (pairs_sync(m) == 0) {
+    i = tab_find(m, &index_of(m)->pair, index_of(m), hash_pair(p.mat1, p.mat2),
+                 NULL, p.mat1, p.mat2);
+  } else {
+    for (int k = 0; k < m->npair && i < 0; k++)
+      if (m->pair[k].mat1 == p.mat1 && m->pair[k].mat2 == p.mat2) i = k;
+  }
+  if (i >= 0) {
+    m->pair[i] = p;
+    return SS_OK;
+  }
   if (grow((void **)&m->pair, &m->cap_pair, m->npair + 1, sizeof p) != 0)
     return ss_error_set(err, SS_ERR_NOMEM, m->source_path, 0, "out of memory");
   m->pair[m->npair++] = p;
@@ -242,6 +471,13 @@ ssStatus ss_model_set_pair(ssModel *m, const char *name1, const char *name2,
 const ssMaterialPair *ss_model_pair(const ssModel *m, int mat1, int mat2)
 {
   int a = mat1 < mat2 ? mat1 : mat2, b = mat1 < mat2 ? mat2 : mat1;
+  /* the table when it is current and worth a hash (a step asks this for
+   * every body contact); a few pairs are scanned */
+  const modelIndex *ix = index_of(m);
+  if (m->npair > 8 && ix->npair == m->npair) {
+    int i = tab_find(m, &ix->pair, ix, hash_pair(a, b), NULL, a, b);
+    return i >= 0 ? &m->pair[i] : &m->material_default;
+  }
   for (int i = 0; i < m->npair; i++)
     if (m->pair[i].mat1 == a && m->pair[i].mat2 == b) return &m->pair[i];
   return &m->material_default;
@@ -576,6 +812,12 @@ void ss_model_rollback(ssModel *m, const ssModelMark *k)
   for (int i = k->nmesh; i < m->nmesh; i++) {
     ss_mesh_free(m->mesh[i]);
     free(m->mesh_path[i]);
+  }
+  /* names may come back under other indices: the table is rebuilt */
+  if (m->nsys != k->nsys) {
+    modelIndex *ix = index_of(m);
+    tab_clear(&ix->name);
+    ix->nsys = ix->nplane = ix->nhfield = 0;
   }
   m->nsys = k->nsys;
   m->nbody = k->nbody;
@@ -953,6 +1195,13 @@ int ss_model_add_xforce(ssModel *m, int body, const double force[3],
 
 int ss_model_find_sys(const ssModel *m, const char *name)
 {
+  /* names are unique across systems, grounds and height maps: the one
+   * entry of this name is the system or none is */
+  if (names_current(m)) {
+    const modelIndex *ix = index_of(m);
+    int code = tab_find(m, &ix->name, ix, hash_str(name), name, 0, 0);
+    return code >= 0 && code % 3 == 0 ? code / 3 : -1;
+  }
   for (int i = 0; i < m->nsys; i++)
     if (!strcmp(m->sys_name[i], name)) return i;
   return -1;

@@ -1640,6 +1640,51 @@ static ssStatus read_objects(readCtx *c, xmlNodePtr n)
 /* ---------------------------------------------------------------------- */
 /* materials, options, camera, clock                                       */
 
+/* <pair_prop>s read so far, by their material indices a <= b: an
+ * open-addressing hash table, at most half full */
+typedef struct seenPair {
+  int a, b, line, used;
+} seenPair;
+
+typedef struct seenPairs {
+  seenPair *slot;
+  int cap;  /* a power of two, or 0 */
+  int n;
+} seenPairs;
+
+static unsigned seen_slot(const seenPairs *t, int a, int b)
+{
+  uint64_t h = ((uint64_t)(unsigned)a << 32 | (unsigned)b) * 0x9E3779B97F4A7C15ULL;
+  unsigned mask = (unsigned)t->cap - 1, k = (unsigned)(h ^ (h >> 29)) & mask;
+  while (t->slot[k].used && (t->slot[k].a != a || t->slot[k].b != b))
+    k = (k + 1) & mask;
+  return k;
+}
+
+/* Enter the pair a <= b read at `line`, or set *first to the line of the
+ * one entered before; 0, or -1 out of memory. */
+static int seen_enter(seenPairs *t, int a, int b, int line, int *first)
+{
+  if (2 * (t->n + 1) > t->cap) {
+    if (t->cap > INT_MAX / 4) return -1;
+    seenPairs g = {NULL, t->cap ? 2 * t->cap : 64, t->n};
+    if (!(g.slot = calloc((size_t)g.cap, sizeof *g.slot))) return -1;
+    for (int k = 0; k < t->cap; k++)
+      if (t->slot[k].used)
+        g.slot[seen_slot(&g, t->slot[k].a, t->slot[k].b)] = t->slot[k];
+    free(t->slot);
+    *t = g;
+  }
+  seenPair *p = &t->slot[seen_slot(t, a, b)];
+  if (p->used) {
+    *first = p->line;
+    return 0;
+  }
+  *p = (seenPair){a, b, line, 1};
+  t->n++;
+  return 0;
+}
+
 static ssStatus read_material(readCtx *c, xmlNodePtr n)
 {
   static const char *const kids[] = {"default", "pair_prop", NULL};
@@ -1651,9 +1696,12 @@ static ssStatus read_material(readCtx *c, xmlNodePtr n)
   static const char *const none[] = {NULL};
   xEl e;
   int seen_default = 0;
-  /* pairs already given (in either order), for the duplicate check */
-  struct { const char *n1, *n2; int line; } *seen = NULL;
-  int nseen = 0;
+  /* pairs already given (in either order), for the duplicate check: a
+   * hash table by the pair's material indices (names and indices are one
+   * to one, and the materials are the ones ss_model_set_pair makes below,
+   * in the same order), so that n pairs are checked in linear time, not
+   * each against every earlier one */
+  seenPairs seen = {NULL, 0, 0};
   ssStatus st = el_open(c, n, NULL, &e);
   if (!st) st = el_allow(c, &e, none);
   for (xmlNodePtr k = n->children; !st && k; k = k->next) {
@@ -1684,23 +1732,24 @@ static ssStatus read_material(readCtx *c, xmlNodePtr n)
         st = fail(c, SS_ERR_VALUE, x.line,
                   "%s: name1 and name2 must be non-empty material names",
                   x.label);
-      for (int i = 0; !st && i < nseen; i++)
-        if ((!strcmp(seen[i].n1, n1) && !strcmp(seen[i].n2, n2)) ||
-            (!strcmp(seen[i].n1, n2) && !strcmp(seen[i].n2, n1)))
-          st = fail(c, SS_ERR_PARSE, x.line,
-                    "%s: the pair '%.100s' / '%.100s' is given twice (first "
-                    "at line %d)", x.label, n1, n2, seen[i].line);
+      int ma = -1, mb = -1;
       if (!st) {
-        void *p = realloc(seen, (size_t)(nseen + 1) * sizeof *seen);
-        if (!p) {
-          st = fail(c, SS_ERR_NOMEM, x.line, "out of memory");
-        } else {
-          seen = p;
-          seen[nseen].n1 = n1;
-          seen[nseen].n2 = n2;
-          seen[nseen++].line = x.line;
+        ma = ss_model_material(c->m, n1);
+        mb = ss_model_material(c->m, n2);
+        if (ma < 0 || mb < 0) st = fail(c, SS_ERR_NOMEM, x.line, "out of memory");
+        if (ma > mb) {
+          int swap = ma;
+          ma = mb;
+          mb = swap;
         }
       }
+      int first = -1;
+      if (!st && seen_enter(&seen, ma, mb, x.line, &first) < 0)
+        st = fail(c, SS_ERR_NOMEM, x.line, "out of memory");
+      if (!st && first >= 0)
+        st = fail(c, SS_ERR_PARSE, x.line,
+                  "%s: the pair '%.100s' / '%.100s' is given twice (first "
+                  "at line %d)", x.label, n1, n2, first);
       if (!st) st = get_num(c, &x, "friction", 1, &f);
       if (!st) st = get_num(c, &x, "restitution", 0, &r);
       if (!st) st = get_num(c, &x, "restitution_threshold", 0, &t);
@@ -1713,7 +1762,7 @@ static ssStatus read_material(readCtx *c, xmlNodePtr n)
       st = unknown_child(c, k, &e, kids);
     }
   }
-  free(seen);
+  free(seen.slot);
   el_free(&e);
   return st;
 }

@@ -81,7 +81,8 @@ typedef struct uCtx {
   int *link_extra;       /* line of the first inertial/visual/collision */
   int njoint, capjoint;
   ssUrdfJoint *joint;
-  nameTab link_tab, joint_tab;
+  nameTab link_tab, joint_tab, mat_tab;
+  const ssUrdf *out;     /* the result, while build_tree fills it */
 
   int npend, cappend;
   uPending *pend;
@@ -439,11 +440,16 @@ static int is_pd(const double ev[3])
 /* ---------------------------------------------------------------------- */
 /* materials                                                               */
 
+/* name tables (below): kinds of entry */
+enum { TAB_LINK, TAB_JOINT, TAB_MAT, TAB_CLOSURE, TAB_SPRING };
+static int tab_find(const uCtx *c, const nameTab *t, int kind, const char *name);
+static int tab_add(const uCtx *c, nameTab *t, int kind, int i);
+
+/* hashed: a URDF may define a material per link, and every visual that
+ * names one looks it up */
 static int find_material(const uCtx *c, const char *name)
 {
-  for (int i = 0; i < c->nmat; i++)
-    if (!strcmp(c->mat[i].name, name)) return i;
-  return -1;
+  return tab_find(c, &c->mat_tab, TAB_MAT, name);
 }
 
 static ssStatus read_color(uCtx *c, xmlNodePtr n, const char *label,
@@ -507,6 +513,8 @@ static ssStatus add_material(uCtx *c, const uMaterial *m)
   if (grow((void **)&c->mat, &c->capmat, c->nmat, sizeof *c->mat))
     return nomem(c, m->line);
   c->mat[c->nmat++] = *m;
+  /* callers add only names not defined yet */
+  if (tab_add(c, &c->mat_tab, TAB_MAT, c->nmat - 1)) return nomem(c, m->line);
   return SS_OK;
 }
 
@@ -852,31 +860,37 @@ static uint64_t name_hash(const char *s)
   return h;
 }
 
-/* The name of entry i: a link's (joints == 0) or a joint's. */
-static const char *entry_name(const uCtx *c, int joints, int i)
+/* The name of entry i of a kind (TAB_*). */
+static const char *entry_name(const uCtx *c, int kind, int i)
 {
-  return joints ? c->joint[i].name : c->link[i].name;
+  switch (kind) {
+  case TAB_LINK: return c->link[i].name;
+  case TAB_JOINT: return c->joint[i].name;
+  case TAB_MAT: return c->mat[i].name;
+  case TAB_CLOSURE: return c->out->closure[i].name;
+  default: return c->out->spring[i].name;
+  }
 }
 
 /* The slot of `name` in t: its entry's, or the empty one it would take. */
-static int tab_slot(const uCtx *c, const nameTab *t, int joints,
+static int tab_slot(const uCtx *c, const nameTab *t, int kind,
                     const char *name)
 {
   unsigned mask = (unsigned)t->cap - 1;
   unsigned k = (unsigned)name_hash(name) & mask;
-  while (t->slot[k] && strcmp(entry_name(c, joints, t->slot[k] - 1), name))
+  while (t->slot[k] && strcmp(entry_name(c, kind, t->slot[k] - 1), name))
     k = (k + 1) & mask;
   return (int)k;
 }
 
-static int tab_find(const uCtx *c, const nameTab *t, int joints,
+static int tab_find(const uCtx *c, const nameTab *t, int kind,
                     const char *name)
 {
-  return t->cap ? t->slot[tab_slot(c, t, joints, name)] - 1 : -1;
+  return t->cap ? t->slot[tab_slot(c, t, kind, name)] - 1 : -1;
 }
 
 /* Enter entry i under its name (not yet entered); 0, or -1 out of memory. */
-static int tab_add(const uCtx *c, nameTab *t, int joints, int i)
+static int tab_add(const uCtx *c, nameTab *t, int kind, int i)
 {
   if (2 * (t->n + 1) > t->cap) {
     nameTab g = {NULL, t->cap ? 2 * t->cap : 64, 0};
@@ -884,25 +898,25 @@ static int tab_add(const uCtx *c, nameTab *t, int joints, int i)
     if (!g.slot) return -1;
     for (int k = 0; k < t->cap; k++)
       if (t->slot[k])
-        g.slot[tab_slot(c, &g, joints, entry_name(c, joints, t->slot[k] - 1))] =
+        g.slot[tab_slot(c, &g, kind, entry_name(c, kind, t->slot[k] - 1))] =
             t->slot[k];
     g.n = t->n;
     free(t->slot);
     *t = g;
   }
-  t->slot[tab_slot(c, t, joints, entry_name(c, joints, i))] = i + 1;
+  t->slot[tab_slot(c, t, kind, entry_name(c, kind, i))] = i + 1;
   t->n++;
   return 0;
 }
 
 static int find_link_doc(const uCtx *c, const char *name)
 {
-  return tab_find(c, &c->link_tab, 0, name);
+  return tab_find(c, &c->link_tab, TAB_LINK, name);
 }
 
 static int find_joint_doc(const uCtx *c, const char *name)
 {
-  return tab_find(c, &c->joint_tab, 1, name);
+  return tab_find(c, &c->joint_tab, TAB_JOINT, name);
 }
 
 static ssStatus add_geom(uCtx *c, ssUrdfLink *l, int *cap, const ssUrdfGeom *g)
@@ -937,7 +951,7 @@ static ssStatus read_link(uCtx *c, xmlNodePtr n)
       st = fail(c, SS_ERR_PARSE, e.line,
                 "duplicate link name '%s' (first at line %d)", l->name,
                 c->link[i].line);
-    else if (tab_add(c, &c->link_tab, 0, c->nlink - 1))
+    else if (tab_add(c, &c->link_tab, TAB_LINK, c->nlink - 1))
       st = nomem(c, e.line);
   }
   char label[NAME_LEN + 16];
@@ -1049,7 +1063,7 @@ static ssStatus read_joint(uCtx *c, xmlNodePtr n)
       st = fail(c, SS_ERR_PARSE, e.line,
                 "duplicate joint name '%s' (first at line %d)", j->name,
                 c->joint[i].line);
-    else if (tab_add(c, &c->joint_tab, 1, c->njoint - 1))
+    else if (tab_add(c, &c->joint_tab, TAB_JOINT, c->njoint - 1))
       st = nomem(c, e.line);
   }
   char label[NAME_LEN + 16];
@@ -1695,27 +1709,36 @@ static ssStatus build_tree(uCtx *c, ssUrdf *u)
         u->closure[kc++] = p->cl;
       }
     }
+  /* unique names, each against the earlier ones through a name table
+   * (the first of a name stays in it, so a duplicate names that one) */
+  nameTab names = {NULL, 0, 0};
+  c->out = u;
   for (int i = 0; i < u->nclosure && !st; i++) {
     const ssUrdfClosure *q = &u->closure[i];
-    for (int k = 0; k < i && q->name[0]; k++)
-      if (!strcmp(u->closure[k].name, q->name)) {
-        st = fail(c, SS_ERR_PARSE, q->line,
-                  "duplicate constraint name '%s' (first at line %d)", q->name,
-                  u->closure[k].line);
-        break;
-      }
+    if (!q->name[0]) continue;
+    int k = tab_find(c, &names, TAB_CLOSURE, q->name);
+    if (k >= 0)
+      st = fail(c, SS_ERR_PARSE, q->line,
+                "duplicate constraint name '%s' (first at line %d)", q->name,
+                u->closure[k].line);
+    else if (tab_add(c, &names, TAB_CLOSURE, i))
+      st = nomem(c, q->line);
   }
+  free(names.slot);
+  names = (nameTab){NULL, 0, 0};
   for (int i = 0; i < u->nspring && !st; i++) {
     ssUrdfSpring *s = &u->spring[i];
     if (!s->name[0]) snprintf(s->name, sizeof s->name, "spring%d", i);
-    for (int k = 0; k < i; k++)
-      if (!strcmp(u->spring[k].name, s->name)) {
-        st = fail(c, SS_ERR_PARSE, s->line,
-                  "duplicate spring name '%s' (first at line %d)", s->name,
-                  u->spring[k].line);
-        break;
-      }
+    int k = tab_find(c, &names, TAB_SPRING, s->name);
+    if (k >= 0)
+      st = fail(c, SS_ERR_PARSE, s->line,
+                "duplicate spring name '%s' (first at line %d)", s->name,
+                u->spring[k].line);
+    else if (tab_add(c, &names, TAB_SPRING, i))
+      st = nomem(c, s->line);
   }
+  free(names.slot);
+  c->out = NULL;
 
 done:
   free(pj);
@@ -1822,6 +1845,7 @@ static void ctx_free(uCtx *c)
   free(c->pend);
   free(c->link_tab.slot);
   free(c->joint_tab.slot);
+  free(c->mat_tab.slot);
   if (c->doc) xmlFreeDoc(c->doc);
   memset(c, 0, sizeof *c);
 }

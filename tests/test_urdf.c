@@ -9,6 +9,7 @@
  *   <!-- expect: LINE: SUBSTRING --> */
 #include "soilsim.h"
 #include "urdf.h"
+#include "articulated.h"
 #include "mesh.h"
 #include "ss_math.h"
 #include "tap.h"
@@ -1169,6 +1170,97 @@ static void test_many_links(void)
      "%.3f s)", t8, t1);
 }
 
+/* A URDF of many links, each with a material of its own that its visual
+ * names, on revolute joints, with springs: it loads and builds with the
+ * right counts; a material or spring name repeated at the end is refused
+ * naming the first, as when every earlier one was scanned (the look-ups
+ * are hashed).  Correctness only: the time is benchmarks --bench load's. */
+static char *many_urdf(int n, int dup_mat, int dup_spring, size_t *len)
+{
+  size_t cap = (size_t)n * 600 + 400, k = 0;
+  char *buf = malloc(cap);
+  if (!buf) return NULL;
+  /* line 1 <robot>, material i on line 2 + i, link i on 2 + n + i */
+  k += (size_t)snprintf(buf + k, cap - k, "<robot name=\"many\">\n");
+  for (int i = 0; i < n; i++)
+    k += (size_t)snprintf(buf + k, cap - k,
+                          "<material name=\"c%d\"><color rgba=\"0.%d 0 0 1\"/></material>\n",
+                          i == n - 1 && dup_mat >= 0 ? dup_mat : i, i % 10);
+  for (int i = 0; i < n; i++)
+    k += (size_t)snprintf(buf + k, cap - k,
+                          "<link name=\"l%d\"><inertial><mass value=\"1\"/><inertia "
+                          "ixx=\"0.01\" ixy=\"0\" ixz=\"0\" iyy=\"0.01\" iyz=\"0\" "
+                          "izz=\"0.01\"/></inertial><visual><geometry><sphere "
+                          "radius=\"0.05\"/></geometry><material name=\"c%d\"/></visual>"
+                          "</link>\n", i, n - 1 - i);
+  for (int i = 1; i < n; i++)
+    k += (size_t)snprintf(buf + k, cap - k,
+                          "<joint name=\"j%d\" type=\"revolute\"><parent link=\"l%d\"/>"
+                          "<child link=\"l%d\"/><origin xyz=\"0 0 0.1\"/></joint>\n",
+                          i, (i - 1) / 4, i);
+  /* springs on line 1 + 3 n + i */
+  for (int i = 0; i + 1 < n; i++)
+    k += (size_t)snprintf(buf + k, cap - k,
+                          "<spring name=\"s%d\" body1=\"l%d\" body2=\"l%d\" stiffness=\"1\"/>\n",
+                          i + 2 == n && dup_spring >= 0 ? dup_spring : i, i, i + 1);
+  k += (size_t)snprintf(buf + k, cap - k, "</robot>\n");
+  *len = k;
+  return buf;
+}
+
+static void test_many_names(void)
+{
+  enum { N = 5000 };
+  size_t len = 0;
+  ssUrdf *u = NULL;
+  ssError e;
+  char *buf = many_urdf(N, -1, -1, &len);
+  ssStatus st = buf ? ss_urdf_load_buffer(buf, len, "many.urdf", NULL, &u, &e) : SS_ERR_NOMEM;
+  int good = st == SS_OK && u->nlink == N && u->njoint == N - 1 && u->nspring == N - 1;
+  /* link 0 is l0; the material of l(i) is c(N - 1 - i), red 0.(that % 10) */
+  for (int i = 0; good && i < u->nlink; i++) {
+    int li = atoi(u->link[i].name + 1), c = N - 1 - li;
+    good = u->link[i].ngeom == 1 && u->link[i].geom[0].rgba[0] == (double)(c % 10) / 10;
+  }
+  ssModel *m = good ? ss_model_new() : NULL;
+  int s = -1;
+  if (m) {
+    ssArtDef d = ss_art_def_default();
+    d.name = "many";
+    d.fixed_base = 1;
+    s = ss_model_add_articulated(m, u, &d, &e);
+  }
+  ok(good && s == 0 && m->nbody == N && m->ngeom == N && m->nv == N - 1 &&
+         m->nspring == N - 1 && m->neq == 0 && ss_model_find_body(m, 0, "l4999") >= 0,
+     "%d links, materials and springs load and build (%s)", N,
+     st ? e.message : s < 0 && m ? e.message : "ok");
+  ss_model_free(m);
+  ss_urdf_free(u);
+  free(buf);
+  u = NULL;
+
+  buf = many_urdf(N, 2345, -1, &len);
+  st = buf ? ss_urdf_load_buffer(buf, len, "many.urdf", NULL, &u, &e) : SS_ERR_NOMEM;
+  char want[200];
+  snprintf(want, sizeof want, "duplicate material name 'c2345' (first at line %d)", 2 + 2345);
+  ok(st == SS_ERR_PARSE && e.line == 2 + N - 1 && !strcmp(e.message, want) && !u,
+     "the last of %d materials repeating an earlier name: refused at its line, naming "
+     "the first (%s:%d: %s)", N, e.file, e.line, e.message);
+  ss_urdf_free(u);
+  free(buf);
+  u = NULL;
+
+  buf = many_urdf(N, -1, 17, &len);
+  st = buf ? ss_urdf_load_buffer(buf, len, "many.urdf", NULL, &u, &e) : SS_ERR_NOMEM;
+  snprintf(want, sizeof want, "duplicate spring name 's17' (first at line %d)",
+           1 + 3 * N + 17);
+  ok(st == SS_ERR_PARSE && e.line == 1 + 3 * N + N - 2 && !strcmp(e.message, want) && !u,
+     "the last of %d springs repeating an earlier name: refused at its line, naming "
+     "the first (%s:%d: %s)", N - 1, e.file, e.line, e.message);
+  ss_urdf_free(u);
+  free(buf);
+}
+
 int main(void)
 {
   test_fourbar();
@@ -1176,6 +1268,7 @@ int main(void)
   test_world();
   test_floating_root();
   test_many_links();
+  test_many_names();
   test_paths();
   test_locale();
   test_size_cap();

@@ -1205,6 +1205,125 @@ static void test_count_before_alloc(void)
      "300 MB (its count is checked before 800 MB are allocated)");
 }
 
+/* Many objects: the builder's duplicate checks are hashed (names of
+ * bodies, grounds and systems; materials; <pair_prop> pairs), and must
+ * refuse and accept exactly what a scan of every earlier object did, at
+ * the same line with the same message.  Correctness only: the time is the
+ * benchmark's (benchmarks --bench load). */
+static char *many_scene(int n, int what, int dup)
+{
+  size_t cap = (size_t)n * 160 + 400, k = 0;
+  char *xml = malloc(cap);
+  if (!xml) return NULL;
+  /* line 1 <raisim>, line 2 <material> or <objects>, objects from line 3 */
+  k += (size_t)snprintf(xml + k, cap - k, "<raisim>\n%s\n", what ? "<material>" : "<objects>");
+  for (int i = 0; i < n; i++) {
+    int j = i == n - 1 && dup >= 0 ? dup : i;
+    if (what)  /* the duplicate written the other way round */
+      k += (size_t)snprintf(xml + k, cap - k,
+                            "<pair_prop name1=\"m%d\" name2=\"m%d\" friction=\"0.%d\"/>\n",
+                            j == i ? j : j + 1, j == i ? j + 1 : j, 1 + i % 9);
+    else
+      k += (size_t)snprintf(xml + k, cap - k,
+                            "<box name=\"b%d\" mass=\"1\"><dim x=\"1\" y=\"1\" z=\"1\"/>"
+                            "<state pos=\"%d 0 1\" quat=\"1 0 0 0\"/></box>\n", j, i);
+  }
+  k += (size_t)snprintf(xml + k, cap - k, "%s\n", what ? "</material>" : "</objects>");
+  if (what && dup == -2)  /* a ground named like no material, after them */
+    k += (size_t)snprintf(xml + k, cap - k, "<objects><ground name=\"g\"/></objects>\n");
+  snprintf(xml + k, cap - k, "</raisim>\n");
+  return xml;
+}
+
+static void test_many_objects(void)
+{
+  enum { N = 5000 };
+  ssModel *m = NULL;
+  ssData *d = NULL;
+  ssError e;
+  char want[200];
+
+  char *xml = many_scene(N, 0, -1);
+  ssStatus st = xml ? load_str(xml, &m, &d, &e) : SS_ERR_NOMEM;
+  int order = st == SS_OK && m->nsys == N && m->ngeom == N;
+  for (int i = 0; order && i < N; i++) {
+    char nm[32];
+    snprintf(nm, sizeof nm, "b%d", i);
+    order = !strcmp(m->sys_name[i], nm) && ss_model_find_sys(m, nm) == i &&
+            m->sys_line[i] == 3 + i && m->geom_body[i] == i;
+  }
+  ok(order && ss_model_find_sys(m, "b5000") < 0,
+     "%d boxes load in order, each found by name (%s)", N, st ? e.message : "ok");
+  if (st == SS_OK) {
+    /* names are unique across kinds: the model's builder still says so */
+    ssBodyDef bd = ss_body_def_default();
+    bd.name = "b4999";
+    bd.line = 77;
+    int r1 = ss_model_add_body(m, &bd, &e);
+    int dup1 = r1 < 0 && e.line == 77 && strstr(e.message, "duplicate name 'b4999'");
+    int r2 = ss_model_add_plane(m, "b17", 0, NULL, 78, &e);
+    int dup2 = r2 < 0 && e.line == 78 && strstr(e.message, "duplicate name 'b17'");
+    int r3 = ss_model_add_plane(m, "g", 0, NULL, 79, &e);
+    int r4 = ss_model_add_plane(m, "g", 0, NULL, 80, &e);
+    ok(dup1 && dup2 && r3 == 0 && r4 < 0 && e.line == 80 &&
+           ss_model_find_sys(m, "g") < 0 && m->nsys == N,
+       "and a body or ground of a name taken is refused after them");
+  }
+  ss_data_free(d);
+  ss_model_free(m);
+  free(xml);
+  m = NULL;
+  d = NULL;
+
+  /* the last box takes the name of box 1234 (line 3 + 1234) */
+  xml = many_scene(N, 0, 1234);
+  st = xml ? load_str(xml, &m, &d, &e) : SS_ERR_NOMEM;
+  snprintf(want, sizeof want, "duplicate name 'b1234': names of bodies, systems, "
+           "grounds and height maps must be unique");
+  ok(st == SS_ERR_VALUE && e.line == 3 + N - 1 && !strcmp(e.message, want) && !m,
+     "%d boxes, the last named as an earlier one: refused at its line (%s:%d: %s)", N,
+     e.file, e.line, e.message);
+  ss_data_free(d);
+  ss_model_free(m);
+  free(xml);
+  m = NULL;
+  d = NULL;
+
+  /* pairs: all distinct load, in order; the last repeating pair 321 the
+   * other way round is refused naming pair 321's line */
+  xml = many_scene(N, 1, -2);
+  st = xml ? load_str(xml, &m, &d, &e) : SS_ERR_NOMEM;
+  int pairs = st == SS_OK && m->npair == N && m->nmaterial == N + 2;
+  for (int i = 0; pairs && i < N; i++) {
+    char a[32], b[32];
+    snprintf(a, sizeof a, "m%d", i);
+    snprintf(b, sizeof b, "m%d", i + 1);
+    pairs = !strcmp(m->material_name[m->pair[i].mat1], a) &&
+            !strcmp(m->material_name[m->pair[i].mat2], b) &&
+            m->pair[i].friction == (double)(1 + i % 9) / 10 &&
+            ss_model_pair(m, m->pair[i].mat2, m->pair[i].mat1) == &m->pair[i];
+  }
+  ok(pairs && ss_model_pair(m, 1, 3) == &m->material_default,
+     "%d <pair_prop>s load in order, each found by its materials (%s)", N,
+     st ? e.message : "ok");
+  ss_data_free(d);
+  ss_model_free(m);
+  free(xml);
+  m = NULL;
+  d = NULL;
+
+  xml = many_scene(N, 1, 321);
+  st = xml ? load_str(xml, &m, &d, &e) : SS_ERR_NOMEM;
+  snprintf(want, sizeof want, "<material> <pair_prop>: the pair 'm322' / 'm321' is "
+           "given twice (first at line %d)", 3 + 321);
+  ok(st == SS_ERR_PARSE && e.line == 3 + N - 1 && !strcmp(e.message, want),
+     "%d <pair_prop>s, the last repeating an earlier pair: refused at its line, "
+     "naming the first (%s:%d: %s)", N, e.file, e.line, e.message);
+  ss_data_free(d);
+  ss_model_free(m);
+  free(xml);
+}
+
 int main(void)
 {
   snprintf(tmpdir, sizeof tmpdir, "/tmp/soilsim-xml-XXXXXX");
@@ -1222,6 +1341,7 @@ int main(void)
   test_mesh_bodies();
   test_many_systems();
   test_many_pd();
+  test_many_objects();
   test_massless_root();
   test_huge_quaternions();
   test_count_before_alloc();
