@@ -1714,6 +1714,38 @@ static double rigid_residual(const ssModel *m, ssData *d, ssContact *const *cs, 
   return lmax > 0 ? dmax / lmax : 0;
 }
 
+/* Block B solved (block_solve, no group open) and its answer kept only
+ * where it lowers B's measure (rigid_residual), its changes then into
+ * the sweep's measure; else B's impulses and the velocities of the nsys
+ * systems sys it moves put back.  (Systems of more than 256 velocities
+ * in all keep the sweeps alone.) */
+static void block_try(const ssModel *m, ssData *d, Block *B, const int *sys, int nsys,
+                      double *dmax, double *lmax)
+{
+  Group none = {NULL, NULL, NULL, {0}, {0}, {0}};
+  double keep[3 * BLOCK_MAX], u0[256];
+  int nu = 0;
+  for (int s = 0; s < nsys; s++) nu += m->sys_nv[sys[s]];
+  if (nu > 256) return;
+  for (int j = 0; j < B->n; j++) memcpy(keep + 3 * j, B->c[j]->lambda, sizeof B->c[j]->lambda);
+  for (int s = 0, k = 0; s < nsys; k += m->sys_nv[sys[s]], s++)
+    memcpy(u0 + k, d->qvel + m->sys_vadr[sys[s]], (size_t)m->sys_nv[sys[s]] * sizeof(double));
+  double before = rigid_residual(m, d, B->c, B->n);
+  if (!block_solve(m, d, B, &none)) return;
+  double after = rigid_residual(m, d, B->c, B->n);
+  if (!(after < before)) {
+    for (int j = 0; j < B->n; j++) memcpy(B->c[j]->lambda, keep + 3 * j, sizeof B->c[j]->lambda);
+    for (int s = 0, k = 0; s < nsys; k += m->sys_nv[sys[s]], s++)
+      memcpy(d->qvel + m->sys_vadr[sys[s]], u0 + k, (size_t)m->sys_nv[sys[s]] * sizeof(double));
+    return;
+  }
+  for (int j = 0; j < B->n; j++) {
+    double dl[3];
+    ss_v3_sub(dl, B->c[j]->lambda, keep + 3 * j);
+    measure_add(dl, B->c[j]->lambda, dmax, lmax);
+  }
+}
+
 /* Every SYSTEM_EVERY sweeps, after the sweep: each articulated system's
  * rigid contacts on more than one collider solved together (block_solve,
  * the links' responses to one another from the factors, ss_art_link_pair),
@@ -1753,7 +1785,6 @@ enum { SYSTEM_EVERY = 2 };
 static void system_blocks(const ssModel *m, ssData *d, int first_row, double *dmax,
                           double *lmax)
 {
-  Group none = {NULL, NULL, NULL, {0}, {0}, {0}};
   for (int i = 0; i < first_row;) {
     ssContact *c = d->contact + i;
     if (c->type != SS_CONTACT_RIGID || c->link < 0) {
@@ -1786,23 +1817,7 @@ static void system_blocks(const ssModel *m, ssData *d, int first_row, double *dm
         B.c[B.n++] = e;
     }
     /* (a system of more than 256 dofs keeps the collider blocks alone) */
-    double keep[3 * BLOCK_MAX], *u = d->qvel + c->vadr, u0[256];
-    if (c->nv > 256) continue;
-    for (int j = 0; j < B.n; j++) memcpy(keep + 3 * j, B.c[j]->lambda, sizeof B.c[j]->lambda);
-    memcpy(u0, u, (size_t)c->nv * sizeof(double));
-    double before = rigid_residual(m, d, B.c, B.n);
-    if (!block_solve(m, d, &B, &none)) continue;
-    double after = rigid_residual(m, d, B.c, B.n);
-    if (!(after < before)) {
-      for (int j = 0; j < B.n; j++) memcpy(B.c[j]->lambda, keep + 3 * j, sizeof B.c[j]->lambda);
-      memcpy(u, u0, (size_t)c->nv * sizeof(double));
-      continue;
-    }
-    for (int j = 0; j < B.n; j++) {
-      double dl[3];
-      ss_v3_sub(dl, B.c[j]->lambda, keep + 3 * j);
-      measure_add(dl, B.c[j]->lambda, dmax, lmax);
-    }
+    block_try(m, d, &B, &sys, 1, dmax, lmax);
   }
 }
 
@@ -1829,7 +1844,6 @@ static int in_list(const int *v, int n, int x)
 static void island_blocks(const ssModel *m, ssData *d, int first_row, double *dmax,
                           double *lmax)
 {
-  Group none = {NULL, NULL, NULL, {0}, {0}, {0}};
   int done[ISLAND_PAIRS], ndone = 0;
   for (int i = 0; i < first_row; i++) {
     ssContact *c = d->contact + i;
@@ -1868,24 +1882,7 @@ static void island_blocks(const ssModel *m, ssData *d, int first_row, double *dm
       else B.c[B.n++] = e;
     }
     if (!whole || B.n < 2) continue;
-    double keep[3 * BLOCK_MAX], u0[6 * ISLAND_BODIES];
-    for (int j = 0; j < B.n; j++) memcpy(keep + 3 * j, B.c[j]->lambda, sizeof B.c[j]->lambda);
-    for (int s = 0; s < nsys; s++)
-      memcpy(u0 + 6 * s, d->qvel + m->sys_vadr[sys[s]], 6 * sizeof(double));
-    double before = rigid_residual(m, d, B.c, B.n);
-    if (!block_solve(m, d, &B, &none)) continue;
-    double after = rigid_residual(m, d, B.c, B.n);
-    if (!(after < before)) {
-      for (int j = 0; j < B.n; j++) memcpy(B.c[j]->lambda, keep + 3 * j, sizeof B.c[j]->lambda);
-      for (int s = 0; s < nsys; s++)
-        memcpy(d->qvel + m->sys_vadr[sys[s]], u0 + 6 * s, 6 * sizeof(double));
-      continue;
-    }
-    for (int j = 0; j < B.n; j++) {
-      double dl[3];
-      ss_v3_sub(dl, B.c[j]->lambda, keep + 3 * j);
-      measure_add(dl, B.c[j]->lambda, dmax, lmax);
-    }
+    block_try(m, d, &B, sys, nsys, dmax, lmax);
   }
 }
 
