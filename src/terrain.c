@@ -750,6 +750,7 @@ static ssStatus rigid_contacts(const ssModel *m, ssData *d, int h, int plane,
 typedef struct PairBox {
   double lo[3], hi[3];
   int g;
+  ssShape s; /* the collider in the world (shape_in_frame) */
 } PairBox;
 
 static int pair_box_cmp(const void *pa, const void *pb)
@@ -760,12 +761,13 @@ static int pair_box_cmp(const void *pa, const void *pb)
 }
 
 /* The contacts of colliders ga (moving) and gb (another system's, static
- * or moving) from ss_shape_pair_points: against a static body a rigid
+ * or moving), A and B in the world, from ss_shape_pair_points: against a static body a rigid
  * contact of ga's with gb as its support, between two moving bodies a
  * pair contact (ga takes lambda, gb -lambda).  Keys as a rigid contact's
  * (ss_rigid_feature), with gb's support number nhfield + nplane + gb and
  * the point's feature. */
-static ssStatus pair_contacts(const ssModel *m, ssData *d, int ga, int gb, ssError *err)
+static ssStatus pair_contacts(const ssModel *m, ssData *d, int ga, int gb, const ssShape *A,
+                              const ssShape *B, ssError *err)
 {
   static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, o[3] = {0, 0, 0};
   int sa = m->body_sys[m->geom_body[ga]], sb = m->body_sys[m->geom_body[gb]];
@@ -773,13 +775,10 @@ static ssStatus pair_contacts(const ssModel *m, ssData *d, int ga, int gb, ssErr
   long support = (long)m->nhfield + m->nplane + gb;
   /* (the keys' room: ss_rigid_feature) */
   if (support >= (1L << 26) - 1) return SS_OK;
-  ssShape A, B;
-  shape_in_frame(m, d, ga, I3, o, &A);
-  shape_in_frame(m, d, gb, I3, o, &B);
   double margin = geom_margin(m, d, ga, sa, NULL);
   if (dynb) margin += geom_margin(m, d, gb, sb, NULL) - m->opt.contact_margin;
   ssPairPoint pts[SS_PAIR_POINTS_MAX];
-  int npt = ss_shape_pair_points(&A, &B, margin, pts, SS_PAIR_POINTS_MAX);
+  int npt = ss_shape_pair_points(A, B, margin, pts, SS_PAIR_POINTS_MAX);
   if (!npt) return SS_OK;
   const ssMaterialPair *pair =
       ss_model_pair(m, m->geom_material[ga], m->geom_material[gb]);
@@ -824,10 +823,9 @@ static ssStatus body_contacts(const ssModel *m, ssData *d, ssError *err)
     int s = m->body_sys[m->geom_body[g]];
     if (!(d->sys_active[s] && (m->geom_group[g] & 1) && m->geom_type[g] != SS_GEOM_MESH))
       continue;
-    ssShape sh;
-    shape_in_frame(m, d, g, I3, o, &sh);
     PairBox *b = box + n++;
-    ss_shape_aabb(&sh, b->lo, b->hi);
+    shape_in_frame(m, d, g, I3, o, &b->s);
+    ss_shape_aabb(&b->s, b->lo, b->hi);
     double reach = geom_margin(m, d, g, m->sys_nv[s] > 0 ? s : -1, NULL);
     for (int k = 0; k < 3; k++) {
       b->lo[k] -= reach;
@@ -852,11 +850,11 @@ static ssStatus body_contacts(const ssModel *m, ssData *d, ssError *err)
         if (!da && !db) continue;
         /* the moving one first; of two moving ones the lower index */
         if (!da || (db && gb < ga)) {
-          int t = ga;
-          ga = gb;
-          gb = t;
+          const PairBox *t = a;
+          a = b;
+          b = t;
         }
-        st = pair_contacts(m, d, ga, gb, err);
+        st = pair_contacts(m, d, a->g, b->g, &a->s, &b->s, err);
       }
   }
   free(box);
