@@ -1926,6 +1926,11 @@ static void visit_piece(const ssModel *m, ssData *d, int i, int end, int back, G
   }
 }
 
+/* The sweeps after which a step left unconverged goes to the creeping
+ * body solve, where it applies (ss_creep_solve): a step the Newton phase
+ * or its first sweeps settle never meets it */
+enum { CREEP_AFTER = 20 };
+
 ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
 {
   const double dt = m->opt.timestep, tol = m->opt.solver_tolerance;
@@ -2067,6 +2072,11 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
     st->sweeps = sweep + 1;
     st->residual = lmax > 0 ? dmax / lmax : 0;
     if (st->residual <= tol) break;
+    /* still unconverged after CREEP_AFTER sweeps, every contact a free
+     * body's soil point: the creeping body solve (creep.c) moves the
+     * sweeps on to its answer, which the next sweep checks */
+    if (sweep + 1 == CREEP_AFTER && !d->solver_gs_only && ss_creep_applies(m, d))
+      ss_creep_solve(m, d, tol, &st->newton);
   }
   st->converged = st->residual <= tol;
 

@@ -242,6 +242,15 @@ static void test_replay_buggy(void)
   replay_straight("buggy.xml", 100, 60, 0);
 }
 
+/* The creeping body solve (creep.c) in the replayed stretch: drag.xml's
+ * plate comes to rest rocking on its front edge at steps 1159-1164, which
+ * that solve takes; from a checkpoint of step 1150 the restored run goes
+ * through them bit for bit. */
+static void test_replay_creep(void)
+{
+  replay_straight("drag.xml", 1200, 1150, 0);
+}
+
 static void test_replay(void)
 {
   replay_scene("plate.xml", 200, 80);
@@ -1736,6 +1745,7 @@ int main(void)
   test_soil_api();
   test_replay();
   test_replay_buggy();
+  test_replay_creep();
   test_cache_matters();
   test_lazy_jacobian();
   test_state_changes();
