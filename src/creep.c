@@ -39,8 +39,9 @@
  *
  * It is an accelerator like the Newton phase: it only moves the sweeps'
  * start.  Its answer (impulses and the velocity they give) is applied only
- * when its last level met its own test; the sweeps that follow decide
- * convergence with the same measure and tolerance as always. */
+ * where its last level came within CREEP_LINEAR_TOL of balance before the
+ * linear step; the sweeps that follow decide convergence with the same
+ * measure and tolerance as always. */
 #include "solver.h"
 #include "point.h"
 #include "ss_math.h"
