@@ -878,6 +878,19 @@ static inline __attribute__((always_inline)) void h_sums(const NPoint *pt, const
   A->ww[8] += ww[8][0] + ww[8][1];
 }
 
+/* a group's H' (frame about o) from h_sums' sums */
+static inline __attribute__((always_inline)) void sums_H(const NSum *A, double Hg[36])
+{
+  double Kv[9] = {A->K[0], 0, 0, A->K[1], A->K[3], A->K[4], A->K[2], A->K[4], A->K[5]};
+  for (int a = 0; a < 3; a++)
+    for (int b = 0; b < 3; b++) {
+      Hg[6 * a + b] = A->ww[3 * a + b];
+      Hg[6 * a + 3 + b] = A->wv[3 * a + b];
+      Hg[6 * (a + 3) + b] = A->vw[3 * a + b];
+      Hg[6 * (a + 3) + 3 + b] = Kv[3 * a + b];
+    }
+}
+
 /* What a form of the laws' loops knows of its material (evaluate_at,
  * check_run): nothing, linear soil, or nonlinear soil with the power's
  * series and a shear modulus; mat_form sets what the form knows in M, so
@@ -987,14 +1000,7 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
       continue;
     }
     double Hg[36];
-    double Kv[9] = {A->K[0], 0, 0, A->K[1], A->K[3], A->K[4], A->K[2], A->K[4], A->K[5]};
-    for (int a = 0; a < 3; a++)
-      for (int b = 0; b < 3; b++) {
-        Hg[6 * a + b] = A->ww[3 * a + b];
-        Hg[6 * a + 3 + b] = A->wv[3 * a + b];
-        Hg[6 * (a + 3) + b] = A->vw[3 * a + b];
-        Hg[6 * (a + 3) + 3 + b] = Kv[3 * a + b];
-      }
+    sums_H(A, Hg);
     if (with_imp) {
       for (int k = 0; k < 36; k++) Hg[k] += A->Q[k];
       from_group(w->grp + g, A->q, NULL, q + 6 * g, NULL);
@@ -1681,9 +1687,10 @@ static void apply(const ssModel *m, ssData *d, const Setup *s, const ssNewtonWor
  * less of the impulses where the step is 1e-5 of the velocities), far
  * within the check, which decides as for any answer; only where it fails
  * are the laws evaluated at y + dy.  Impulse-form points are not
- * modelled: not with them.  Applies that answer (the trial buffers hold
- * it) and returns check's measure of it. */
-static double apply_linear(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork *w)
+ * modelled: not with them.  linear_end forms that answer into the trial
+ * buffers (0 where it declines); apply_linear applies it and returns
+ * check's measure of it (INFINITY where it declined). */
+static int linear_end(const Setup *s, ssNewtonWork *w)
 {
   /* (the scratch sums' V hold each group's dy, frame about o) */
   for (int g = 0; g < s->ngroup; g++) to_group(w->grp + g, w->dy + 6 * g, w->sum[g].V);
@@ -1708,7 +1715,7 @@ static double apply_linear(const ssModel *m, ssData *d, const Setup *s, ssNewton
       point_velocity(pt[i].r, V, dv);
       double ln = l[0] + K[0] * dv[0];
       /* (lamtry is left part written: declined, nothing applies it) */
-      if (!(ln > 0)) return INFINITY;
+      if (!(ln > 0)) return 0;
       lt[0] = ln;
       lt[1] = l[1] + K[1] * dv[0] + K[3] * dv[1] + K[4] * dv[2];
       lt[2] = l[2] + K[2] * dv[0] + K[4] * dv[1] + K[5] * dv[2];
@@ -1726,6 +1733,12 @@ static double apply_linear(const ssModel *m, ssData *d, const Setup *s, ssNewton
     int k = 6 * s->ngroup + r;
     w->Ftry[k] = w->F[k] + w->H[36 * s->ngroup + r] * w->dy[k];
   }
+  return 1;
+}
+
+static double apply_linear(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork *w)
+{
+  if (!linear_end(s, w)) return INFINITY;
   apply_at(m, d, s, w, w->lamtry, w->Ftry);
   return check(m, d, s, w);
 }
@@ -2408,22 +2421,21 @@ static int stick_solve(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork
   return 2;
 }
 
-static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
-                        int *sticking, double *residual_out, int may_predict,
-                        int *predicted)
+/* The Newton phase's set-up for contacts [0, first_row) (soil points on
+ * articulated links or free bodies) and [first_row, ncontact) (PD rows):
+ * the groups, their points' constants, Lam and the groups' frames and
+ * laws.  NULL where the contacts do not suit it (or out of memory). */
+static ssNewtonWork *setup(const ssModel *m, ssData *d, int first_row, Setup *sp)
 {
-  *iterations = 0;
-  *sticking = 0;
-  *residual_out = INFINITY;
-  if (first_row == 0) return 0;
+  if (first_row == 0) return NULL;
   /* suited: soil points on articulated links or free bodies (checked
    * where each run of one link or body on one bed starts, below), PD
    * rows */
   int ngroup = 0, nrow = d->ncontact - first_row;
   for (int i = first_row; i < d->ncontact; i++)
-    if (!(d->contact[i].type == SS_CONTACT_PD && d->contact[i].nv > 0)) return 0;
+    if (!(d->contact[i].type == SS_CONTACT_PD && d->contact[i].nv > 0)) return NULL;
   ssNewtonWork *w = work(d, 0, d->ncontact, m->nv, 0);
-  if (!w) return 0;
+  if (!w) return NULL;
   /* groups: one per link (or body) and bed (a link's contacts may come in
    * several runs); every point of a bed shares the bed's frame (the
    * bed's axes, terrain.c's frame_from_bed: the same bits for all its
@@ -2437,15 +2449,15 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
   int nrun = 0;
   for (int i = 0; i < first_row;) {
     const ssContact *c = contact + i;
-    if (c->type != SS_CONTACT_SOIL) return 0;
+    if (c->type != SS_CONTACT_SOIL) return NULL;
     w->run[nrun++] = i;
     if (!(c->nv > 0 && (c->link >= 0 || (c->nv == 6 && m->sys_type[c->sys] == SS_SYS_FREE))))
-      return 0;
+      return NULL;
     int gr = 0;
     while (gr < ngroup && !(w->grp[gr].link == c->link && w->grp[gr].sys == c->sys &&
                            w->grp[gr].mat == &m->hfield_soilmat[c->hfield]))
       gr++;
-    if (gr == w->cap_g && !work(d, 0, 0, 0, 2 * gr + 4)) return 0;
+    if (gr == w->cap_g && !work(d, 0, 0, 0, 2 * gr + 4)) return NULL;
     NGroup *G = w->grp + gr;
     if (gr == ngroup) {
       ngroup++;
@@ -2465,7 +2477,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
       G->rmax[0] = G->rmax[1] = G->rmax[2] = 0;
       if (c->link < 0) body_block(m, d, G->body, G->Yb);
     } else if (memcmp(G->R, c->frame, sizeof G->R)) {
-      return 0;
+      return NULL;
     }
     i = G->axes ? setup_run(m, contact, pts, group_of, i, first_row, gr, G, 1)
                 : setup_run(m, contact, pts, group_of, i, first_row, gr, G, 0);
@@ -2473,7 +2485,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
   w->run[nrun] = first_row;
   w->nrun = nrun;
   int n = 6 * ngroup + nrow;
-  if (!work(d, n, 0, 0, ngroup)) return 0;
+  if (!work(d, n, 0, 0, ngroup)) return NULL;
   Setup s = {ngroup, nrow, n, first_row, 1, 1};
   for (int g = 0; g < ngroup; g++) s.linear &= w->grp[g].mat->sinkage_exponent == 1.0;
 
@@ -2492,6 +2504,21 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
     const Mat *M = &w->grp[g].M;
     s.pow_shear &= form_of(M) == FORM_POW_SHEAR;
   }
+  *sp = s;
+  return w;
+}
+
+static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterations,
+                        int *sticking, double *residual_out, int may_predict,
+                        int *predicted)
+{
+  *iterations = 0;
+  *sticking = 0;
+  *residual_out = INFINITY;
+  Setup s;
+  ssNewtonWork *w = setup(m, d, first_row, &s);
+  if (!w) return 0;
+  const int ngroup = s.ngroup, n = s.n;
   unknowns_of(m, d, &s, w, d->qvel_free, w->yfree);
   uint64_t key = unknowns_key(d, &s, w);
   int from_last = *predicted = may_predict && predict(m, d, &s, w, key);
@@ -2715,4 +2742,378 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
   *iterations = it;
   *sticking = w->ns;
   return 0;
+}
+
+/* ---------------------------------------------------------------------- */
+/* the creeping solve                                                      */
+
+/* A patch that creeps (its points slip at 1e-6 m/s and less, most at
+ * their full Janosi bound, and where its body rocks or turns some slip
+ * one way and some the other about a row of stuck points) is neither
+ * stuck whole (stick_solve: no sharing of its wrench stays within the
+ * points' bounds) nor slipping everywhere, and the impulse form stalls
+ * on it; the sweeps contract by about 0.998 a sweep there (drag.xml's
+ * step 1159: 11 338 sweeps to the tolerance).
+ *
+ * Yet with each point's shear bound held at its normal impulse the step
+ * is the minimum of a convex function.  Let f be the impulses in the
+ * unknowns' space (F's: 6 a group, one a row) and y = y_free + Lam f.
+ * The laws are gradients, F(y) = -grad Psi(y) with Psi convex (the
+ * normal law non-increasing in v_n, the shear law -T(|v_t|) v_t/|v_t| the
+ * gradient of the integral of T, T non-decreasing, with a kink at zero
+ * slip; a PD row's impulse non-increasing in its velocity), so
+ *
+ *   E(f) = 1/2 f^T Lam f + Psi(y_free + Lam f)
+ *
+ * is convex (Lam = J Y J^T is positive semidefinite), with grad E =
+ * Lam (f - F(y)) = -phi: its minima are the step's answers, and no
+ * inverse of Lam is needed (it is singular where links outnumber the
+ * dofs, the buggy's).  Newton's step dy of the phase, (I - Lam H) dy =
+ * -phi, is E's Newton step df = F - f + H dy (Lam df = dy), and E's slope
+ * along it is (f - F(y))^T dy < 0.
+ *
+ * The kink is smoothed, |v_t| -> (|v_t|^2 + eps^2)^(1/2), and Newton with
+ * a line search on that slope (monotone along the line) runs at eps
+ * falling by CREEP_EPS_STEP a level, each from the last one's answer
+ * (continuation), down to an eps below which a point's sweep visit sticks
+ * it and moves its impulse by less than CREEP_FINAL times the tolerance
+ * (eps / G_tt's least eigenvalue, its own response).  The shear bound's
+ * dependence on lambda_n (tf = A dt c + mu lambda_n: there the law is not
+ * a gradient) is kept in H and seen by the line search.  At the last eps
+ * the stuck points' stiffness T/eps turns the last bits of y into noise
+ * in phi that no y removes; the last step is applied by the laws' linear
+ * model (linear_end), whose impulses hold what y cannot, and the sweeps
+ * that follow check that answer with their own measure and tolerance. */
+
+/* eps starts at this fraction of the largest slip and falls by
+ * CREEP_EPS_STEP a level */
+#define CREEP_EPS_START 0.1
+#define CREEP_EPS_STEP 1e-2
+/* Newton steps of one level at most (the last level: twice that) */
+#define CREEP_ITER 16
+/* an intermediate level is done when |phi| is within this fraction of
+ * |Lam F| (residual's weights) */
+#define CREEP_LEVEL_TOL 1e-6
+/* the last eps: this fraction of the tolerance times the largest impulse
+ * times the least of the points' tangential responses; and the last
+ * level's |phi|: this fraction of the tolerance of |Lam F| */
+#define CREEP_FINAL 1e-2
+/* the last level's answer goes to the linear end only when |phi| is
+ * within this fraction of |Lam F| there */
+#define CREEP_LINEAR_TOL 1e-4
+/* line search: a step is taken where the slope is at most this fraction
+ * of its first value's size (a Wolfe curvature test: convex along the
+ * line, E fell) */
+#define CREEP_WOLFE 0.5
+#define CREEP_SEARCH 30
+/* a level whose |phi| has not halved in this many full Newton steps is
+ * done: as close as y holds it (its best iterate kept) */
+#define CREEP_STALL 3
+
+/* the smoothed law of point P at its group's velocity V: lam and K (the
+ * 6 entries of point_law); 0 where unloaded (lam = 0) */
+static int creep_point(const Mat *M, NPoint *P, const double V[6], double eps, double lam[3],
+                       double K[6])
+{
+  double v[3], kn;
+  point_velocity(P->r, V, v);
+  double ln = point_normal(M, P, v[0], &kn, 1);
+  if (ln < 0) {
+    lam[0] = lam[1] = lam[2] = 0;
+    memset(K, 0, 6 * sizeof(double));
+    return 0;
+  }
+  double s = sqrt(v[1] * v[1] + v[2] * v[2] + eps * eps), tf = P->tf0 + M->mu * ln;
+  double mob = 1, e = 0;
+  if (M->rj > 0) {
+    mob = -expm1(-(P->x0 + M->rj * s));
+    e = 1 - mob;
+  }
+  double T = tf * mob;
+  lam[0] = ln;
+  K[0] = kn;
+  if (!(s > 0) || !(T > 0)) {
+    lam[1] = lam[2] = 0;
+    K[1] = K[2] = K[3] = K[4] = K[5] = 0;
+    return 1;
+  }
+  /* d lam_t / d v_t = -(T/s)(I - t t^T) - tf m' t t^T (t = v_t / s, |t| < 1
+   * by the smoothing), d lam_t / d v_n through tf */
+  double is = 1 / s, t1 = v[1] * is, t2 = v[2] * is;
+  double a = T * is, b = tf * e * M->rj, tn = M->mu * mob * kn;
+  lam[1] = -T * t1;
+  lam[2] = -T * t2;
+  K[1] = -t1 * tn;
+  K[2] = -t2 * tn;
+  K[3] = -a * (1 - t1 * t1) - b * t1 * t1;
+  K[4] = (a - b) * t1 * t2;
+  K[5] = -a * (1 - t2 * t2) - b * t2 * t2;
+  return 1;
+}
+
+/* The smoothed laws at y: F (n, world), H (36 a group, one a row), each
+ * point's lam and K; *lmax the largest |lam|_1, *smax the largest slip */
+static void creep_eval(const ssData *d, const Setup *s, ssNewtonWork *w, const double *y,
+                       double eps, double *F, double *H, double *lam, double *K, double *lmax,
+                       double *smax)
+{
+  double lm = 0, sm = 0;
+  for (int g = 0; g < s->ngroup; g++) {
+    NSum *A = w->sum + g;
+    memset(A, 0, sizeof *A);
+    to_group(w->grp + g, y + 6 * g, A->V);
+  }
+  for (int u = 0; u < w->nrun; u++) {
+    const int i0 = w->run[u], i1 = w->run[u + 1], g = w->group_of[i0];
+    NSum *A = w->sum + g;
+    const Mat *M = &w->grp[g].M;
+    int nl = 0;
+    for (int i = i0; i < i1; i++) {
+      NPoint *P = w->pt + i;
+      double *l = lam + 3 * i, v[3];
+      if (!creep_point(M, P, A->V, eps, l, K + 6 * i)) continue;
+      w->live[nl++] = i;
+      point_velocity(P->r, A->V, v);
+      double sv = sqrt(v[1] * v[1] + v[2] * v[2]), lv = fabs(l[0]) + fabs(l[1]) + fabs(l[2]);
+      sm = sv > sm ? sv : sm;
+      lm = lv > lm ? lv : lm;
+      /* F' += X^T lam (X: rows n, t1, t2 at r) */
+      const double *r = P->r;
+      A->F[0] += r[1] * l[2] - r[2] * l[1];
+      A->F[1] += r[2] * l[0] - r[0] * l[2];
+      A->F[2] += r[0] * l[1] - r[1] * l[0];
+      A->F[3] += l[0];
+      A->F[4] += l[1];
+      A->F[5] += l[2];
+    }
+    h_sums(w->pt, K, w->live, nl, A);
+  }
+  for (int g = 0; g < s->ngroup; g++) {
+    double Hg[36];
+    sums_H(w->sum + g, Hg);
+    from_group(w->grp + g, w->sum[g].F, Hg, F + 6 * g, H + 36 * g);
+  }
+  for (int r = 0; r < s->nrow; r++) {
+    const ssContact *c = d->contact + s->first_row + r;
+    int k = 6 * s->ngroup + r;
+    double l = c->row_a - c->row_b * y[k], h = -c->row_b;
+    if (l > c->row_bound || l < -c->row_bound) {
+      l = l > 0 ? c->row_bound : -c->row_bound;
+      h = 0;
+    }
+    F[k] = l;
+    H[36 * s->ngroup + r] = h;
+  }
+  *lmax = lm;
+  *smax = sm;
+}
+
+/* the impulses the contacts hold, in the unknowns' space (F's form) */
+static void held_impulses(const ssData *d, const Setup *s, ssNewtonWork *w, double *f)
+{
+  for (int g = 0; g < s->ngroup; g++) memset(w->sum[g].F, 0, sizeof w->sum[g].F);
+  for (int i = 0; i < s->first_row; i++) {
+    const double *r = w->pt[i].r, *l = d->contact[i].lambda;
+    double *A = w->sum[w->group_of[i]].F;
+    A[0] += r[1] * l[2] - r[2] * l[1];
+    A[1] += r[2] * l[0] - r[0] * l[2];
+    A[2] += r[0] * l[1] - r[1] * l[0];
+    A[3] += l[0];
+    A[4] += l[1];
+    A[5] += l[2];
+  }
+  for (int g = 0; g < s->ngroup; g++) from_group(w->grp + g, w->sum[g].F, NULL, f + 6 * g, NULL);
+  for (int r = 0; r < s->nrow; r++) f[6 * s->ngroup + r] = d->contact[s->first_row + r].lambda[0];
+}
+
+/* the least tangential response (G_tt's least eigenvalue) over the loaded
+ * points (lam[0] > 0) */
+static double least_response(const Setup *s, const ssNewtonWork *w, const double *lam)
+{
+  double gmin = INFINITY;
+  for (int i = 0; i < s->first_row; i++) {
+    if (!(lam[3 * i] > 0)) continue;
+    const NGroup *G = w->grp + w->group_of[i];
+    double x[2][6], Gt[4];
+    point_trows(w->pt[i].r, x);
+    for (int a = 0; a < 2; a++)
+      for (int b = 0; b < 2; b++) {
+        double t = 0;
+        for (int p = 0; p < 6; p++)
+          for (int q = 0; q < 6; q++) t += x[a][p] * G->Lg[6 * p + q] * x[b][q];
+        Gt[2 * a + b] = t;
+      }
+    double tr = Gt[0] + Gt[3], det = Gt[0] * Gt[3] - Gt[1] * Gt[2];
+    double disc = sqrt(fmax(0, 0.25 * tr * tr - det));
+    gmin = fmin(gmin, 0.5 * tr - disc);
+  }
+  return gmin;
+}
+
+static double dotn(const double *a, const double *b, int n)
+{
+  double t = 0;
+  for (int k = 0; k < n; k++) t += a[k] * b[k];
+  return t;
+}
+
+/* the creeping solve's scratch: f at y, its trial and step, the best
+ * iterate */
+typedef struct Creep {
+  double *f, *ft, *df, *yb, *fb;
+  int count;
+} Creep;
+
+/* Newton at one eps from (w->y, c->f), with w->F, w->H, w->lam, w->K at
+ * w->y on entry, at most iters steps, until |phi|^2 <= tol2 |Lam F|^2 or a
+ * stall.  On return (w->y, c->f) is the best iterate and the arrays are
+ * at it.  Returns 0, or -1 where a step is no descent or the matrix is
+ * singular. */
+static int creep_level(const ssData *d, const Setup *s, ssNewtonWork *w, Creep *c, double eps,
+                       double tol2, int iters)
+{
+  const int n = s->n;
+  double lm, sm, size, res = residual(s, w, w->y, w->F, NULL, NULL, w->phi, &size);
+  double best = res, mark = res;
+  int since = 0, at_best = 1;
+  memcpy(c->yb, w->y, (size_t)n * sizeof(double));
+  memcpy(c->fb, c->f, (size_t)n * sizeof(double));
+  for (int it = 0; it < iters && !(res <= tol2 * size); it++) {
+    newton_matrix(s, w, w->H);
+    if (!ss_lu_factor(w->A, w->piv, n)) return -1;
+    for (int a = 0; a < n; a++) w->dy[a] = -w->phi[a];
+    ss_lu_solve(w->A, w->piv, n, w->dy);
+    /* df = F - f + H dy */
+    for (int g = 0; g < s->ngroup; g++)
+      for (int a = 0; a < 6; a++) {
+        const double *Hr = w->H + 36 * g + 6 * a, *dy = w->dy + 6 * g;
+        c->df[6 * g + a] = w->F[6 * g + a] - c->f[6 * g + a] + Hr[0] * dy[0] + Hr[1] * dy[1] +
+                           Hr[2] * dy[2] + Hr[3] * dy[3] + Hr[4] * dy[4] + Hr[5] * dy[5];
+      }
+    for (int r = 0; r < s->nrow; r++) {
+      int k = 6 * s->ngroup + r;
+      c->df[k] = w->F[k] - c->f[k] + w->H[36 * s->ngroup + r] * w->dy[k];
+    }
+    double s0 = 0;
+    for (int a = 0; a < n; a++) s0 += (c->f[a] - w->F[a]) * w->dy[a];
+    /* (no descent: round-off at the answer, or the coupling's asymmetry
+     * far from it; the best iterate stands) */
+    if (!(s0 < 0)) break;
+    /* line search on the slope (f + a df - F(y + a dy)) . dy, increasing
+     * in a: taken where it is at most CREEP_WOLFE |s0|; past that, a falls
+     * to the root of the slope interpolated linearly from 0 (within
+     * [0.05 a, 0.9 a]) */
+    double al = 1;
+    int ok = 0;
+    for (int ls = 0; ls < CREEP_SEARCH && !ok; ls++) {
+      for (int a = 0; a < n; a++) {
+        w->ytry[a] = w->y[a] + al * w->dy[a];
+        c->ft[a] = c->f[a] + al * c->df[a];
+      }
+      creep_eval(d, s, w, w->ytry, eps, w->Ftry, w->Htry, w->lamtry, w->Ktry, &lm, &sm);
+      c->count++;
+      double sl = 0;
+      for (int a = 0; a < n; a++) sl += (c->ft[a] - w->Ftry[a]) * w->dy[a];
+      if (sl <= -CREEP_WOLFE * s0) {
+        ok = 1;
+      } else {
+        double t = sl == sl ? al * s0 / (s0 - sl) : 0.5 * al;
+        al = t < 0.05 * al ? 0.05 * al : t > 0.9 * al ? 0.9 * al : t;
+      }
+    }
+    if (!ok) break;
+    double *t;
+    t = w->y; w->y = w->ytry; w->ytry = t;
+    t = w->F; w->F = w->Ftry; w->Ftry = t;
+    t = w->H; w->H = w->Htry; w->Htry = t;
+    t = w->K; w->K = w->Ktry; w->Ktry = t;
+    t = w->lam; w->lam = w->lamtry; w->lamtry = t;
+    t = c->f; c->f = c->ft; c->ft = t;
+    res = residual(s, w, w->y, w->F, NULL, NULL, w->phi, &size);
+    at_best = res < best;
+    if (at_best) {
+      best = res;
+      memcpy(c->yb, w->y, (size_t)n * sizeof(double));
+      memcpy(c->fb, c->f, (size_t)n * sizeof(double));
+    }
+    /* progress: |phi| halved since the mark, or a damped step */
+    if (res <= 0.25 * mark || al < 1) {
+      mark = fmin(mark, res);
+      since = 0;
+    } else if (++since >= CREEP_STALL) {
+      break;
+    }
+  }
+  if (!at_best) {
+    memcpy(w->y, c->yb, (size_t)n * sizeof(double));
+    memcpy(c->f, c->fb, (size_t)n * sizeof(double));
+    creep_eval(d, s, w, w->y, eps, w->F, w->H, w->lam, w->K, &lm, &sm);
+    c->count++;
+    residual(s, w, w->y, w->F, NULL, NULL, w->phi, &size);
+  }
+  return 0;
+}
+
+int ss_newton_creep(const ssModel *m, ssData *d, int first_row, double tol, int *count)
+{
+  Setup s;
+  ssNewtonWork *w = setup(m, d, first_row, &s);
+  if (!w) return 0;
+  const int n = s.n;
+  w->ns = 0;
+  Creep c = {NULL, NULL, NULL, NULL, NULL, 0};
+  double *buf = malloc((size_t)5 * n * sizeof(double));
+  int done = 0;
+  if (!buf) return 0;
+  c.f = buf;
+  c.ft = buf + n;
+  c.df = buf + 2 * n;
+  c.yb = buf + 3 * n;
+  c.fb = buf + 4 * n;
+  /* the start: the impulses the contacts hold and the velocities they
+   * give (y = y_free + Lam f, as the sweeps keep them) */
+  unknowns_of(m, d, &s, w, d->qvel_free, w->yfree);
+  held_impulses(d, &s, w, c.f);
+  for (int a = 0; a < n; a++) w->y[a] = w->yfree[a] + dotn(w->Lam + (size_t)a * n, c.f, n);
+  double lmax, smax, size;
+  creep_eval(d, &s, w, w->y, 0, w->F, w->H, w->lam, w->K, &lmax, &smax);
+  c.count++;
+  double gmin = least_response(&s, w, w->lam);
+  double eps_end = CREEP_FINAL * tol * lmax * gmin;
+  if (lmax > 0 && eps_end > 0 && isfinite(eps_end)) {
+    double eps = fmax(CREEP_EPS_START * smax, eps_end);
+    done = 1;
+    for (;;) {
+      int last = !(eps > eps_end);
+      if (last) eps = eps_end;
+      creep_eval(d, &s, w, w->y, eps, w->F, w->H, w->lam, w->K, &lmax, &smax);
+      c.count++;
+      double lt = last ? CREEP_FINAL * tol : CREEP_LEVEL_TOL;
+      if (creep_level(d, &s, w, &c, eps, lt * lt, last ? 2 * CREEP_ITER : CREEP_ITER) < 0) {
+        done = 0;
+        break;
+      }
+      if (last) break;
+      eps *= CREEP_EPS_STEP;
+    }
+  }
+  /* the last step by the laws' linear model, from an answer within
+   * CREEP_LINEAR_TOL */
+  if (done) {
+    double res = residual(&s, w, w->y, w->F, NULL, NULL, w->phi, &size);
+    done = res <= CREEP_LINEAR_TOL * CREEP_LINEAR_TOL * size;
+    if (done) {
+      newton_matrix(&s, w, w->H);
+      done = ss_lu_factor(w->A, w->piv, n);
+    }
+    if (done) {
+      for (int a = 0; a < n; a++) w->dy[a] = -w->phi[a];
+      ss_lu_solve(w->A, w->piv, n, w->dy);
+      done = linear_end(&s, w);
+    }
+    if (done) apply_at(m, d, &s, w, w->lamtry, w->Ftry);
+  }
+  *count += c.count;
+  free(buf);
+  return done;
 }

@@ -299,19 +299,18 @@ const double *ss_newton_law(const ssData *d);
 void ss_newton_keep(ssData *d);
 void ss_newton_work_free(ssNewtonWork *w);
 
-/* The creeping body solve (creep.c): where every contact is a soil point
- * of a free body, the step of each body as the minimum of a convex
- * function of its velocity (its laws' potentials, the shear kink smoothed
- * and the smoothing taken down to where no sweep can see it), by Newton's
- * method with a line search.  For the steps the Newton phase and the first
- * sweeps leave unconverged (a creeping patch, stick and slip mixed).  On
- * entry the contacts' rows (J, W) and laws are set up for the sweeps, the
- * impulses and d->qvel consistent.  Returns 1 when every body's answer met
- * its test and was applied (impulses, and d->qvel from them); 0 when not
- * (the bodies solved before the one that failed keep their answers: each
- * is consistent).  *count: the passes over the points it spent. */
-int ss_creep_applies(const ssModel *m, const ssData *d);
-int ss_creep_solve(const ssModel *m, ssData *d, double tol, int *count);
+/* The creeping solve (newton.c): the step's contacts as the minimum of
+ * their laws' convex potential in the Newton phase's unknowns (the shear
+ * kink smoothed, the smoothing taken down to where no sweep can see it),
+ * by Newton's method with a line search; its last step by the laws'
+ * linear model.  For the steps the Newton phase and the first sweeps
+ * leave unconverged (a creeping patch, stick and slip mixed), where the
+ * contacts suit the Newton phase.  On entry the impulses and d->qvel are
+ * consistent.  Returns 1 when it applied an answer (the contacts'
+ * impulses, d->qvel their velocity; the sweeps then check it), 0 when
+ * not (everything as it was).  *count: its passes over the points,
+ * added. */
+int ss_newton_creep(const ssModel *m, ssData *d, int first_row, double tol, int *count);
 
 /* Dense LU with partial pivoting of the n x n matrix A (row-major), in
  * place, the row swaps in piv; 0 where a column has no nonzero pivot left

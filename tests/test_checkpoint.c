@@ -242,7 +242,7 @@ static void test_replay_buggy(void)
   replay_straight("buggy.xml", 100, 60, 0);
 }
 
-/* The creeping body solve (creep.c) in the replayed stretch: drag.xml's
+/* The creeping solve (newton.c) in the replayed stretch: drag.xml's
  * plate comes to rest rocking on its front edge at steps 1159-1164, which
  * that solve takes; from a checkpoint of step 1150 the restored run goes
  * through them bit for bit. */
