@@ -1276,7 +1276,8 @@ static int reevaluate(const ssModel *m, const ssData *d, const Setup *s, ssNewto
 }
 
 /* A = I - Lam H (the impulse-form points eliminated into H) */
-static void newton_matrix(const Setup *s, ssNewtonWork *w, const double *H)
+static inline __attribute__((always_inline)) void newton_matrix(const Setup *s, ssNewtonWork *w,
+                                                              const double *H)
 {
   int n = s->n;
   for (int a = 0; a < n; a++) {
@@ -1690,7 +1691,7 @@ static void apply(const ssModel *m, ssData *d, const Setup *s, const ssNewtonWor
  * modelled: not with them.  linear_end forms that answer into the trial
  * buffers (0 where it declines); apply_linear applies it and returns
  * check's measure of it (INFINITY where it declined). */
-static int linear_end(const Setup *s, ssNewtonWork *w)
+static inline __attribute__((always_inline)) int linear_end(const Setup *s, ssNewtonWork *w)
 {
   /* (the scratch sums' V hold each group's dy, frame about o) */
   for (int g = 0; g < s->ngroup; g++) to_group(w->grp + g, w->dy + 6 * g, w->sum[g].V);
@@ -2425,7 +2426,8 @@ static int stick_solve(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork
  * articulated links or free bodies) and [first_row, ncontact) (PD rows):
  * the groups, their points' constants, Lam and the groups' frames and
  * laws.  NULL where the contacts do not suit it (or out of memory). */
-static ssNewtonWork *setup(const ssModel *m, ssData *d, int first_row, Setup *sp)
+static inline __attribute__((always_inline)) ssNewtonWork *setup(const ssModel *m, ssData *d,
+                                                                    int first_row, Setup *sp)
 {
   if (first_row == 0) return NULL;
   /* suited: soil points on articulated links or free bodies (checked
