@@ -534,8 +534,10 @@ typedef struct ssData {
   int solver_full;        /* 1: every contact updates the full velocity
                              (no packed link groups); the reference path of
                              the tests, equal to the default at round-off */
-  int solver_gs_only;     /* 1: no Newton phase before the sweeps (solver.h);
-                             the reference path of the tests */
+  int solver_gs_only;     /* 1: no Newton phase before the sweeps and no
+                             creeping solve among them (solver.h): the
+                             sweeps alone, the reference path of the
+                             tests */
   int solver_no_predict;  /* 1: the Newton phase starts from the warm start
                              alone, not from its last answers extrapolated
                              (newton.c); the reference path of the tests */
