@@ -1125,13 +1125,13 @@ static void test_floating_root(void)
   ss_urdf_free(u);
 }
 
-/* CPU seconds to read a chain of n links on fixed joints (the best of
- * two), or -1 when it does not load. */
-static double chain_seconds(int n)
+/* A chain of n links on fixed joints, read: 1 when it loads with n + 1
+ * links, each joint k joining link k - 1 to link k in the file's order */
+static int chain_reads(int n)
 {
   size_t cap = (size_t)n * 120 + 64, k = 0;
   char *buf = malloc(cap);
-  if (!buf) return -1;
+  if (!buf) return 0;
   k += (size_t)snprintf(buf + k, cap - k, "<robot name=\"chain\">\n");
   for (int i = 0; i <= n; i++)
     k += (size_t)snprintf(buf + k, cap - k, "<link name=\"l%d\"/>\n", i);
@@ -1140,34 +1140,29 @@ static double chain_seconds(int n)
                           "<joint name=\"j%d\" type=\"fixed\"><parent link=\"l%d\"/>"
                           "<child link=\"l%d\"/></joint>\n", i, i - 1, i);
   k += (size_t)snprintf(buf + k, cap - k, "</robot>\n");
-  double best = -1;
-  for (int rep = 0; rep < 2; rep++) {
-    ssUrdf *u = NULL;
-    ssError e;
-    clock_t t0 = clock();
-    ssStatus st = ss_urdf_load_buffer(buf, k, "chain.urdf", NULL, &u, &e);
-    double t = (double)(clock() - t0) / CLOCKS_PER_SEC;
-    int good = st == SS_OK && u->nlink == n + 1;
-    ss_urdf_free(u);
-    if (!good) {
-      best = -1;
-      break;
-    }
-    if (best < 0 || t < best) best = t;
+  ssUrdf *u = NULL;
+  ssError e;
+  ssStatus st = ss_urdf_load_buffer(buf, k, "chain.urdf", NULL, &u, &e);
+  int good = st == SS_OK && u->nlink == n + 1 && u->njoint == n;
+  for (int j = 0; good && j < u->njoint; j++) {
+    const ssUrdfJoint *jt = u->joint + j;
+    good = jt->parent >= 0 && jt->child >= 0 && atoi(u->link[jt->parent].name + 1) == j &&
+           atoi(u->link[jt->child].name + 1) == j + 1;
   }
+  ss_urdf_free(u);
   free(buf);
-  return best;
+  return good;
 }
 
-/* Links and joints are found by name in constant time: eight times the
- * links take about eight times as long to read, not 64 (a 64 MiB URDF of
- * short links once took hours). */
+/* Links and joints are found by name in constant time (a 64 MiB URDF of
+ * short links once took hours): a chain of 32 000 links reads, every
+ * joint joining the links it names.  Correctness only: how the time
+ * grows with the links is benchmarks --bench load's (a timed ratio here,
+ * as before, would fail on a busy machine). */
 static void test_many_links(void)
 {
-  double t1 = chain_seconds(4000), t8 = chain_seconds(32000);
-  ok(t1 >= 0 && t8 >= 0 && t8 < 24 * fmax(t1, 1e-3),
-     "reading 32000 links takes less than 24 times as long as 4000 (%.3f s, "
-     "%.3f s)", t8, t1);
+  ok(chain_reads(4000) && chain_reads(32000),
+     "chains of 4000 and 32000 links read, every joint joining the links it names");
 }
 
 /* A URDF of many links, each with a material of its own that its visual
