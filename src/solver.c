@@ -1935,8 +1935,11 @@ static void visit_piece(const ssModel *m, ssData *d, int i, int end, int back, G
  * them on to its answer, which the next sweep checks.  Its pass over the
  * points costs about a third of a sweep of an articulated link's points
  * and one of a free body's, and it takes 60 to 200 of them: a step that
- * the sweeps settle in a few tens more is left to them. */
-enum { CREEP_EVERY = 10, CREEP_WORTH = 40 };
+ * the sweeps settle in a few tens more is left to them.  At most
+ * CREEP_TRIES a step: one that fails twice (a soil so stiff that its
+ * laws turn rounding into their answer) is left to the sweeps, at their
+ * cost alone. */
+enum { CREEP_EVERY = 10, CREEP_WORTH = 40, CREEP_TRIES = 2 };
 
 static int creep_due(double r, double r_before, double tol)
 {
@@ -2037,6 +2040,7 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   }
   Group g = {NULL, NULL, NULL, {0}, {0}, {0}};
   double r_before = 0; /* the residual CREEP_EVERY sweeps before */
+  int creep_tries = 0;
   for (int sweep = 0; sweep < sweeps; sweep++) {
     double dmax = 0, lmax = 0;
     int since = 0, pending = 1;
@@ -2088,9 +2092,11 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
     st->residual = lmax > 0 ? dmax / lmax : 0;
     if (st->residual <= tol) break;
     /* the sweeps crawl: the creeping solve, where it applies */
-    if ((sweep + 1) % CREEP_EVERY == 0 && !d->solver_gs_only) {
-      if (sweep + 1 > CREEP_EVERY && creep_due(st->residual, r_before, tol))
+    if ((sweep + 1) % CREEP_EVERY == 0 && !d->solver_gs_only && creep_tries < CREEP_TRIES) {
+      if (sweep + 1 > CREEP_EVERY && creep_due(st->residual, r_before, tol)) {
+        creep_tries++;
         ss_newton_creep(m, d, first_row, tol, &st->newton);
+      }
       r_before = st->residual;
     }
   }
