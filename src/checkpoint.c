@@ -35,7 +35,10 @@
  *           fingerprint(); the rigid materials as the friction and
  *           restitution each collider meets on each rigid support, not
  *           by their indices, which earlier builds hashed and a restore
- *           still accepts), u32 length and bytes of the model's source path
+ *           still accepts, and as the table of those the colliders'
+ *           materials meet on each other, which builds before contacts
+ *           between bodies left out and a restore still accepts), u32
+ *           length and bytes of the model's source path
  *     OPTS  ssOption: timestep, gravity x y z (f64), solver_max_sweeps (i32),
  *           solver_tolerance, scalar_tolerance (f64), terrain_warm_start
  *           (i32), contact_margin, rigid_erp (f64)
@@ -195,16 +198,39 @@ typedef struct Fingerprint {
  * rigid_contacts).  Material indices are only the order in which a file
  * named the materials, and an export names them in another order (its
  * ground planes before its bodies), so they are not hashed. */
-static void hash_contact_materials(Hash *h, const ssModel *m)
+static void hash_pair(Hash *h, const ssModel *m, int a, int b)
+{
+  const ssMaterialPair *p = ss_model_pair(m, a, b);
+  const double v[3] = {p->friction, p->restitution, p->restitution_threshold};
+  hash_doubles(h, v, 3);
+}
+
+/* with colliders: also the material each collider meets on each other
+ * collider (contacts between bodies), as a table over the colliders'
+ * materials numbered by the first collider that names each (an order an
+ * export keeps); 0 for the builds before contacts between bodies, which
+ * left it out (a checkpoint they wrote still restores) */
+static int hash_contact_materials(Hash *h, const ssModel *m, int colliders)
 {
   for (int g = 0; g < m->ngeom; g++)
     for (int k = 0; k < m->nhfield + m->nplane; k++) {
       if (k < m->nhfield && m->hfield_soil[k]) continue;
       int mat = k < m->nhfield ? m->hfield_material[k] : m->plane_material[k - m->nhfield];
-      const ssMaterialPair *p = ss_model_pair(m, m->geom_material[g], mat);
-      const double v[3] = {p->friction, p->restitution, p->restitution_threshold};
-      hash_doubles(h, v, 3);
+      hash_pair(h, m, m->geom_material[g], mat);
     }
+  if (!colliders || m->ngeom == 0) return 1;
+  /* the colliders' distinct materials in the order of their first use */
+  int *used = malloc((size_t)m->ngeom * sizeof(int)), nu = 0;
+  if (!used) return 0;
+  for (int g = 0; g < m->ngeom; g++) {
+    int mat = m->geom_material[g], seen = 0;
+    for (int k = 0; k < nu && !seen; k++) seen = used[k] == mat;
+    if (!seen) used[nu++] = mat;
+  }
+  for (int a = 0; a < nu; a++)
+    for (int b = a; b < nu; b++) hash_pair(h, m, used[a], used[b]);
+  free(used);
+  return 1;
 }
 
 /* Everything in the model that changes what a step computes, grouped so
@@ -212,12 +238,17 @@ static void hash_contact_materials(Hash *h, const ssModel *m)
  * pd_target0, bed poses) are left out: a checkpoint replaces them.  Names,
  * colours and file paths are left out: they do not change the dynamics;
  * so is the numbering of the rigid materials (hash_contact_materials).
- * legacy: the fingerprint of earlier builds, which hashed the material
- * indices and the pair table as numbered (a checkpoint they wrote is
- * still compared with it, so it restores into the world it was written
- * for). */
-static void fingerprint(const ssModel *m, Fingerprint *f, int legacy)
+ * legacy (FP_LEGACY): the fingerprint of earlier builds, which hashed the
+ * material indices and the pair table as numbered; FP_NO_BETWEEN: of the
+ * builds before contacts between bodies, which left out the materials
+ * colliders meet on each other (a checkpoint either wrote is still
+ * compared with it, so it restores into the world it was written for).
+ * Returns 0 out of memory. */
+enum { FP_NOW, FP_LEGACY, FP_NO_BETWEEN };
+
+static int fingerprint(const ssModel *m, Fingerprint *f, int variant)
 {
+  const int legacy = variant == FP_LEGACY, no_between = variant == FP_NO_BETWEEN;
   const int c[NCOUNT] = {m->nq, m->nv, m->nsys, m->nbody, m->ngeom,
                          m->nhfield, m->nhfielddata, m->npd, m->neq,
                          m->nspring, m->nplane, m->nxforce, m->nmaterial,
@@ -329,14 +360,15 @@ static void fingerprint(const ssModel *m, Fingerprint *f, int legacy)
       hash_ints(&h, mi, 2);
       hash_doubles(&h, v, 3);
     }
-  } else {
-    hash_contact_materials(&h, m);
+  } else if (!hash_contact_materials(&h, m, !no_between)) {
+    return 0;
   }
   hash_ints(&h, m->xforce_body, m->nxforce);
   hash_doubles(&h, m->xforce_force, 3L * m->nxforce);
   hash_doubles(&h, m->xforce_torque, 3L * m->nxforce);
   hash_doubles(&h, m->xforce_time, 2L * m->nxforce);
   f->hash[6] = h.h;
+  return 1;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -485,7 +517,8 @@ ssStatus ss_checkpoint_save_buffer(const ssModel *m, const ssData *d,
 
   Writer w = {NULL, 0, 0, 0};
   Fingerprint f;
-  fingerprint(m, &f, 0);
+  if (!fingerprint(m, &f, FP_NOW))
+    return ss_error_set(err, SS_ERR_NOMEM, NULL, 0, "cannot write a checkpoint: out of memory");
   size_t hd = 0, s;
 
   w_bytes(&w, CKPT_MAGIC, 8);
@@ -1001,9 +1034,10 @@ static ssStatus compare_model(const ssModel *m, const Fingerprint *fc,
                               const char *src, size_t srclen, const char *path,
                               ssError *err)
 {
-  Fingerprint fm, fl;
-  fingerprint(m, &fm, 0);
-  fingerprint(m, &fl, 1);
+  Fingerprint fm, fl, fb;
+  if (!fingerprint(m, &fm, FP_NOW) || !fingerprint(m, &fl, FP_LEGACY) ||
+      !fingerprint(m, &fb, FP_NO_BETWEEN))
+    return ss_error_set(err, SS_ERR_NOMEM, path, 0, "out of memory");
   char from[600] = "";
   if (srclen) {
     char s[512];
@@ -1019,10 +1053,11 @@ static ssStatus compare_model(const ssModel *m, const Fingerprint *fc,
                           (unsigned long)fm.count[k]);
   char what[512] = "";
   size_t used = 0;
-  /* a file of an earlier build holds the legacy hashes (they differ from
-   * the current ones only in the groups with materials) */
+  /* a file of an earlier build holds the legacy hashes or those without
+   * the materials between colliders (they differ from the current ones
+   * only in the groups with materials) */
   for (int k = 0; k < NHASH; k++)
-    if (fc->hash[k] != fm.hash[k] && fc->hash[k] != fl.hash[k]) {
+    if (fc->hash[k] != fm.hash[k] && fc->hash[k] != fl.hash[k] && fc->hash[k] != fb.hash[k]) {
       int n = snprintf(what + used, sizeof what - used, "%s%s",
                        used ? "; " : "", hash_name[k]);
       if (n > 0 && (size_t)n < sizeof what - used) used += (size_t)n;

@@ -1191,6 +1191,65 @@ out:
   ss_model_free(m2);
 }
 
+/* The materials colliders meet on each other (contacts between bodies)
+ * are in the fingerprint: two wooden boxes stacked on a concrete ground,
+ * a checkpoint refused where the wood-on-wood friction differs (accepted
+ * before: only the materials met on ground planes and rigid height maps
+ * were hashed), restored where nothing differs. */
+static void test_between_materials(void)
+{
+  static const char scene[] =
+      "<raisim version=\"1.0\">\n"
+      "  <timeStep value=\"0.001\"/>\n"
+      "  <objects>\n"
+      "    <ground name=\"ground\" height=\"0\" material=\"concrete\"/>\n"
+      "    <box name=\"low\" mass=\"4\" material=\"wood\">\n"
+      "      <dim x=\"0.4\" y=\"0.4\" z=\"0.2\"/><state pos=\"0 0 0.1\"/>\n"
+      "    </box>\n"
+      "    <box name=\"high\" mass=\"1\" material=\"wood\">\n"
+      "      <dim x=\"0.2\" y=\"0.2\" z=\"0.1\"/><state pos=\"0 0 0.252\"/>\n"
+      "    </box>\n"
+      "  </objects>\n"
+      "  <material>\n"
+      "    <pair_prop name1=\"wood\" name2=\"concrete\" friction=\"0.7\" restitution=\"0\" "
+      "restitution_threshold=\"0\"/>\n"
+      "    <pair_prop name1=\"wood\" name2=\"wood\" friction=\"0.4\" restitution=\"0\" "
+      "restitution_threshold=\"0\"/>\n"
+      "  </material>\n"
+      "</raisim>\n";
+  char path[600];
+  tmp_path(path, sizeof path, "between.xml");
+  ssModel *m = NULL, *m2 = NULL;
+  ssData *d = NULL, *d2 = NULL;
+  ssError e;
+  size_t len = 0;
+  unsigned char *buf = NULL;
+  int r = write_file(path, scene, sizeof scene - 1) &&
+          ss_scene_load(path, &m, &d, &e) == SS_OK && ss_scene_load(path, &m2, &d2, &e) == SS_OK &&
+          run(m, d, 50) && (buf = snapshot(m, d, &len));
+  int ww = -1;
+  for (int k = 0; r && k < m2->npair; k++)
+    if (m2->pair[k].mat1 == m2->pair[k].mat2) ww = k;
+  if (!r || ww < 0) {
+    ok(0, "two wooden boxes on concrete: load, run, checkpoint (%s)", e.message);
+  } else {
+    ssStatus st = ss_checkpoint_load_buffer(m2, d2, buf, len, &e);
+    ok(st == SS_OK, "two wooden boxes on concrete: a checkpoint restores into the same world (%s)",
+       st ? e.message : "ok");
+    m2->pair[ww].friction = 0.8;
+    st = ss_checkpoint_load_buffer(m2, d2, buf, len, &e);
+    ok(st == SS_ERR_VALUE && strstr(e.message, "contact materials"),
+       "... and is refused where only the wood-on-wood friction differs (%s)",
+       st ? e.message : "accepted");
+  }
+  free(buf);
+  unlink(path);
+  ss_data_free(d);
+  ss_model_free(m);
+  ss_data_free(d2);
+  ss_model_free(m2);
+}
+
 /* A step that fails leaves everything as it was: the same checkpoint
  * bytes before and after, soil state and warm-start cache included.  Two
  * ways: the step itself blows up (gravity turned to 2e8 m/s^2 upward
@@ -1756,6 +1815,7 @@ int main(void)
   test_cache_overflow();
   test_export();
   test_restore_into_export();
+  test_between_materials();
   test_mesh_bodies();
   test_failed_step();
   test_step_limit();
