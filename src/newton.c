@@ -1077,6 +1077,20 @@ static double measure_value(const Measure *q)
   return q->lmax > 0 ? q->dmax / q->lmax : 0;
 }
 
+/* A point's tangential response G_tt (2 x 2) at r, from its group's Lam'
+ * (group_lam): x_k^T Lam' x_l over its tangential rows x_1, x_2 */
+static void point_gtt2(const NGroup *G, const double r[3], double Gt[4])
+{
+  const double x[2][6] = {{-r[2], 0, r[0], 0, 1, 0}, {r[1], -r[0], 0, 0, 0, 1}};
+  for (int a = 0; a < 2; a++)
+    for (int b = 0; b < 2; b++) {
+      double t = 0;
+      for (int i = 0; i < 6; i++)
+        for (int k = 0; k < 6; k++) t += x[a][i] * G->Lg[6 * i + k] * x[b][k];
+      Gt[2 * a + b] = t;
+    }
+}
+
 /* check's measure at an impulse-form point: the change a visit of the
  * sweeps would make to its impulse lam (held) at group velocity V, the
  * others held.  Normal: the law's impulse at v_n against the one held;
@@ -1095,15 +1109,8 @@ static double imp_check(const Mat *M, NPoint *P, const NGroup *G, const double V
   NImpEval ie;
   double mu[2] = {lam[1], lam[2]};
   imp_map(M, P, v + 1, ln, kn, mu, 0, &ie);
-  const double x[2][6] = {{-r[2], 0, r[0], 0, 1, 0}, {r[1], -r[0], 0, 0, 0, 1}};
   double Gt[4], A[4];
-  for (int a = 0; a < 2; a++)
-    for (int b = 0; b < 2; b++) {
-      double t = 0;
-      for (int i = 0; i < 6; i++)
-        for (int k = 0; k < 6; k++) t += x[a][i] * G->Lg[6 * i + k] * x[b][k];
-      Gt[2 * a + b] = t;
-    }
+  point_gtt2(G, r, Gt);
   for (int a = 0; a < 2; a++)
     for (int b = 0; b < 2; b++)
       A[2 * a + b] = ie.Dm[2 * a + b] + ie.Dv[2 * a] * Gt[b] + ie.Dv[2 * a + 1] * Gt[2 + b];
@@ -1940,6 +1947,35 @@ static void point_trows(const double r[3], double x[2][6])
   memcpy(x, a, sizeof a);
 }
 
+/* A += X^T l: a point's impulse l (n, t1, t2) at r as a spatial impulse
+ * about the group's origin, (r x l; l), group frame */
+static inline void wrench_add(double A[6], const double r[3], const double l[3])
+{
+  A[0] += r[1] * l[2] - r[2] * l[1];
+  A[1] += r[2] * l[0] - r[0] * l[2];
+  A[2] += r[0] * l[1] - r[1] * l[0];
+  A[3] += l[0];
+  A[4] += l[1];
+  A[5] += l[2];
+}
+
+/* The PD rows' laws at y, lambda = clamp(a - b v, -bound, bound): F and,
+ * with H, dF/dv (0 where clamped), for stick_eval and creep_eval */
+static void row_laws(const ssData *d, const Setup *s, const double *y, double *F, double *H)
+{
+  for (int r = 0; r < s->nrow; r++) {
+    const ssContact *c = d->contact + s->first_row + r;
+    int k = 6 * s->ngroup + r;
+    double l = c->row_a - c->row_b * y[k], h = -c->row_b;
+    if (l > c->row_bound || l < -c->row_bound) {
+      l = l > 0 ? c->row_bound : -c->row_bound;
+      h = 0;
+    }
+    F[k] = l;
+    if (H) H[36 * s->ngroup + r] = h;
+  }
+}
+
 /* The laws for stick_solve at y: a sticking group's points (stick[g])
  * give their normal impulse alone (their tangential impulses are the
  * group's constraint wrench, added apart), the other groups' points
@@ -1993,17 +2029,7 @@ static int stick_eval(const ssData *d, const Setup *s, ssNewtonWork *w, const in
   for (int g = 0; g < s->ngroup; g++)
     from_group(w->grp + g, w->sum[g].F, H ? w->sum[g].Q : NULL, F + 6 * g,
                H ? H + 36 * g : NULL);
-  for (int r = 0; r < s->nrow; r++) {
-    const ssContact *c = d->contact + s->first_row + r;
-    int k = 6 * s->ngroup + r;
-    double l = c->row_a - c->row_b * y[k], h = -c->row_b;
-    if (l > c->row_bound || l < -c->row_bound) {
-      l = l > 0 ? c->row_bound : -c->row_bound;
-      h = 0;
-    }
-    F[k] = l;
-    if (H) H[36 * s->ngroup + r] = h;
-  }
+  row_laws(d, s, y, F, H);
   return 1;
 }
 
@@ -2379,13 +2405,7 @@ static int stick_solve(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork
     double Fg[6] = {0};
     for (int i = 0; i < s->first_row; i++) {
       if (w->group_of[i] != g) continue;
-      const double *r = w->pt[i].r, *l = lam + 3 * i;
-      Fg[0] += r[1] * l[2] - r[2] * l[1];
-      Fg[1] += r[2] * l[0] - r[0] * l[2];
-      Fg[2] += r[0] * l[1] - r[1] * l[0];
-      Fg[3] += l[0];
-      Fg[4] += l[1];
-      Fg[5] += l[2];
+      wrench_add(Fg, w->pt[i].r, lam + 3 * i);
     }
     from_group(w->grp + g, Fg, NULL, F + 6 * g, NULL);
   }
@@ -2420,6 +2440,18 @@ static int stick_solve(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork
     w->mu[2 * i + 1] = lam[3 * i + 2];
   }
   return 2;
+}
+
+/* The trial point becomes the iterate: y, F, H, K and lam swapped with
+ * their trial buffers */
+static inline void take_trial(ssNewtonWork *w)
+{
+  double *t;
+  t = w->y; w->y = w->ytry; w->ytry = t;
+  t = w->F; w->F = w->Ftry; w->Ftry = t;
+  t = w->H; w->H = w->Htry; w->Htry = t;
+  t = w->K; w->K = w->Ktry; w->Ktry = t;
+  t = w->lam; w->lam = w->lamtry; w->lamtry = t;
 }
 
 /* The Newton phase's set-up for contacts [0, first_row) (soil points on
@@ -2718,13 +2750,9 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
       stalled = 1;
       continue;
     }
-    t = w->y; w->y = w->ytry; w->ytry = t;
-    t = w->F; w->F = w->Ftry; w->Ftry = t;
-    t = w->H; w->H = w->Htry; w->Htry = t;
-    t = w->K; w->K = w->Ktry; w->Ktry = t;
+    take_trial(w);
     t = w->q; w->q = w->qtry; w->qtry = t;
     t = w->phi; w->phi = w->phitry; w->phitry = t;
-    t = w->lam; w->lam = w->lamtry; w->lamtry = t;
     t = w->mu; w->mu = w->mutry; w->mutry = t;
     NImpEval *te = w->ie;
     w->ie = w->ietry;
@@ -2879,14 +2907,8 @@ static void creep_eval(const ssData *d, const Setup *s, ssNewtonWork *w, const d
       double sv = sqrt(v[1] * v[1] + v[2] * v[2]), lv = fabs(l[0]) + fabs(l[1]) + fabs(l[2]);
       sm = sv > sm ? sv : sm;
       lm = lv > lm ? lv : lm;
-      /* F' += X^T lam (X: rows n, t1, t2 at r) */
-      const double *r = P->r;
-      A->F[0] += r[1] * l[2] - r[2] * l[1];
-      A->F[1] += r[2] * l[0] - r[0] * l[2];
-      A->F[2] += r[0] * l[1] - r[1] * l[0];
-      A->F[3] += l[0];
-      A->F[4] += l[1];
-      A->F[5] += l[2];
+      /* F' += X^T lam */
+      wrench_add(A->F, P->r, l);
     }
     h_sums(w->pt, K, w->live, nl, A);
   }
@@ -2895,17 +2917,7 @@ static void creep_eval(const ssData *d, const Setup *s, ssNewtonWork *w, const d
     sums_H(w->sum + g, Hg);
     from_group(w->grp + g, w->sum[g].F, Hg, F + 6 * g, H + 36 * g);
   }
-  for (int r = 0; r < s->nrow; r++) {
-    const ssContact *c = d->contact + s->first_row + r;
-    int k = 6 * s->ngroup + r;
-    double l = c->row_a - c->row_b * y[k], h = -c->row_b;
-    if (l > c->row_bound || l < -c->row_bound) {
-      l = l > 0 ? c->row_bound : -c->row_bound;
-      h = 0;
-    }
-    F[k] = l;
-    H[36 * s->ngroup + r] = h;
-  }
+  row_laws(d, s, y, F, H);
   *lmax = lm;
   *smax = sm;
 }
@@ -2915,14 +2927,7 @@ static void held_impulses(const ssData *d, const Setup *s, ssNewtonWork *w, doub
 {
   for (int g = 0; g < s->ngroup; g++) memset(w->sum[g].F, 0, sizeof w->sum[g].F);
   for (int i = 0; i < s->first_row; i++) {
-    const double *r = w->pt[i].r, *l = d->contact[i].lambda;
-    double *A = w->sum[w->group_of[i]].F;
-    A[0] += r[1] * l[2] - r[2] * l[1];
-    A[1] += r[2] * l[0] - r[0] * l[2];
-    A[2] += r[0] * l[1] - r[1] * l[0];
-    A[3] += l[0];
-    A[4] += l[1];
-    A[5] += l[2];
+    wrench_add(w->sum[w->group_of[i]].F, w->pt[i].r, d->contact[i].lambda);
   }
   for (int g = 0; g < s->ngroup; g++) from_group(w->grp + g, w->sum[g].F, NULL, f + 6 * g, NULL);
   for (int r = 0; r < s->nrow; r++) f[6 * s->ngroup + r] = d->contact[s->first_row + r].lambda[0];
@@ -2935,16 +2940,8 @@ static double least_response(const Setup *s, const ssNewtonWork *w, const double
   double gmin = INFINITY;
   for (int i = 0; i < s->first_row; i++) {
     if (!(lam[3 * i] > 0)) continue;
-    const NGroup *G = w->grp + w->group_of[i];
-    double x[2][6], Gt[4];
-    point_trows(w->pt[i].r, x);
-    for (int a = 0; a < 2; a++)
-      for (int b = 0; b < 2; b++) {
-        double t = 0;
-        for (int p = 0; p < 6; p++)
-          for (int q = 0; q < 6; q++) t += x[a][p] * G->Lg[6 * p + q] * x[b][q];
-        Gt[2 * a + b] = t;
-      }
+    double Gt[4];
+    point_gtt2(w->grp + w->group_of[i], w->pt[i].r, Gt);
     double tr = Gt[0] + Gt[3], det = Gt[0] * Gt[3] - Gt[1] * Gt[2];
     double disc = sqrt(fmax(0, 0.25 * tr * tr - det));
     gmin = fmin(gmin, 0.5 * tr - disc);
@@ -3024,13 +3021,10 @@ static int creep_level(const ssData *d, const Setup *s, ssNewtonWork *w, Creep *
       }
     }
     if (!ok) break;
-    double *t;
-    t = w->y; w->y = w->ytry; w->ytry = t;
-    t = w->F; w->F = w->Ftry; w->Ftry = t;
-    t = w->H; w->H = w->Htry; w->Htry = t;
-    t = w->K; w->K = w->Ktry; w->Ktry = t;
-    t = w->lam; w->lam = w->lamtry; w->lamtry = t;
-    t = c->f; c->f = c->ft; c->ft = t;
+    take_trial(w);
+    double *t = c->f;
+    c->f = c->ft;
+    c->ft = t;
     res = residual(s, w, w->y, w->F, NULL, NULL, w->phi, &size);
     at_best = res < best;
     if (at_best) {
