@@ -43,7 +43,12 @@
  * not a soil point on an articulated link or a free body or a PD row, or
  * when Newton does not converge fast; it leaves impulses and velocities
  * as it found them unless an answer it applied failed its check before
- * (then that answer, impulses and velocities consistent: solver.h). */
+ * (then that answer, impulses and velocities consistent: solver.h).
+ *
+ * The creeping solve at the end of this file (ss_newton_creep) shares
+ * the phase's unknowns and set-up: where the sweeps crawl on a creeping
+ * patch (stick and slip mixed, which neither form here settles), it
+ * minimises the laws' convex potential over them instead. */
 #include "solver.h"
 #include "articulated.h"
 #include "ss_math.h"
