@@ -2251,29 +2251,26 @@ static int range_basis(const double S[36], double thr, double B[36])
  * drag.xml's rocking plate is tilted on its bed, so C has rank 5, and the
  * wrench about its tangent axes needs tangential impulses 1.5 to 220
  * times their bounds (the lever arms are the tilt's): 2 of its 30 stalled
- * steps stick whole (39 -> 28 steps at the cap in 1300).  Only the flat
- * patch's three directions held (rocking free) leave slip of 1e-3 to 1e-1
- * of the check; started cold, that answer is Newton's one restart
- * (plate_arm.xml cold: 478 -> 265 of 1000 steps at the cap; warm, the
- * sweeps settle those steps from the warm start and nothing changes).
+ * steps stick whole (39 -> 28 steps at the cap in 1300); the rest are
+ * creeping patches, the creeping solve's (below).  (Started cold, Newton
+ * once restarted from the flat patch's three directions held, rocking
+ * free: plate_arm.xml cold 478 -> 265 of 1000 steps at the cap.  The
+ * creeping solve takes those steps; without the restart, none at the cap
+ * either way, and cold plate_arm.xml 4.73 -> 3.77 s for 1000 steps.)
  * STICK_ITER: its Newton iterations; STICK_RANK: C's rank cut for the
- * whole patch (relative); STICK_RANK_FLAT: for the flat patch's three */
+ * whole patch (relative) */
 #define STICK_ITER 30
 #define STICK_RANK 1e-10
-#define STICK_RANK_FLAT 1e-4
 
 static int stick_solve(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork *w,
-                       double tol, double *res, double thr, int restart);
+                       double tol, double *res, double thr);
 
 /* Where Newton stalled or declined in impulse form: the whole patch stuck
- * (every direction of C), else, started cold, Newton once more from the
- * flat patch's stick (the tangential motion stopped, rocking free; 2) */
+ * (every direction of C) */
 static int stick_try(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork *w, double tol,
                      double *res)
 {
-  if (stick_solve(m, d, s, w, tol, res, STICK_RANK, 0)) return 1;
-  if (m->opt.terrain_warm_start) return 0;
-  return stick_solve(m, d, s, w, tol, res, STICK_RANK_FLAT, 1);
+  return stick_solve(m, d, s, w, tol, res, STICK_RANK);
 }
 
 /* The stick solve of the groups whose loaded points are all in impulse
@@ -2283,7 +2280,7 @@ static int stick_try(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork *
  * their bounds but the check fails, its y and shared-out impulses then
  * Newton's iterate (w->y, w->mu, the impulse-form points). */
 static int stick_solve(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork *w,
-                       double tol, double *res, double thr, int restart)
+                       double tol, double *res, double thr)
 {
   int n = s->n, ng = s->ngroup, nc = d->ncontact, nv = m->nv, Nmax = n + 6 * ng;
   size_t need = (size_t)Nmax * Nmax + 5 * (size_t)Nmax + 2 * (size_t)n +
@@ -2433,18 +2430,7 @@ static int stick_solve(const ssModel *m, ssData *d, const Setup *s, ssNewtonWork
   for (int i = 0; i < nc; i++) memcpy(d->contact[i].lambda, save + 3 * i, 3 * sizeof(double));
   memcpy(d->qvel, save + 3 * (size_t)nc, (size_t)nv * sizeof(double));
   d->warm_pending = pending;
-  if (!restart) return 0;
-  /* Newton's next start: this y, the impulse-form points' mu its shares */
-  memcpy(w->y, x, (size_t)n * sizeof(double));
-  w->ns = 0;
-  for (int i = 0; i < s->first_row; i++) {
-    if (!w->pt[i].imp) continue;
-    point_gtt(w->grp[w->group_of[i]].gq, w->pt + i);
-    w->imp[w->ns++] = i;
-    w->mu[2 * i] = lam[3 * i + 1];
-    w->mu[2 * i + 1] = lam[3 * i + 2];
-  }
-  return 2;
+  return 0;
 }
 
 /* The trial point becomes the iterate: y, F, H, K and lam swapped with
@@ -2601,7 +2587,7 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
   if (st & STUCK) return 0;
   int limit = w->ns ? 2 * MAX_ITER : MAX_ITER;
   double f = residual(&s, w, w->y, w->F, w->mu, w->ie, w->phi, &size);
-  int it = 0, stalled = 0, rescued = 0, restarted = 0;
+  int it = 0, stalled = 0, rescued = 0;
   double rel_prev = 0;
   for (;;) {
     if (f <= try2 * size || stalled || it >= limit) {
@@ -2612,20 +2598,16 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
        * towards a stick it cannot reach in that form) go to impulse form
        * first, as after a failed line search, so that the stick solve
        * can take their patch */
-      int far = f > tol2 * size && !(f <= tol * size), r = 0;
+      int far = f > tol2 * size && !(f <= tol * size);
       if (far) {
-        if (restarted) break;
         if (!w->ns) {
           if (!(switch_all(w, &s) && reevaluate(m, d, &s, w, &f, &size))) break;
           have_H = 1;
         }
-        r = stick_try(m, d, &s, w, tol, residual_out);
-        if (r == 1) {
-          *iterations = it;
-          *sticking = w->ns;
-          return 1;
-        }
-        if (r != 2) break;
+        if (!stick_try(m, d, &s, w, tol, residual_out)) break;
+        *iterations = it;
+        *sticking = w->ns;
+        return 1;
       } else {
         /* the warm start may stand as it is (a settled body): then
          * neither the apply nor check's pass is needed, and w->lam holds
@@ -2637,18 +2619,8 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
         }
         apply(m, d, &s, w);
         *residual_out = check(m, d, &s, w);
-        if (*residual_out > tol && (stalled || it >= limit) && w->ns && !restarted)
-          r = stick_try(m, d, &s, w, tol, residual_out);
-      }
-      if (r == 2) {
-        /* Newton once more, from the stick solve's start (stick_try) */
-        restarted = 1;
-        if (!reevaluate(m, d, &s, w, &f, &size)) break;
-        have_H = 1;
-        stalled = 0;
-        limit = it + 2 * MAX_ITER;
-        rel_prev = 0;
-        continue;
+        if (*residual_out > tol && (stalled || it >= limit) && w->ns)
+          stick_try(m, d, &s, w, tol, residual_out);
       }
       if (*residual_out <= tol || stalled || it >= limit) {
         *iterations = it;
