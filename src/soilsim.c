@@ -1011,9 +1011,12 @@ static void print_summary(FILE *out, const Options *o, const ssModel *m,
     fprintf(out, "wall time   %.3f s\n", wall);
   if (steps > 0) {
     fprintf(out, "sweeps      %d", d->stats.sweeps);
-    if (d->stats.newton > 0)
-      fprintf(out, " after %d Newton iteration%s", d->stats.newton,
-              d->stats.newton == 1 ? "" : "s");
+    int newton = d->stats.newton - d->stats.creep, creep = d->stats.creep;
+    if (newton > 0)
+      fprintf(out, " after %d Newton iteration%s", newton, newton == 1 ? "" : "s");
+    if (creep > 0)
+      fprintf(out, "%s %d creeping pass%s", newton > 0 ? " and" : " after", creep,
+              creep == 1 ? "" : "es");
     fprintf(out, " (last step)");
     if (unconverged)
       fprintf(out, "; %ld step%s stopped at the sweep cap", unconverged,

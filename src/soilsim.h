@@ -435,6 +435,9 @@ typedef struct ssStepStats {
                                step by the laws' linear model, not evaluated
                                there (newton.c, apply_linear; checked as
                                every answer is) */
+  int creep;                /* passes over the points of the creeping solve
+                               among the sweeps (solver.h, ss_newton_creep;
+                               0: it did not run); newton counts them too */
   double residual;          /* final relative impulse change */
   int converged;            /* 1 if the tolerance was met */
   /* wall time of each stage of the last step (s): forward kinematics, free

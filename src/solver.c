@@ -1959,6 +1959,7 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
   st->newton = 0;
   st->newton_sticking = 0;
   st->newton_linear = 0;
+  st->creep = 0;
   d->solver_settled = 0;
   d->newton_rec[2].step = -1;
   if (m->nv) memcpy(d->qvel_free, d->qvel, (size_t)m->nv * sizeof(double));
@@ -2094,8 +2095,11 @@ ssStatus ss_solver_solve(const ssModel *m, ssData *d, ssError *err)
     /* the sweeps crawl: the creeping solve, where it applies */
     if ((sweep + 1) % CREEP_EVERY == 0 && !d->solver_gs_only && creep_tries < CREEP_TRIES) {
       if (sweep + 1 > CREEP_EVERY && creep_due(st->residual, r_before, tol)) {
+        int passes = 0;
         creep_tries++;
-        ss_newton_creep(m, d, first_row, tol, &st->newton);
+        ss_newton_creep(m, d, first_row, tol, &passes);
+        st->creep += passes;
+        st->newton += passes;
       }
       r_before = st->residual;
     }

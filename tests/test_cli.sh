@@ -493,6 +493,12 @@ run "$PLATE" --steps 50
 check "the summary reports the last step's sweeps and Newton iterations" \
   'rc_is 0 && out_has "sweeps      0 after 1 Newton iteration (last step)"'
 
+# ... and, where the creeping solve ran, its passes apart (drag.xml's
+# step 1159: its plate comes to rest rocking, stick and slip mixed).
+run "$top_srcdir/scenes/drag.xml" --steps 1159
+check "the summary reports the creeping solve's passes apart from Newton's iterations" \
+  'rc_is 0 && out_has "Newton iterations and " && out_has " creeping passes (last step)"'
+
 # An existing output file is replaced whole.
 echo "old" >"$tmp/old.xml"
 run "$PLATE" --steps 10 --export "$tmp/old.xml" --quiet
