@@ -1035,9 +1035,7 @@ static ssStatus compare_model(const ssModel *m, const Fingerprint *fc,
                               ssError *err)
 {
   Fingerprint fm, fl, fb;
-  if (!fingerprint(m, &fm, FP_NOW) || !fingerprint(m, &fl, FP_LEGACY) ||
-      !fingerprint(m, &fb, FP_NO_BETWEEN))
-    return ss_error_set(err, SS_ERR_NOMEM, path, 0, "out of memory");
+  if (!fingerprint(m, &fm, FP_NOW)) return ss_error_set(err, SS_ERR_NOMEM, path, 0, "out of memory");
   char from[600] = "";
   if (srclen) {
     char s[512];
@@ -1055,7 +1053,13 @@ static ssStatus compare_model(const ssModel *m, const Fingerprint *fc,
   size_t used = 0;
   /* a file of an earlier build holds the legacy hashes or those without
    * the materials between colliders (they differ from the current ones
-   * only in the groups with materials) */
+   * only in the groups with materials); formed only where the current
+   * ones do not all match (each variant hashes the whole model again) */
+  int match = 1;
+  for (int k = 0; k < NHASH; k++) match &= fc->hash[k] == fm.hash[k];
+  if (match) return SS_OK;
+  if (!fingerprint(m, &fl, FP_LEGACY) || !fingerprint(m, &fb, FP_NO_BETWEEN))
+    return ss_error_set(err, SS_ERR_NOMEM, path, 0, "out of memory");
   for (int k = 0; k < NHASH; k++)
     if (fc->hash[k] != fm.hash[k] && fc->hash[k] != fl.hash[k] && fc->hash[k] != fb.hash[k]) {
       int n = snprintf(what + used, sizeof what - used, "%s%s",

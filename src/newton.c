@@ -1689,6 +1689,25 @@ static void apply(const ssModel *m, ssData *d, const Setup *s, const ssNewtonWor
   apply_at(m, d, s, w, w->lam, w->F);
 }
 
+/* F + H dy, the sums' linear model at the end of the step dy, into out
+ * (linear_end; the creeping solve's step df = F + H dy - f) */
+static inline __attribute__((always_inline)) void linear_F(const Setup *s, const ssNewtonWork *w,
+                                                          double *out)
+{
+  for (int g = 0; g < s->ngroup; g++) {
+    const double *H = w->H + 36 * g, *dy = w->dy + 6 * g;
+    for (int a = 0; a < 6; a++) {
+      double t = w->F[6 * g + a];
+      for (int b = 0; b < 6; b++) t += H[6 * a + b] * dy[b];
+      out[6 * g + a] = t;
+    }
+  }
+  for (int r = 0; r < s->nrow; r++) {
+    int k = 6 * s->ngroup + r;
+    out[k] = w->F[k] + w->H[36 * s->ngroup + r] * w->dy[k];
+  }
+}
+
 /* The end of the step expected to end the solve, y + dy, by the laws'
  * linear model at y instead of an evaluation there: each soil point's
  * impulse lam + K X dy (0 where it was not loaded at y) and F + H dy, the
@@ -1734,18 +1753,7 @@ static inline __attribute__((always_inline)) int linear_end(const Setup *s, ssNe
       lt[2] = l[2] + K[2] * dv[0] + K[4] * dv[1] + K[5] * dv[2];
     }
   }
-  for (int g = 0; g < s->ngroup; g++) {
-    const double *H = w->H + 36 * g, *dy = w->dy + 6 * g;
-    for (int a = 0; a < 6; a++) {
-      double t = w->F[6 * g + a];
-      for (int b = 0; b < 6; b++) t += H[6 * a + b] * dy[b];
-      w->Ftry[6 * g + a] = t;
-    }
-  }
-  for (int r = 0; r < s->nrow; r++) {
-    int k = 6 * s->ngroup + r;
-    w->Ftry[k] = w->F[k] + w->H[36 * s->ngroup + r] * w->dy[k];
-  }
+  linear_F(s, w, w->Ftry);
   return 1;
 }
 
@@ -2908,9 +2916,8 @@ static void creep_eval(const ssData *d, const Setup *s, ssNewtonWork *w, const d
 static void held_impulses(const ssData *d, const Setup *s, ssNewtonWork *w, double *f)
 {
   for (int g = 0; g < s->ngroup; g++) memset(w->sum[g].F, 0, sizeof w->sum[g].F);
-  for (int i = 0; i < s->first_row; i++) {
+  for (int i = 0; i < s->first_row; i++)
     wrench_add(w->sum[w->group_of[i]].F, w->pt[i].r, d->contact[i].lambda);
-  }
   for (int g = 0; g < s->ngroup; g++) from_group(w->grp + g, w->sum[g].F, NULL, f + 6 * g, NULL);
   for (int r = 0; r < s->nrow; r++) f[6 * s->ngroup + r] = d->contact[s->first_row + r].lambda[0];
 }
@@ -2965,17 +2972,9 @@ static int creep_level(const ssData *d, const Setup *s, ssNewtonWork *w, Creep *
     if (!ss_lu_factor(w->A, w->piv, n)) return -1;
     for (int a = 0; a < n; a++) w->dy[a] = -w->phi[a];
     ss_lu_solve(w->A, w->piv, n, w->dy);
-    /* df = F - f + H dy */
-    for (int g = 0; g < s->ngroup; g++)
-      for (int a = 0; a < 6; a++) {
-        const double *Hr = w->H + 36 * g + 6 * a, *dy = w->dy + 6 * g;
-        c->df[6 * g + a] = w->F[6 * g + a] - c->f[6 * g + a] + Hr[0] * dy[0] + Hr[1] * dy[1] +
-                           Hr[2] * dy[2] + Hr[3] * dy[3] + Hr[4] * dy[4] + Hr[5] * dy[5];
-      }
-    for (int r = 0; r < s->nrow; r++) {
-      int k = 6 * s->ngroup + r;
-      c->df[k] = w->F[k] - c->f[k] + w->H[36 * s->ngroup + r] * w->dy[k];
-    }
+    /* df = F + H dy - f */
+    linear_F(s, w, c->df);
+    for (int a = 0; a < n; a++) c->df[a] -= c->f[a];
     double s0 = 0;
     for (int a = 0; a < n; a++) s0 += (c->f[a] - w->F[a]) * w->dy[a];
     /* (no descent: round-off at the answer, or the coupling's asymmetry
