@@ -1661,6 +1661,45 @@ static int edge_contacts(const ssShape *a, const ssShape *b, double margin, doub
   return cnt;
 }
 
+/* The crossings of box x's edges with cylinder y's side (ss_shape_pair_
+ * points' rule), into out (room for 4) in order of id (base + 8 + colour:
+ * the box's ids past its corners); flip as side_contacts' for the box's
+ * candidates.  Returns the count. */
+static int edge_side_contacts(const ssShape *x, const ssShape *y, int base, double margin,
+                              ssPairPoint *out)
+{
+  const double tol = 1e-9; /* of the edge's and the axis's lengths */
+  const double a[3] = {y->R[2], y->R[5], y->R[8]}, hl = 0.5 * y->size[1];
+  ssPairPoint slot[4];
+  int used[4] = {0};
+  for (int e = 0; e < 12; e++) {
+    double p0[3], d[3], r[3];
+    box_edge(x, e, p0, d);
+    /* the closest points of the edge's line, p0 + s d, and the axis's,
+     * pos + t a (|a| = 1) */
+    ss_v3_sub(r, p0, y->pos);
+    double A = ss_v3_dot(d, d), B = ss_v3_dot(d, a), C = ss_v3_dot(d, r), F = ss_v3_dot(a, r);
+    double den = A - B * B;
+    /* parallel (sine under 1e-6): the corners and the rims meet there */
+    if (!(den > 1e-12 * A)) continue;
+    double sp = (B * F - C) / den, t = (A * F - B * C) / den;
+    if (!(sp > tol && sp < 1 - tol && fabs(t) < hl * (1 - tol))) continue;
+    double p[3];
+    ss_v3_copy(p, p0);
+    ss_v3_addscl(p, d, sp);
+    ssPairPoint c;
+    int k = edge_colour[e];
+    if (!sphere_contact(y, p, 0, base != 0, base + 8 + k, margin, &c)) continue;
+    if (used[k] && !(c.gap < slot[k].gap)) continue;
+    used[k] = 1;
+    slot[k] = c;
+  }
+  int cnt = 0;
+  for (int k = 0; k < 4; k++)
+    if (used[k]) out[cnt++] = slot[k];
+  return cnt;
+}
+
 int ss_shape_pair_points(const ssShape *a, const ssShape *b, double margin,
                          ssPairPoint *out, int max)
 {
@@ -1670,6 +1709,10 @@ int ss_shape_pair_points(const ssShape *a, const ssShape *b, double margin,
   /* two boxes: their edges' crossings (ids 8..15, after a's corners) */
   if (a->type == SS_GEOM_BOX && b->type == SS_GEOM_BOX)
     k += edge_contacts(a, b, margin, 1e-9 * (shape_extent(a) + shape_extent(b)), all + k);
+  /* a box and a cylinder: the box's edges across the cylinder's side
+   * (ids 8..11 after a box's corners, 24..27 after b's) */
+  if (a->type == SS_GEOM_BOX && b->type == SS_GEOM_CYLINDER)
+    k += edge_side_contacts(a, b, 0, margin, all + k);
   /* two spheres touch at one point, which a's candidate gives exactly */
   if (!(a->type == SS_GEOM_SPHERE && b->type == SS_GEOM_SPHERE)) {
     int nb = side_contacts(b, a, 16, margin, bs);
@@ -1679,6 +1722,8 @@ int ss_shape_pair_points(const ssShape *a, const ssShape *b, double margin,
       for (int i = 0; i < ka && !dup; i++) dup = same_contact(&all[i], &bs[j], tol);
       if (!dup) all[k++] = bs[j];
     }
+    if (b->type == SS_GEOM_BOX && a->type == SS_GEOM_CYLINDER)
+      k += edge_side_contacts(b, a, 16, margin, all + k);
   }
   if (k > max) k = max;
   for (int i = 0; i < k; i++) out[i] = all[i];

@@ -272,7 +272,9 @@ typedef struct ssPairPoint {
   double gap;     /* signed separation along n, < 0 penetrating */
   int id;         /* the feature: [0, 16) a's candidates, [16, 32) b's
                      (two boxes: 0..7 a's corners, 8..15 edge crossings,
-                     16..23 b's corners), the same number from step to
+                     16..23 b's corners; a box and a cylinder: the box's
+                     corners, then its edges across the cylinder's side
+                     at 8..11 past them), the same number from step to
                      step while the same feature touches */
 } ssPairPoint;
 #define SS_PAIR_POINTS_MAX 32
@@ -345,9 +347,30 @@ typedef struct ssPairPoint {
  * octagon.  Edge pairs on the same id otherwise (deep overlaps): the
  * deepest (least gap) kept, the first in order (ea, eb) on ties.
  *
- * Limits: boxes against anything but a box test only points (corners,
- * rims, spheres), never edges -- a box edge across a cylinder's side
- * finds no contact until a corner reaches the other; the crossings of two
+ * A box and a cylinder: also the box's edges across the cylinder's side
+ * (ids 8..11 past the box's corners: 8..11 where the box is a, 24..27
+ * where it is b).  An edge e (12) is a contact where the closest points
+ * of its line and the cylinder's axis are, on the edge, strictly inside
+ * it (over 1e-9 of its length from either end: at an end its corner
+ * holds it) and, on the axis, strictly between the caps (within 1e-9 of
+ * the half length of neither: there the rims hold it), the edge and the
+ * axis not parallel (sine over 1e-6: a box's edge along a cylinder is
+ * held by corners and rims); at that point p of the edge, its point
+ * nearest the axis and so deepest into the side, the contact is p's as a
+ * corner's (gap sdf_cyl(p), the cylinder's normal there).  Its id: the
+ * base past the box's corners plus the edge's colour (0..3, as above);
+ * two edges of one colour (never two of one face, nor two that share a
+ * corner): the deepest kept, the first in order on ties.  The segment a
+ * cylinder's side shares with a box's face ends at the cylinder's caps
+ * (its lowest rim points) or where it crosses the face's edges (these
+ * contacts), so a log lying across a narrower table rests on the
+ * table's two edges under it and a crate across a log on its two bottom
+ * edges over the log's top line.
+ *
+ * Limits: boxes against a sphere or a capsule, and cylinders against
+ * cylinders and capsules, test only points (corners, rims, spheres),
+ * never edges or sides -- a log lying across another log finds no
+ * contact until a rim reaches the other, so it falls into it; the crossings of two
  * boxes go by the separating axis test's best axis, so where two boxes
  * overlap deeply in every direction they are where the least overlap's
  * axis says, not every place edges cross, and their ids may collide there

@@ -1,7 +1,8 @@
 /* test_bodies.c -- contacts between bodies (DESIGN 3: rigid contacts
  * between bodies, a Coulomb cone solved in the sweeps): a body on a static
- * one, a stack, two balls meeting in free space, sliding on a static
- * body, a link against a static body.  Numbers from closed forms: rest
+ * one, a stack, a log across a table and a crate across a log, two balls
+ * meeting in free space, sliding on a static body, a link against a
+ * static body.  Numbers from closed forms: rest
  * heights from the shapes' sizes, momentum and restitution for the balls,
  * mu g for sliding.  Before these contacts existed every body passed
  * through every other. */
@@ -183,10 +184,53 @@ static void test_slide(void)
   drop(m, d);
 }
 
+/* A log lying across something narrower than itself, and a crate lying
+ * across a log: each rests on the crossings of the box's edges with the
+ * log's side.  A 2 m log (r 0.1, 20 kg) dropped across a 1 m static table
+ * (top at 0.4 m) rests with its axis at 0.5; a crate (0.3 x 0.3 x 0.2, 5
+ * kg, turned 15 degrees about z) dropped across a static log (r 0.2,
+ * axis at 0.2 m) rests at 0.5.  Both fell: the log through the table to
+ * the ground (0.1), the crate into the log until its corners met it
+ * (0.470).  Tolerance as test_on_static's. */
+static void test_across_log(void)
+{
+  const char *xml =
+      "<raisim version=\"1.0\"><timeStep value=\"0.001\"/><objects>"
+      "<ground name=\"g\" height=\"0\"/>"
+      "<box name=\"table\" body_type=\"static\"><dim x=\"1\" y=\"1\" z=\"0.4\"/>"
+      "<state pos=\"0 0 0.2\"/></box>"
+      "<cylinder name=\"log\" mass=\"20\"><dim radius=\"0.1\" height=\"2\"/>"
+      "<state pos=\"0.05 0 0.505\" quat=\"0.7071067811865476 -0.7071067811865476 0 0\"/>"
+      "</cylinder>"
+      "<cylinder name=\"static_log\" body_type=\"static\"><dim radius=\"0.2\" height=\"2\"/>"
+      "<state pos=\"3 0 0.2\" quat=\"0.7071067811865476 -0.7071067811865476 0 0\"/>"
+      "</cylinder>"
+      "<box name=\"crate\" mass=\"5\"><dim x=\"0.3\" y=\"0.3\" z=\"0.2\"/>"
+      "<state pos=\"3 0.1 0.505\" quat=\"0.9914448613738104 0 0 0.13052619222005157\"/></box>"
+      "</objects></raisim>";
+  ssModel *m;
+  ssData *d;
+  if (!load(xml, &m, &d)) {
+    ok(0, "across a log: loads");
+    return;
+  }
+  int lg = ss_model_find_sys(m, "log"), cr = ss_model_find_sys(m, "crate");
+  int good = lg >= 0 && cr >= 0 && steps(m, d, 2000);
+  const double *ql = d->qpos + m->sys_qadr[lg], *qc = d->qpos + m->sys_qadr[cr];
+  double sl = speed(d->qvel + m->sys_vadr[lg]), sc = speed(d->qvel + m->sys_vadr[cr]);
+  ok(good && fabs(ql[2] - 0.5) <= 1e-6 && sl <= 1e-6,
+     "a 2 m log dropped across a 1 m static table rests on the table's edges: z %.9f m (0.5), "
+     "speed %.3g", ql[2], sl);
+  ok(good && fabs(qc[2] - 0.5) <= 1e-6 && sc <= 1e-6,
+     "a crate dropped across a static log rests on it: z %.9f m (0.5), speed %.3g", qc[2], sc);
+  drop(m, d);
+}
+
 int main(void)
 {
   test_on_static();
   test_stack();
+  test_across_log();
   test_balls();
   test_slide();
   return done_testing();

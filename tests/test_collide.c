@@ -1588,6 +1588,14 @@ static int all_up_at(const ssPairPoint *out, int n, double want, double tol)
   return n > 0;
 }
 
+/* no edge-side contact (ids 8..15 or 24..31) among out[0..n) */
+static int edge_side_none(const ssPairPoint *out, int n)
+{
+  for (int i = 0; i < n; i++)
+    if ((out[i].id >= 8 && out[i].id < 16) || out[i].id >= 24) return 0;
+  return 1;
+}
+
 static void test_pair_points(void)
 {
   const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, up[3] = {0, 0, 1}, tol = 1e-12;
@@ -1715,6 +1723,45 @@ static void test_pair_points(void)
   ok(rim && all_up_at(out, n, -0.002, tol),
      "pair: a cylinder standing on its end: its bottom cap's 8 rim points (ids 0, 2-8), gap -0.002");
   ok(pair_swaps(&post, &slab, 0.01), "pair: standing cylinder and box swapped: the same, n -z");
+
+  /* a box (0.3 x 0.3 x 0.2) across a log (r 0.2, 2 long, its axis along
+   * y through the origin), turned 10-20 degrees about z, its bottom 2 mm
+   * into the log's top: its corners and the log's rims are far (no
+   * contact), but the two bottom edges that cross the log's top line do,
+   * each at its point over the axis, gap -0.002, n +z (ids 8..11).  It
+   * found none: a crate sank into a log until its corners met it. */
+  rot_wheel(R, 0, 0);
+  ssShape log_ = make_shape(SS_GEOM_CYLINDER, 0.2, 2, 0, 0, 0, 0, R);
+  rot_z(R, urand(10, 20) * PI / 180);
+  ssShape crate = make_shape(SS_GEOM_BOX, 0.3, 0.3, 0.2, 0, 0, 0.298, R);
+  n = ss_shape_pair_points(&crate, &log_, 0.01, out, SS_PAIR_POINTS_MAX);
+  int across = n == 2 && all_up_at(out, n, -0.002, tol);
+  for (int i = 0; i < n && across; i++)
+    across = out[i].id >= 8 && out[i].id < 12 && fabs(out[i].pos[0]) <= tol &&
+             fabs(out[i].pos[2] - 0.198) <= tol;
+  ok(across && out[0].pos[1] * out[1].pos[1] < 0,
+     "pair: a box across a cylinder's side: the two bottom edges over the axis (ids 8-11), "
+     "gap -0.002, n +z (%d contacts)", n);
+  ok(pair_swaps(&crate, &log_, 0.01), "pair: box across a cylinder swapped: the same, ids 24-27, n -z");
+  /* a log (r 0.1, 2 long) across a 1 m wide box, 1 mm in: the box's two
+   * top edges under it, at y = +-0.5 (the log's rims overhang) */
+  rot_wheel(R, 0, urand(0, 2 * PI));
+  log_ = make_shape(SS_GEOM_CYLINDER, 0.1, 2, 0, 0.1, 0, 0.099, R);
+  n = ss_shape_pair_points(&log_, &slab, 0.01, out, SS_PAIR_POINTS_MAX);
+  across = n == 2 && all_up_at(out, n, -0.001, tol);
+  for (int i = 0; i < n && across; i++)
+    across = out[i].id >= 24 && out[i].id < 28 && fabs(fabs(out[i].pos[1]) - 0.5) <= tol &&
+             fabs(out[i].pos[0] - 0.1) <= tol && fabs(out[i].pos[2]) <= tol;
+  ok(across, "pair: a cylinder across a narrower box: the box's two top edges under it (ids 24-27), "
+     "gap -0.001, n +z (%d contacts)", n);
+  /* parallel to the axis: no edge contact (the rims and corners hold it) */
+  rot_wheel(R, 0, 0);
+  log_ = make_shape(SS_GEOM_CYLINDER, 0.2, 2, 0, 0, 0, 0, R);
+  double Rq[9];
+  rot_y(Rq, 0.25 * PI);
+  ssShape ridge = make_shape(SS_GEOM_BOX, 0.3, 0.3, 0.3, 0, 0, 0.2 + 0.15 * sqrt(2) - 0.001, Rq);
+  n = ss_shape_pair_points(&ridge, &log_, 0.01, out, SS_PAIR_POINTS_MAX);
+  ok(edge_side_none(out, n), "pair: a box's edge along a cylinder's axis: no edge contact (%d)", n);
 
   /* the margin: a gap of half the margin kept, of 1.5 margins dropped */
   memcpy(top.R, I, sizeof I);
