@@ -1661,10 +1661,10 @@ static int edge_contacts(const ssShape *a, const ssShape *b, double margin, doub
   return cnt;
 }
 
-/* The crossings of box x's edges with cylinder y's side (ss_shape_pair_
- * points' rule), into out (room for 4) in order of id (base + 8 + colour:
- * the box's ids past its corners); flip as side_contacts' for the box's
- * candidates.  Returns the count. */
+/* The crossings of box x's edges with round y's side (a cylinder's or a
+ * capsule's; ss_shape_pair_points' rule), into out (room for 4) in order
+ * of id (base + 8 + colour: the box's ids past its corners); flip as
+ * side_contacts' for the box's candidates.  Returns the count. */
 static int edge_side_contacts(const ssShape *x, const ssShape *y, int base, double margin,
                               ssPairPoint *out)
 {
@@ -1700,18 +1700,81 @@ static int edge_side_contacts(const ssShape *x, const ssShape *y, int base, doub
   return cnt;
 }
 
+static int is_round(int t)
+{
+  return t == SS_GEOM_CYLINDER || t == SS_GEOM_CAPSULE;
+}
+
+/* The contact of two round shapes' sides (cylinders' or capsules') where
+ * their axes cross (ss_shape_pair_points' rule): 1 with it in *out, its
+ * point on b's side where on_b, else on a's; 0 where there is none. */
+static int axis_contact(const ssShape *a, const ssShape *b, double margin, int on_b,
+                        ssPairPoint *out)
+{
+  const double tol = 1e-9; /* of the half lengths */
+  const double ua[3] = {a->R[2], a->R[5], a->R[8]}, ub[3] = {b->R[2], b->R[5], b->R[8]};
+  const double ha = 0.5 * a->size[1], hb = 0.5 * b->size[1];
+  double r[3], c[3];
+  ss_v3_sub(r, a->pos, b->pos);
+  ss_v3_cross(c, ua, ub);
+  double B = ss_v3_dot(ua, ub), C = ss_v3_dot(ua, r), F = ss_v3_dot(ub, r);
+  double cc = ss_v3_dot(c, c);
+  /* parallel (sine under 1e-6): the rims and ends meet there */
+  if (!(cc > 1e-12)) return 0;
+  double sa = (B * F - C) / cc, tb = (F - B * C) / cc;
+  if (!(fabs(sa) < ha * (1 - tol) && fabs(tb) < hb * (1 - tol))) return 0;
+  double pa[3], pb[3], w[3], n[3];
+  ss_v3_copy(pa, a->pos);
+  ss_v3_addscl(pa, ua, sa);
+  ss_v3_copy(pb, b->pos);
+  ss_v3_addscl(pb, ub, tb);
+  ss_v3_sub(w, pa, pb);
+  /* the common normal of the axes, from b's towards a's (where they
+   * meet, towards a's centre) */
+  double cn = sqrt(cc), side = ss_v3_dot(w, c);
+  if (side == 0) side = ss_v3_dot(r, c);
+  ss_v3_scale(n, c, side < 0 ? -1 / cn : 1 / cn);
+  double gap = ss_v3_dot(w, n) - a->size[0] - b->size[0];
+  if (!(gap <= margin)) return 0;
+  if (on_b) {
+    ss_v3_copy(out->pos, pb);
+    ss_v3_addscl(out->pos, n, b->size[0]);
+  } else {
+    ss_v3_copy(out->pos, pa);
+    ss_v3_addscl(out->pos, n, -a->size[0]);
+  }
+  ss_v3_copy(out->n, n);
+  out->gap = gap;
+  return 1;
+}
+
+/* p into all[0..*k), kept in order of id: where no contact holds its id
+ * and none is the same point with the same normal (same_contact) */
+static void put_extra(ssPairPoint *all, int *k, const ssPairPoint *p, double tol)
+{
+  int at = *k;
+  for (int i = 0; i < *k; i++) {
+    if (all[i].id == p->id || same_contact(&all[i], p, tol)) return;
+    if (all[i].id > p->id && at == *k) at = i;
+  }
+  for (int i = *k; i > at; i--) all[i] = all[i - 1];
+  all[at] = *p;
+  (*k)++;
+}
+
 int ss_shape_pair_points(const ssShape *a, const ssShape *b, double margin,
                          ssPairPoint *out, int max)
 {
   if (max <= 0 || !pair_type(a->type) || !pair_type(b->type)) return 0;
-  ssPairPoint all[SS_PAIR_POINTS_MAX], bs[16];
+  /* (one more: two cylinders' 32 candidates and their sides' contact) */
+  ssPairPoint all[SS_PAIR_POINTS_MAX + 1], bs[16];
   int k = side_contacts(a, b, 0, margin, all), ka = k;
   /* two boxes: their edges' crossings (ids 8..15, after a's corners) */
   if (a->type == SS_GEOM_BOX && b->type == SS_GEOM_BOX)
     k += edge_contacts(a, b, margin, 1e-9 * (shape_extent(a) + shape_extent(b)), all + k);
-  /* a box and a cylinder: the box's edges across the cylinder's side
-   * (ids 8..11 after a box's corners, 24..27 after b's) */
-  if (a->type == SS_GEOM_BOX && b->type == SS_GEOM_CYLINDER)
+  /* a box and a cylinder or a capsule: the box's edges across the
+   * other's side (ids 8..11 after a box's corners, 24..27 after b's) */
+  if (a->type == SS_GEOM_BOX && is_round(b->type))
     k += edge_side_contacts(a, b, 0, margin, all + k);
   /* two spheres touch at one point, which a's candidate gives exactly */
   if (!(a->type == SS_GEOM_SPHERE && b->type == SS_GEOM_SPHERE)) {
@@ -1722,8 +1785,21 @@ int ss_shape_pair_points(const ssShape *a, const ssShape *b, double margin,
       for (int i = 0; i < ka && !dup; i++) dup = same_contact(&all[i], &bs[j], tol);
       if (!dup) all[k++] = bs[j];
     }
-    if (b->type == SS_GEOM_BOX && a->type == SS_GEOM_CYLINDER)
+    if (b->type == SS_GEOM_BOX && is_round(a->type))
       k += edge_side_contacts(b, a, 16, margin, all + k);
+    /* a cylinder and a cylinder or a capsule: their sides where the axes
+     * cross, a capsule's id 3 (19 as b), else a's id 5 (its rim point
+     * farthest from b, which gives way to it) */
+    ssPairPoint x;
+    int cyl_a = a->type == SS_GEOM_CYLINDER, cyl_b = b->type == SS_GEOM_CYLINDER;
+    if (is_round(a->type) && is_round(b->type) && (cyl_a || cyl_b) &&
+        axis_contact(a, b, margin, !cyl_b, &x)) {
+      x.id = !cyl_a ? 3 : !cyl_b ? 19 : 5;
+      if (cyl_a && cyl_b)
+        for (int i = 0; i < k; i++)
+          if (all[i].id == 5) all[i] = x;
+      put_extra(all, &k, &x, tol);
+    }
   }
   if (k > max) k = max;
   for (int i = 0; i < k; i++) out[i] = all[i];

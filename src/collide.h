@@ -272,10 +272,12 @@ typedef struct ssPairPoint {
   double gap;     /* signed separation along n, < 0 penetrating */
   int id;         /* the feature: [0, 16) a's candidates, [16, 32) b's
                      (two boxes: 0..7 a's corners, 8..15 edge crossings,
-                     16..23 b's corners; a box and a cylinder: the box's
-                     corners, then its edges across the cylinder's side
-                     at 8..11 past them), the same number from step to
-                     step while the same feature touches */
+                     16..23 b's corners; a box and a cylinder or capsule:
+                     the box's corners, then its edges across the other's
+                     side at 8..11 past them; a cylinder's or capsule's
+                     side against a cylinder's: 3 or 19 on a capsule, 5
+                     on a cylinder a), the same number from step to step
+                     while the same feature touches */
 } ssPairPoint;
 #define SS_PAIR_POINTS_MAX 32
 /* Contacts of a with b (one frame): a's candidate points within margin of
@@ -347,37 +349,54 @@ typedef struct ssPairPoint {
  * octagon.  Edge pairs on the same id otherwise (deep overlaps): the
  * deepest (least gap) kept, the first in order (ea, eb) on ties.
  *
- * A box and a cylinder: also the box's edges across the cylinder's side
- * (ids 8..11 past the box's corners: 8..11 where the box is a, 24..27
- * where it is b).  An edge e (12) is a contact where the closest points
- * of its line and the cylinder's axis are, on the edge, strictly inside
- * it (over 1e-9 of its length from either end: at an end its corner
- * holds it) and, on the axis, strictly between the caps (within 1e-9 of
- * the half length of neither: there the rims hold it), the edge and the
- * axis not parallel (sine over 1e-6: a box's edge along a cylinder is
- * held by corners and rims); at that point p of the edge, its point
- * nearest the axis and so deepest into the side, the contact is p's as a
- * corner's (gap sdf_cyl(p), the cylinder's normal there).  Its id: the
- * base past the box's corners plus the edge's colour (0..3, as above);
- * two edges of one colour (never two of one face, nor two that share a
- * corner): the deepest kept, the first in order on ties.  The segment a
- * cylinder's side shares with a box's face ends at the cylinder's caps
- * (its lowest rim points) or where it crosses the face's edges (these
- * contacts), so a log lying across a narrower table rests on the
- * table's two edges under it and a crate across a log on its two bottom
- * edges over the log's top line.
+ * A box and a cylinder or a capsule (round, below): also the box's edges
+ * across the round shape's side (ids 8..11 past the box's corners: 8..11
+ * where the box is a, 24..27 where it is b).  An edge e (12) is a
+ * contact where the closest points of its line and the round shape's
+ * axis are, on the edge, strictly inside it (over 1e-9 of its length
+ * from either end: at an end its corner holds it) and, on the axis,
+ * strictly between its ends (within 1e-9 of the half length of neither:
+ * there a cylinder's rims or a capsule's end spheres hold it), the edge
+ * and the axis not parallel (sine over 1e-6: a box's edge along a
+ * cylinder is held by corners and rims); at that point p of the edge,
+ * its point nearest the axis and so deepest into the side, the contact
+ * is p's as a corner's (gap sdf(p), the round shape's normal there).
+ * Its id: the base past the box's corners plus the edge's colour (0..3,
+ * as above); two edges of one colour (never two of one face, nor two
+ * that share a corner): the deepest kept, the first in order on ties.
+ * The segment a cylinder's side shares with a box's face ends at the
+ * cylinder's caps (its lowest rim points) or where it crosses the face's
+ * edges (these contacts), so a log lying across a narrower table rests
+ * on the table's two edges under it and a crate across a log on its two
+ * bottom edges over the log's top line.
  *
- * Limits: boxes against a sphere or a capsule, and cylinders against
- * cylinders and capsules, test only points (corners, rims, spheres),
- * never edges or sides -- a log lying across another log finds no
- * contact until a rim reaches the other, so it falls into it; the crossings of two
- * boxes go by the separating axis test's best axis, so where two boxes
- * overlap deeply in every direction they are where the least overlap's
- * axis says, not every place edges cross, and their ids may collide there
- * (one kept); a cylinder's rim is sampled at 8 points a cap (its
- * side on a face it finds exactly, through the lowest rim points); a
- * capsule's middle point is taken towards o's centre, not o's nearest
- * point, exact on a large flat face under it but not across o's edge. */
+ * A cylinder and a cylinder or a capsule: also their sides where their
+ * axes cross.  Where the closest points of the two axes' lines, pa on
+ * a's and pb on b's, lie strictly between each one's ends (as above) and
+ * the axes are not parallel (sine over 1e-6), n is the unit common
+ * normal a's axis x b's, turned so that (pa - pb) . n > 0 (where the
+ * axes meet, (a.pos - b.pos) . n >= 0), and the gap (pa - pb) . n - r_a
+ * - r_b; kept within margin.  Its point and id: on the capsule's side
+ * where one is a capsule (pa - r_a n with id 3, or pb + r_b n with id 19:
+ * past the capsule's three candidates), on a's side where both are
+ * cylinders (pa - r_a n, id 5: the slot of a's rim point farthest from b
+ * on its first cap, which gives way to it where it is within margin as
+ * well).  A contact of the same point and normal as one already there
+ * (same_contact: a capsule's middle point where the axes cross square
+ * at its centre) is not added again.  So a log dropped across another
+ * rests on it.  Two capsules keep their points (their middle points).
+ *
+ * Limits: two capsules, and a cylinder's cap rim against another's side
+ * between its sample points, test only points (rims, spheres); the
+ * crossings of two boxes go by the separating axis test's best axis, so
+ * where two boxes overlap deeply in every direction they are where the
+ * least overlap's axis says, not every place edges cross, and their ids
+ * may collide there (one kept); a cylinder's rim is sampled at 8 points
+ * a cap (its side on a face it finds exactly, through the lowest rim
+ * points); a capsule's middle point is taken towards o's centre, not o's
+ * nearest point, exact on a large flat face under it (across a box's
+ * edges or a cylinder's side the contacts above hold it), but two
+ * capsules crossed away from their centres meet late. */
 int ss_shape_pair_points(const ssShape *a, const ssShape *b, double margin,
                          ssPairPoint *out, int max);
 /* Effective width b (DESIGN 2.4), measured in the shape's own frame so that

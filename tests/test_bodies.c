@@ -1,6 +1,7 @@
 /* test_bodies.c -- contacts between bodies (DESIGN 3: rigid contacts
  * between bodies, a Coulomb cone solved in the sweeps): a body on a static
- * one, a stack, a log across a table and a crate across a log, two balls
+ * one, a stack, a log across a table, a crate across a log and crossed
+ * logs, two balls
  * meeting in free space, sliding on a static body, a link against a
  * static body.  Numbers from closed forms: rest
  * heights from the shapes' sizes, momentum and restitution for the balls,
@@ -226,11 +227,53 @@ static void test_across_log(void)
   drop(m, d);
 }
 
+/* A log (r 0.1, 10 kg) dropped crosswise onto a static log (r 0.2, axis
+ * at 0.2 m), centred over it, and a capsule the same onto another: each
+ * rests where the axes cross, its axis at 0.2 + 0.2 + 0.1 = 0.5 m.  The
+ * log fell into the lower log and on to the ground (0.1); the capsule's
+ * middle point (towards the lower log's centre, which it crosses square)
+ * held it before as well.  Tolerance as test_on_static's. */
+static void test_crossed_logs(void)
+{
+  const char *xml =
+      "<raisim version=\"1.0\"><timeStep value=\"0.001\"/><objects>"
+      "<ground name=\"g\" height=\"0\"/>"
+      "<cylinder name=\"low\" body_type=\"static\"><dim radius=\"0.2\" height=\"2\"/>"
+      "<state pos=\"0 0 0.2\" quat=\"0.7071067811865476 -0.7071067811865476 0 0\"/>"
+      "</cylinder>"
+      "<cylinder name=\"up\" mass=\"10\"><dim radius=\"0.1\" height=\"2\"/>"
+      "<state pos=\"0 0.3 0.505\" quat=\"0.7071067811865476 0 0.7071067811865476 0\"/>"
+      "</cylinder>"
+      "<cylinder name=\"low2\" body_type=\"static\"><dim radius=\"0.2\" height=\"2\"/>"
+      "<state pos=\"4 0 0.2\" quat=\"0.7071067811865476 -0.7071067811865476 0 0\"/>"
+      "</cylinder>"
+      "<capsule name=\"cap\" mass=\"10\"><dim radius=\"0.1\" height=\"1.5\"/>"
+      "<state pos=\"4 -0.2 0.505\" quat=\"0.7071067811865476 0 0.7071067811865476 0\"/>"
+      "</capsule></objects></raisim>";
+  ssModel *m;
+  ssData *d;
+  if (!load(xml, &m, &d)) {
+    ok(0, "crossed logs: loads");
+    return;
+  }
+  int up = ss_model_find_sys(m, "up"), cap = ss_model_find_sys(m, "cap");
+  int good = up >= 0 && cap >= 0 && steps(m, d, 2000);
+  const double *qu = d->qpos + m->sys_qadr[up], *qc = d->qpos + m->sys_qadr[cap];
+  double su = speed(d->qvel + m->sys_vadr[up]), sc = speed(d->qvel + m->sys_vadr[cap]);
+  ok(good && fabs(qu[2] - 0.5) <= 1e-6 && su <= 1e-6,
+     "a log dropped crosswise onto a static log rests on it: z %.9f m (0.5), speed %.3g", qu[2], su);
+  ok(good && fabs(qc[2] - 0.5) <= 1e-6 && sc <= 1e-6,
+     "a capsule dropped crosswise onto a static log rests on it: z %.9f m (0.5), speed %.3g", qc[2],
+     sc);
+  drop(m, d);
+}
+
 int main(void)
 {
   test_on_static();
   test_stack();
   test_across_log();
+  test_crossed_logs();
   test_balls();
   test_slide();
   return done_testing();

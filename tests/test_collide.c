@@ -1754,6 +1754,49 @@ static void test_pair_points(void)
              fabs(out[i].pos[0] - 0.1) <= tol && fabs(out[i].pos[2]) <= tol;
   ok(across, "pair: a cylinder across a narrower box: the box's two top edges under it (ids 24-27), "
      "gap -0.001, n +z (%d contacts)", n);
+  /* the same box across a capsule of the same radius and segment: the
+   * same two edges (ids 8..11), and the swap */
+  rot_wheel(R, 0, 0);
+  ssShape caplog = make_shape(SS_GEOM_CAPSULE, 0.2, 2, 0, 0, 0, 0, R);
+  n = ss_shape_pair_points(&crate, &caplog, 0.01, out, SS_PAIR_POINTS_MAX);
+  int on_cap = 0;
+  for (int i = 0; i < n; i++)
+    on_cap += out[i].id >= 8 && out[i].id < 12 && fabs(out[i].gap + 0.002) <= tol &&
+              near3(out[i].n, up, tol) && fabs(out[i].pos[2] - 0.198) <= tol;
+  ok(on_cap == 2 && pair_swaps(&crate, &caplog, 0.01),
+     "pair: a box across a capsule's side: the two bottom edges over the axis, gap -0.002, n +z; "
+     "swapped the same");
+  /* two logs crossed: b (r 0.2) along y through the origin, a (r 0.1)
+   * along x over it, 1 mm in: one contact of their sides where the axes
+   * cross, a's id 5, gap -0.001, n +z (b to a), on a's surface; the rims
+   * are far.  It found none: the upper log fell into the lower. */
+  rot_wheel(R, 0, urand(0, 2 * PI));
+  ssShape low = make_shape(SS_GEOM_CYLINDER, 0.2, 2, 0, 0, 0, 0, R);
+  rot_wheel(R, 0.5 * PI, urand(0, 2 * PI));
+  ssShape high = make_shape(SS_GEOM_CYLINDER, 0.1, 2, 0, 0.2, 0.3, 0.299, R);
+  double at_a[3] = {0, 0.3, 0.199}, at_b[3] = {0, 0.3, 0.2}, down[3] = {0, 0, -1};
+  n = ss_shape_pair_points(&high, &low, 0.01, out, SS_PAIR_POINTS_MAX);
+  int crossed = n == 1 && out[0].id == 5 && all_up_at(out, n, -0.001, tol) && near3(out[0].pos, at_a, tol);
+  n = ss_shape_pair_points(&low, &high, 0.01, out, SS_PAIR_POINTS_MAX);
+  crossed = crossed && n == 1 && out[0].id == 5 && fabs(out[0].gap + 0.001) <= tol &&
+            near3(out[0].n, down, tol) && near3(out[0].pos, at_b, tol);
+  ok(crossed, "pair: two cylinders crossed, 1 mm in: their sides' one contact where the axes "
+     "cross (a's id 5), gap -0.001, n from b to a, on a's surface either way round");
+  /* a capsule (r 0.1) crossing the lower log at 30 degrees from x, its
+   * centre off the log's axis: the sides' contact (the capsule's id 3, 19
+   * as b) where the axes cross, not only its middle point's towards the
+   * log's centre */
+  double A30[9], W[9];
+  rot_wheel(W, 0.5 * PI, 0);
+  rot_z(A30, PI / 6);
+  ss_m3_mul(R, A30, W);
+  ssShape capx = make_shape(SS_GEOM_CAPSULE, 0.1, 2, 0, 0, 0.3, 0.299, R);
+  n = ss_shape_pair_points(&capx, &low, 0.01, out, SS_PAIR_POINTS_MAX);
+  pc = pair_find(out, n, 3);
+  ok(pc && fabs(pc->gap + 0.001) <= tol && near3(pc->n, up, tol) && near3(pc->pos, at_a, tol) &&
+         pair_swaps(&capx, &low, 0.01),
+     "pair: a capsule across a cylinder: their sides' contact where the axes cross (id 3), "
+     "gap %.12g, n +z; swapped, id 19", pc ? pc->gap : NAN);
   /* parallel to the axis: no edge contact (the rims and corners hold it) */
   rot_wheel(R, 0, 0);
   log_ = make_shape(SS_GEOM_CYLINDER, 0.2, 2, 0, 0, 0, 0, R);
@@ -1824,6 +1867,42 @@ static int edge_swaps(const ssShape *a, const ssShape *b, double margin, double 
     if (!found) return 0;
   }
   return 1;
+}
+
+/* Random overlapping pairs of every kind ss_shape_pair_points takes
+ * (box, sphere, cylinder, capsule, random sizes and poses): at most
+ * SS_PAIR_POINTS_MAX contacts, their ids in [0, 32) strictly rising (a
+ * contact's warm-start key is its id: two of one id would share one),
+ * unit normals, gaps within the margin, points finite. */
+static void test_pair_random(void)
+{
+  static const int types[4] = {SS_GEOM_BOX, SS_GEOM_SPHERE, SS_GEOM_CYLINDER, SS_GEOM_CAPSULE};
+  const double margin = 0.01;
+  int bad = 0, with = 0, most = 0;
+  for (int t = 0; t < 4000; t++) {
+    ssShape sh[2];
+    for (int k = 0; k < 2; k++) {
+      double R[9];
+      rot_random(R);
+      sh[k] = make_shape(types[(t >> (2 * k)) & 3], urand(0.05, 0.5), urand(0.05, 2),
+                         urand(0.05, 0.5), urand(-0.3, 0.3), urand(-0.3, 0.3), urand(-0.3, 0.3), R);
+    }
+    ssPairPoint out[SS_PAIR_POINTS_MAX];
+    int n = ss_shape_pair_points(&sh[0], &sh[1], margin, out, SS_PAIR_POINTS_MAX);
+    with += n > 0;
+    most = n > most ? n : most;
+    for (int i = 0; i < n; i++) {
+      const ssPairPoint *q = out + i;
+      int good = q->id >= 0 && q->id < 32 && (i == 0 || q->id > out[i - 1].id) &&
+                 fabs(ss_v3_norm(q->n) - 1) <= 1e-12 && q->gap <= margin &&
+                 isfinite(q->pos[0] + q->pos[1] + q->pos[2]);
+      bad += !good;
+    }
+  }
+  ok(bad == 0 && with > 1000 && most <= SS_PAIR_POINTS_MAX,
+     "pair: 4000 random pairs of boxes, spheres, cylinders and capsules (%d touching, at most %d "
+     "contacts): ids rising within [0, 32), unit normals, gaps within the margin (%d bad)", with,
+     most, bad);
 }
 
 static void test_pair_edges(void)
@@ -2044,5 +2123,6 @@ int main(void)
   test_shape_sdf();
   test_pair_points();
   test_pair_edges();
+  test_pair_random();
   return done_testing();
 }

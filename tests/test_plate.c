@@ -631,14 +631,19 @@ static void test_rigid_warm(void)
  * meet each other, the map's peaks meet them and boxes meet edge on edge,
  * the bodies tumble into other rest places (the scene is chaotic: any
  * change early in the run moves where each one ends), and the count
- * follows them: across this session's builds 4 to 57 capped steps and 4.3
- * to 15.2 sweeps a step over steps 2001-3000 (40 and 12.4 now; each capped
- * run a round body rolling on a hilltop vertex and its own candidate,
- * residuals 1e-7 to 1e-5, no pair contact in it).  The bounds, 60 capped
- * and 20 sweeps a step, keep that spread and still fail where the blocks
- * or the warm start break (a pass a block and cold rigid contacts: 63
- * sweeps and 46 capped; the sweeps alone: 200 and every step).  None
- * falls through its support. */
+ * follows them: across the builds since 4 to 70 capped steps and 4.3 to
+ * 26.8 sweeps a step over steps 2001-3000 (each capped run a round body
+ * rolling on a hilltop vertex and its own candidate, residuals 1e-7 to
+ * 1e-5, no pair contact in it; 40 and 12.4 before a box's edges met a
+ * capsule's side, from whose first such contact at step 743 the capsule
+ * o3 ends wedged between the boxes o6 and o10 on a hill, the two boxes
+ * touching it with its end spheres alone: 70 and 26.8, most of them
+ * steps 2565-2624 there).  The bounds, 100 capped and 35 sweeps a step,
+ * keep that spread and still fail where the blocks or the warm start
+ * break (cold rigid contacts, --warm-start off: 100 sweeps a step and
+ * 351 capped; a pass a block and cold rigid contacts, on an earlier
+ * build's path: 63 sweeps and 46 capped; the sweeps alone: 200 and every
+ * step).  None falls through its support. */
 static void test_rigid_mix(void)
 {
   ssModel *m;
@@ -659,7 +664,7 @@ static void test_rigid_mix(void)
   }
   double low = INFINITY;
   for (int b = 0; b < m->nbody; b++) low = fmin(low, d->body_xpos[3 * b + 2]);
-  ok(good && sweeps <= 20 * 1000 && capped <= 60,
+  ok(good && sweeps <= 35 * 1000 && capped <= 100,
      "twelve bodies resting or rolling on rigid hills: %.1f sweeps a step, %d of 1000 steps "
      "at the cap",
      sweeps / 1000.0, capped);
