@@ -695,6 +695,9 @@ static void test_rigid_cache(void)
   /* bodies on bodies: the cache's entries of contacts between bodies
    * (a static table's and pair contacts) restore with the rest */
   replay_straight("stack.xml", 700, 450, 12);
+  /* and those of a box's edges across a cylinder's side and of two
+   * cylinders' sides (their own ids in the cache) */
+  replay_straight("logs.xml", 700, 450, 6);
 
   ssModel *m;
   ssError e;
