@@ -1787,14 +1787,15 @@ int ss_shape_pair_points(const ssShape *a, const ssShape *b, double margin,
     }
     if (b->type == SS_GEOM_BOX && is_round(a->type))
       k += edge_side_contacts(b, a, 16, margin, all + k);
-    /* a cylinder and a cylinder or a capsule: their sides where the axes
-     * cross, a capsule's id 3 (19 as b), else a's id 5 (its rim point
-     * farthest from b, which gives way to it) */
+    /* two round shapes: their sides where the axes cross, on a's side
+     * with a capsule a's id 3 or a cylinder a's id 5 (its rim point
+     * farthest from b, which gives way to it), but on a capsule b's side
+     * (id 19) against a cylinder a */
     ssPairPoint x;
     int cyl_a = a->type == SS_GEOM_CYLINDER, cyl_b = b->type == SS_GEOM_CYLINDER;
-    if (is_round(a->type) && is_round(b->type) && (cyl_a || cyl_b) &&
-        axis_contact(a, b, margin, !cyl_b, &x)) {
-      x.id = !cyl_a ? 3 : !cyl_b ? 19 : 5;
+    int on_b = cyl_a && !cyl_b;
+    if (is_round(a->type) && is_round(b->type) && axis_contact(a, b, margin, on_b, &x)) {
+      x.id = on_b ? 19 : cyl_a ? 5 : 3;
       if (cyl_a && cyl_b)
         for (int i = 0; i < k; i++)
           if (all[i].id == 5) all[i] = x;

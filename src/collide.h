@@ -274,9 +274,10 @@ typedef struct ssPairPoint {
                      (two boxes: 0..7 a's corners, 8..15 edge crossings,
                      16..23 b's corners; a box and a cylinder or capsule:
                      the box's corners, then its edges across the other's
-                     side at 8..11 past them; a cylinder's or capsule's
-                     side against a cylinder's: 3 or 19 on a capsule, 5
-                     on a cylinder a), the same number from step to step
+                     side at 8..11 past them; two round shapes' sides:
+                     3 on a capsule a, 5 on a cylinder a, 19 on a
+                     capsule b against a cylinder a), the same number
+                     from step to step
                      while the same feature touches */
 } ssPairPoint;
 #define SS_PAIR_POINTS_MAX 32
@@ -370,24 +371,25 @@ typedef struct ssPairPoint {
  * on the table's two edges under it and a crate across a log on its two
  * bottom edges over the log's top line.
  *
- * A cylinder and a cylinder or a capsule: also their sides where their
+ * Two round shapes (cylinders, capsules): also their sides where their
  * axes cross.  Where the closest points of the two axes' lines, pa on
  * a's and pb on b's, lie strictly between each one's ends (as above) and
  * the axes are not parallel (sine over 1e-6), n is the unit common
  * normal a's axis x b's, turned so that (pa - pb) . n > 0 (where the
  * axes meet, (a.pos - b.pos) . n >= 0), and the gap (pa - pb) . n - r_a
- * - r_b; kept within margin.  Its point and id: on the capsule's side
- * where one is a capsule (pa - r_a n with id 3, or pb + r_b n with id 19:
- * past the capsule's three candidates), on a's side where both are
- * cylinders (pa - r_a n, id 5: the slot of a's rim point farthest from b
- * on its first cap, which gives way to it where it is within margin as
- * well).  A contact of the same point and normal as one already there
- * (same_contact: a capsule's middle point where the axes cross square
- * at its centre) is not added again.  So a log dropped across another
- * rests on it.  Two capsules keep their points (their middle points).
+ * - r_b; kept within margin.  Its point and id: on a's side, pa - r_a n,
+ * with id 3 for a capsule a (past its three candidates) and 5 for a
+ * cylinder a (the slot of its rim point farthest from b on its first
+ * cap, which gives way to it where it is within margin as well), but on
+ * b's side, pb + r_b n with id 19, for a cylinder a and a capsule b.  A
+ * contact of the same point and normal as one already there
+ * (same_contact: a capsule's middle point where the axes cross square at
+ * its centre) is not added again.  So a log dropped across another rests
+ * on it, and two capsules crossed away from their centres meet where
+ * they cross.
  *
- * Limits: two capsules, and a cylinder's cap rim against another's side
- * between its sample points, test only points (rims, spheres); the
+ * Limits: a cylinder's cap rim against another's side between its
+ * sample points tests only points (its rim's); the
  * crossings of two boxes go by the separating axis test's best axis, so
  * where two boxes overlap deeply in every direction they are where the
  * least overlap's axis says, not every place edges cross, and their ids
@@ -395,8 +397,7 @@ typedef struct ssPairPoint {
  * a cap (its side on a face it finds exactly, through the lowest rim
  * points); a capsule's middle point is taken towards o's centre, not o's
  * nearest point, exact on a large flat face under it (across a box's
- * edges or a cylinder's side the contacts above hold it), but two
- * capsules crossed away from their centres meet late. */
+ * edges or another round shape's side the contacts above hold it). */
 int ss_shape_pair_points(const ssShape *a, const ssShape *b, double margin,
                          ssPairPoint *out, int max);
 /* Effective width b (DESIGN 2.4), measured in the shape's own frame so that

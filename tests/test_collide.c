@@ -1797,6 +1797,21 @@ static void test_pair_points(void)
          pair_swaps(&capx, &low, 0.01),
      "pair: a capsule across a cylinder: their sides' contact where the axes cross (id 3), "
      "gap %.12g, n +z; swapped, id 19", pc ? pc->gap : NAN);
+  /* two capsules crossed at 60 degrees away from both centres (the
+   * upper one's centre 0.4 along its axis from the crossing, the lower
+   * one's 0.3): their sides' contact where the axes cross (a's id 3),
+   * which their middle points (towards each other's centres) miss */
+  rot_wheel(R, 0, 0);
+  ssShape capy = make_shape(SS_GEOM_CAPSULE, 0.2, 2, 0, 0, 0, 0, R);
+  ss_m3_mul(R, A30, W);
+  ssShape capu = make_shape(SS_GEOM_CAPSULE, 0.1, 2, 0, 0.4 * cos(PI / 6),
+                            0.3 + 0.4 * sin(PI / 6), 0.299, R);
+  double at_c[3] = {0, 0.3, 0.199};
+  n = ss_shape_pair_points(&capu, &capy, 0.01, out, SS_PAIR_POINTS_MAX);
+  pc = pair_find(out, n, 3);
+  ok(pc && fabs(pc->gap + 0.001) <= tol && near3(pc->n, up, tol) && near3(pc->pos, at_c, tol),
+     "pair: two capsules crossed away from their centres: their sides' contact where the axes "
+     "cross (a's id 3), gap %.12g, n +z", pc ? pc->gap : NAN);
   /* parallel to the axis: no edge contact (the rims and corners hold it) */
   rot_wheel(R, 0, 0);
   log_ = make_shape(SS_GEOM_CYLINDER, 0.2, 2, 0, 0, 0, 0, R);
