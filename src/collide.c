@@ -1683,7 +1683,7 @@ static int edge_side_contacts(const ssShape *x, const ssShape *y, int base, doub
     /* parallel (sine under 1e-6): the corners and the rims meet there */
     if (!(den > 1e-12 * A)) continue;
     double sp = (B * F - C) / den, t = (A * F - B * C) / den;
-    if (!(sp > tol && sp < 1 - tol && fabs(t) < hl * (1 - tol))) continue;
+    if (!(sp > tol && sp < 1 - tol && fabs(t) <= hl + margin)) continue;
     double p[3];
     ss_v3_copy(p, p0);
     ss_v3_addscl(p, d, sp);

@@ -356,12 +356,13 @@ typedef struct ssPairPoint {
  * contact where the closest points of its line and the round shape's
  * axis are, on the edge, strictly inside it (over 1e-9 of its length
  * from either end: at an end its corner holds it) and, on the axis,
- * strictly between its ends (within 1e-9 of the half length of neither:
- * there a cylinder's rims or a capsule's end spheres hold it), the edge
- * and the axis not parallel (sine over 1e-6: a box's edge along a
- * cylinder is held by corners and rims); at that point p of the edge,
- * its point nearest the axis and so deepest into the side, the contact
- * is p's as a corner's (gap sdf(p), the round shape's normal there).
+ * between its ends or within the margin past one (a plank lying across
+ * a post's top, its bottom edges over the cap, which the rim's 8 points
+ * may all miss), the edge and the axis not parallel (sine over 1e-6: a
+ * box's edge along a cylinder is held by corners and rims); at that
+ * point p of the edge, its point nearest the axis and so deepest into
+ * the side, the contact is p's as a corner's (gap sdf(p), the round
+ * shape's normal there: the side's, or over a cap the cap's).
  * Its id: the base past the box's corners plus the edge's colour (0..3,
  * as above); two edges of one colour (never two of one face, nor two
  * that share a corner): the deepest kept, the first in order on ties.

@@ -268,12 +268,53 @@ static void test_crossed_logs(void)
   drop(m, d);
 }
 
+/* A plank (0.1 x 1.2 x 0.05 m, 5 kg) dropped across a static post (a
+ * cylinder standing on its end, r 0.3 m, top at 0.5 m), turned 22.5
+ * degrees so that none of the post's 8 rim points lies under it: it
+ * rests on its two bottom edges over the cap, at 0.525 m, still.  It fell
+ * into the post until it met the rim (with its edges taken only between
+ * the caps: it sank, was pushed out below 2e-10 m of penetration, lost
+ * the edges' contacts and fell again, 10 um hops every 1.5 s).
+ * Tolerance as test_on_static's; still: the same height over the last
+ * second to 1e-12 m. */
+static void test_plank_on_post(void)
+{
+  const char *xml =
+      "<raisim version=\"1.0\"><timeStep value=\"0.001\"/><objects>"
+      "<ground name=\"g\" height=\"0\"/>"
+      "<cylinder name=\"post\" body_type=\"static\"><dim radius=\"0.3\" height=\"0.5\"/>"
+      "<state pos=\"0 0 0.25\"/></cylinder>"
+      "<box name=\"plank\" mass=\"5\"><dim x=\"0.1\" y=\"1.2\" z=\"0.05\"/>"
+      "<state pos=\"0 0 0.53\" quat=\"0.9807852804032304 0 0 0.19509032201612825\"/></box>"
+      "</objects></raisim>";
+  ssModel *m;
+  ssData *d;
+  if (!load(xml, &m, &d)) {
+    ok(0, "plank on a post: loads");
+    return;
+  }
+  int pl = ss_model_find_sys(m, "plank");
+  int good = pl >= 0 && steps(m, d, 2000);
+  const double *q = good ? d->qpos + m->sys_qadr[pl] : NULL;
+  double zlo = INFINITY, zhi = -INFINITY;
+  for (int k = 0; good && k < 1000; k++) {
+    good = steps(m, d, 1);
+    zlo = fmin(zlo, q[2]);
+    zhi = fmax(zhi, q[2]);
+  }
+  ok(good && fabs(zlo - 0.525) <= 1e-6 && zhi - zlo <= 1e-12,
+     "a plank dropped across a post's top, turned off its rim points, rests on its bottom "
+     "edges: z %.9f-%.9f m (0.525)", zlo, zhi);
+  drop(m, d);
+}
+
 int main(void)
 {
   test_on_static();
   test_stack();
   test_across_log();
   test_crossed_logs();
+  test_plank_on_post();
   test_balls();
   test_slide();
   return done_testing();
