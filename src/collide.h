@@ -389,8 +389,10 @@ typedef struct ssPairPoint {
  * on it, and two capsules crossed away from their centres meet where
  * they cross.
  *
- * Limits: a cylinder's cap rim against another's side between its
- * sample points tests only points (its rim's); the
+ * Limits: a cylinder's cap rim against another round shape's side, and
+ * a round shape lying across a cylinder's cap (a log across a post's
+ * top), meet only through the cap's 8 rim points and the other's own
+ * candidates; the
  * crossings of two boxes go by the separating axis test's best axis, so
  * where two boxes overlap deeply in every direction they are where the
  * least overlap's axis says, not every place edges cross, and their ids
