@@ -1,12 +1,11 @@
 /* test_bodies.c -- contacts between bodies (DESIGN 3: rigid contacts
  * between bodies, a Coulomb cone solved in the sweeps): a body on a static
- * one, a stack, a log across a table, a crate across a log and crossed
- * logs, two balls
- * meeting in free space, sliding on a static body, a link against a
- * static body.  Numbers from closed forms: rest
- * heights from the shapes' sizes, momentum and restitution for the balls,
- * mu g for sliding.  Before these contacts existed every body passed
- * through every other. */
+ * one, a stack, a log across a table, a crate across a log, crossed logs,
+ * a plank across a post, two balls meeting in free space, sliding on a
+ * static body, a link against a static body.  Numbers from closed forms:
+ * rest heights from the shapes' sizes, momentum and restitution for the
+ * balls, mu g for sliding.  Before these contacts existed every body
+ * passed through every other. */
 #include "soilsim.h"
 #include "tap.h"
 
