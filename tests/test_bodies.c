@@ -184,6 +184,29 @@ static void test_slide(void)
   drop(m, d);
 }
 
+/* Two bodies of a scene text dropped and settled for 2 s: each one's
+ * height and largest speed against want (tolerance as test_on_static's),
+ * one ok each, what[k] naming its case */
+static void two_rest(const char *xml, const char *name[2], const char *what[2], double want)
+{
+  ssModel *m;
+  ssData *d;
+  if (!load(xml, &m, &d)) {
+    ok(0, "%s: loads", what[0]);
+    ok(0, "%s: loads", what[1]);
+    return;
+  }
+  int sys[2] = {ss_model_find_sys(m, name[0]), ss_model_find_sys(m, name[1])};
+  int good = sys[0] >= 0 && sys[1] >= 0 && steps(m, d, 2000);
+  for (int k = 0; k < 2; k++) {
+    double z = good ? d->qpos[m->sys_qadr[sys[k]] + 2] : NAN;
+    double sp = good ? speed(d->qvel + m->sys_vadr[sys[k]]) : NAN;
+    ok(good && fabs(z - want) <= 1e-6 && sp <= 1e-6, "%s: z %.9f m (%g), speed %.3g", what[k], z,
+       want, sp);
+  }
+  drop(m, d);
+}
+
 /* A log lying across something narrower than itself, and a crate lying
  * across a log: each rests on the crossings of the box's edges with the
  * log's side.  A 2 m log (r 0.1, 20 kg) dropped across a 1 m static table
@@ -208,22 +231,10 @@ static void test_across_log(void)
       "<box name=\"crate\" mass=\"5\"><dim x=\"0.3\" y=\"0.3\" z=\"0.2\"/>"
       "<state pos=\"3 0.1 0.505\" quat=\"0.9914448613738104 0 0 0.13052619222005157\"/></box>"
       "</objects></raisim>";
-  ssModel *m;
-  ssData *d;
-  if (!load(xml, &m, &d)) {
-    ok(0, "across a log: loads");
-    return;
-  }
-  int lg = ss_model_find_sys(m, "log"), cr = ss_model_find_sys(m, "crate");
-  int good = lg >= 0 && cr >= 0 && steps(m, d, 2000);
-  const double *ql = d->qpos + m->sys_qadr[lg], *qc = d->qpos + m->sys_qadr[cr];
-  double sl = speed(d->qvel + m->sys_vadr[lg]), sc = speed(d->qvel + m->sys_vadr[cr]);
-  ok(good && fabs(ql[2] - 0.5) <= 1e-6 && sl <= 1e-6,
-     "a 2 m log dropped across a 1 m static table rests on the table's edges: z %.9f m (0.5), "
-     "speed %.3g", ql[2], sl);
-  ok(good && fabs(qc[2] - 0.5) <= 1e-6 && sc <= 1e-6,
-     "a crate dropped across a static log rests on it: z %.9f m (0.5), speed %.3g", qc[2], sc);
-  drop(m, d);
+  const char *name[2] = {"log", "crate"};
+  const char *what[2] = {"a 2 m log dropped across a 1 m static table rests on the table's edges",
+                         "a crate dropped across a static log rests on it"};
+  two_rest(xml, name, what, 0.5);
 }
 
 /* A log (r 0.1, 10 kg) dropped crosswise onto a static log (r 0.2, axis
@@ -249,22 +260,10 @@ static void test_crossed_logs(void)
       "<capsule name=\"cap\" mass=\"10\"><dim radius=\"0.1\" height=\"1.5\"/>"
       "<state pos=\"4 -0.2 0.505\" quat=\"0.7071067811865476 0 0.7071067811865476 0\"/>"
       "</capsule></objects></raisim>";
-  ssModel *m;
-  ssData *d;
-  if (!load(xml, &m, &d)) {
-    ok(0, "crossed logs: loads");
-    return;
-  }
-  int up = ss_model_find_sys(m, "up"), cap = ss_model_find_sys(m, "cap");
-  int good = up >= 0 && cap >= 0 && steps(m, d, 2000);
-  const double *qu = d->qpos + m->sys_qadr[up], *qc = d->qpos + m->sys_qadr[cap];
-  double su = speed(d->qvel + m->sys_vadr[up]), sc = speed(d->qvel + m->sys_vadr[cap]);
-  ok(good && fabs(qu[2] - 0.5) <= 1e-6 && su <= 1e-6,
-     "a log dropped crosswise onto a static log rests on it: z %.9f m (0.5), speed %.3g", qu[2], su);
-  ok(good && fabs(qc[2] - 0.5) <= 1e-6 && sc <= 1e-6,
-     "a capsule dropped crosswise onto a static log rests on it: z %.9f m (0.5), speed %.3g", qc[2],
-     sc);
-  drop(m, d);
+  const char *name[2] = {"up", "cap"};
+  const char *what[2] = {"a log dropped crosswise onto a static log rests on it",
+                         "a capsule dropped crosswise onto a static log rests on it"};
+  two_rest(xml, name, what, 0.5);
 }
 
 /* A plank (0.1 x 1.2 x 0.05 m, 5 kg) dropped across a static post (a
