@@ -1748,6 +1748,40 @@ static int axis_contact(const ssShape *a, const ssShape *b, double margin, int o
   return 1;
 }
 
+/* The contact of round shape x lying across cylinder y's cap (ss_shape_
+ * pair_points' rule): where the closest points of the two axes' lines
+ * lie strictly between x's ends and past y's end by at most r_x + margin,
+ * x's surface point from the closest point on x's axis towards y's cap
+ * (against the cap's normal, taken across x's axis), as x's candidate
+ * against y (flip as side_contacts' for x's candidates).  1 with it in
+ * *out (its id not set), 0 where there is none. */
+static int cap_contact(const ssShape *x, const ssShape *y, double margin, int flip,
+                       ssPairPoint *out)
+{
+  const double tol = 1e-9; /* of the half lengths */
+  const double ux[3] = {x->R[2], x->R[5], x->R[8]}, uy[3] = {y->R[2], y->R[5], y->R[8]};
+  const double hx = 0.5 * x->size[1], hy = 0.5 * y->size[1], rx = x->size[0];
+  double r[3], c[3];
+  ss_v3_sub(r, x->pos, y->pos);
+  ss_v3_cross(c, ux, uy);
+  double B = ss_v3_dot(ux, uy), C = ss_v3_dot(ux, r), F = ss_v3_dot(uy, r);
+  double cc = ss_v3_dot(c, c);
+  if (!(cc > 1e-12)) return 0;
+  double sx = (B * F - C) / cc, ty = (F - B * C) / cc;
+  if (!(fabs(sx) < hx * (1 - tol) && fabs(ty) >= hy * (1 - tol) && fabs(ty) <= hy + rx + margin))
+    return 0;
+  /* the cap's normal, across x's axis */
+  double nc[3], d[3], p[3];
+  ss_v3_scale(nc, uy, ty > 0 ? 1 : -1);
+  ss_v3_copy(d, nc);
+  ss_v3_addscl(d, ux, -ss_v3_dot(nc, ux));
+  if (!(ss_v3_normalize(d) > 1e-6)) return 0;
+  ss_v3_copy(p, x->pos);
+  ss_v3_addscl(p, ux, sx);
+  ss_v3_addscl(p, d, -rx);
+  return sphere_contact(y, p, 0, flip, 0, margin, out);
+}
+
 /* p into all[0..*k), kept in order of id: where no contact holds its id
  * and none is the same point with the same normal (same_contact) */
 static void put_extra(ssPairPoint *all, int *k, const ssPairPoint *p, double tol)
@@ -1800,6 +1834,20 @@ int ss_shape_pair_points(const ssShape *a, const ssShape *b, double margin,
         for (int i = 0; i < k; i++)
           if (all[i].id == 5) all[i] = x;
       put_extra(all, &k, &x, tol);
+    } else if (is_round(a->type) && is_round(b->type)) {
+      /* one lying across the other's cap (a log across a post's top),
+       * on the one lying: a's slot 3 or 5, b's 19 or 21 (a cylinder's
+       * farthest rim point's, which gives way to it) */
+      int id = -1;
+      if (cyl_b && cap_contact(a, b, margin, 0, &x)) id = cyl_a ? 5 : 3;
+      else if (cyl_a && cap_contact(b, a, margin, 1, &x)) id = cyl_b ? 21 : 19;
+      if (id >= 0) {
+        x.id = id;
+        if (id == 5 || id == 21)
+          for (int i = 0; i < k; i++)
+            if (all[i].id == id) all[i] = x;
+        put_extra(all, &k, &x, tol);
+      }
     }
   }
   if (k > max) k = max;

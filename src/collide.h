@@ -274,10 +274,10 @@ typedef struct ssPairPoint {
                      (two boxes: 0..7 a's corners, 8..15 edge crossings,
                      16..23 b's corners; a box and a cylinder or capsule:
                      the box's corners, then its edges across the other's
-                     side at 8..11 past them; two round shapes' sides:
-                     3 on a capsule a, 5 on a cylinder a, 19 on a
-                     capsule b against a cylinder a), the same number
-                     from step to step
+                     side at 8..11 past them; two round shapes' sides,
+                     or one across a cylinder's cap: 3 on a capsule a,
+                     5 on a cylinder a, 19 on a capsule b, 21 on a
+                     cylinder b), the same number from step to step
                      while the same feature touches */
 } ssPairPoint;
 #define SS_PAIR_POINTS_MAX 32
@@ -387,12 +387,19 @@ typedef struct ssPairPoint {
  * (same_contact: a capsule's middle point where the axes cross square at
  * its centre) is not added again.  So a log dropped across another rests
  * on it, and two capsules crossed away from their centres meet where
- * they cross.
+ * they cross.  Where instead the closest point on a cylinder y's axis
+ * lies past its end by at most the other's radius r_x plus the margin
+ * (and x's strictly between its ends): x lies across y's cap (a log
+ * across a post's top), and the contact is x's surface point from its
+ * axis's closest point against the cap's normal (taken across x's axis),
+ * tested against y as a corner is: on x's side, with x's slot as above
+ * (3 or 5 as a, 19 or 21 as b; 21 is a cylinder b's farthest rim point's,
+ * which gives way to it).  So a log across a post rests on its cap
+ * where the rim's 8 points all miss it.
  *
- * Limits: a cylinder's cap rim against another round shape's side, and
- * a round shape lying across a cylinder's cap (a log across a post's
- * top), meet only through the cap's 8 rim points and the other's own
- * candidates; the
+ * Limits: a cylinder's cap rim against another round shape's side
+ * between its 8 points; a shape lying across a cap away from the cap's
+ * axis is met at its point over the axis, not its deepest; the
  * crossings of two boxes go by the separating axis test's best axis, so
  * where two boxes overlap deeply in every direction they are where the
  * least overlap's axis says, not every place edges cross, and their ids

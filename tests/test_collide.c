@@ -1812,6 +1812,23 @@ static void test_pair_points(void)
   ok(pc && fabs(pc->gap + 0.001) <= tol && near3(pc->n, up, tol) && near3(pc->pos, at_c, tol),
      "pair: two capsules crossed away from their centres: their sides' contact where the axes "
      "cross (a's id 3), gap %.12g, n +z", pc ? pc->gap : NAN);
+  /* a log (r 0.05) across a post's top (a cylinder standing, r 0.3, its
+   * cap at z = 0.5), 1 mm in, turned off the rim's 8 points: the log's
+   * point over the post's axis, on the cap, a's id 5, gap -0.001, n +z;
+   * swapped, on b's side, id 21 */
+  rot_z(R, 0);
+  ssShape post2 = make_shape(SS_GEOM_CYLINDER, 0.3, 0.5, 0, 0, 0, 0.25, R);
+  rot_wheel(R, PI / 8, 0);
+  ssShape lg = make_shape(SS_GEOM_CYLINDER, 0.05, 1.2, 0, 0, 0, 0.549, R);
+  double at_cap[3] = {0, 0, 0.499}, down2[3] = {0, 0, -1};
+  n = ss_shape_pair_points(&lg, &post2, 0.01, out, SS_PAIR_POINTS_MAX);
+  int capped = n == 1 && out[0].id == 5 && all_up_at(out, n, -0.001, tol) &&
+               near3(out[0].pos, at_cap, tol);
+  n = ss_shape_pair_points(&post2, &lg, 0.01, out, SS_PAIR_POINTS_MAX);
+  capped = capped && n == 1 && out[0].id == 21 && fabs(out[0].gap + 0.001) <= tol &&
+           near3(out[0].n, down2, tol) && near3(out[0].pos, at_cap, tol);
+  ok(capped, "pair: a cylinder lying across another's cap, off its rim points: one contact "
+     "over the axis on the cap (id 5; 21 swapped), gap -0.001 (%d)", n);
   /* parallel to the axis: no edge contact (the rims and corners hold it) */
   rot_wheel(R, 0, 0);
   log_ = make_shape(SS_GEOM_CYLINDER, 0.2, 2, 0, 0, 0, 0, R);
