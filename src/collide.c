@@ -1705,6 +1705,24 @@ static int is_round(int t)
   return t == SS_GEOM_CYLINDER || t == SS_GEOM_CAPSULE;
 }
 
+/* The closest points of round shapes a's and b's axis lines, a->pos + s
+ * ua and b->pos + t ub (their unit local z), as s and t, with ua x ub in
+ * c; 0 where the axes are parallel (the sine of their angle 1e-6 or
+ * less: there the rims and ends meet) */
+static int axes_closest(const ssShape *a, const ssShape *b, double *s, double *t, double c[3])
+{
+  const double ua[3] = {a->R[2], a->R[5], a->R[8]}, ub[3] = {b->R[2], b->R[5], b->R[8]};
+  double r[3];
+  ss_v3_sub(r, a->pos, b->pos);
+  ss_v3_cross(c, ua, ub);
+  double B = ss_v3_dot(ua, ub), C = ss_v3_dot(ua, r), F = ss_v3_dot(ub, r);
+  double cc = ss_v3_dot(c, c);
+  if (!(cc > 1e-12)) return 0;
+  *s = (B * F - C) / cc;
+  *t = (F - B * C) / cc;
+  return 1;
+}
+
 /* The contact of two round shapes' sides (cylinders' or capsules') where
  * their axes cross (ss_shape_pair_points' rule): 1 with it in *out, its
  * point on b's side where on_b, else on a's; 0 where there is none. */
@@ -1714,16 +1732,11 @@ static int axis_contact(const ssShape *a, const ssShape *b, double margin, int o
   const double tol = 1e-9; /* of the half lengths */
   const double ua[3] = {a->R[2], a->R[5], a->R[8]}, ub[3] = {b->R[2], b->R[5], b->R[8]};
   const double ha = 0.5 * a->size[1], hb = 0.5 * b->size[1];
-  double r[3], c[3];
-  ss_v3_sub(r, a->pos, b->pos);
-  ss_v3_cross(c, ua, ub);
-  double B = ss_v3_dot(ua, ub), C = ss_v3_dot(ua, r), F = ss_v3_dot(ub, r);
-  double cc = ss_v3_dot(c, c);
-  /* parallel (sine under 1e-6): the rims and ends meet there */
-  if (!(cc > 1e-12)) return 0;
-  double sa = (B * F - C) / cc, tb = (F - B * C) / cc;
+  double c[3], r[3], sa, tb;
+  if (!axes_closest(a, b, &sa, &tb, c)) return 0;
   if (!(fabs(sa) < ha * (1 - tol) && fabs(tb) < hb * (1 - tol))) return 0;
-  double pa[3], pb[3], w[3], n[3];
+  ss_v3_sub(r, a->pos, b->pos);
+  double cc = ss_v3_dot(c, c), pa[3], pb[3], w[3], n[3];
   ss_v3_copy(pa, a->pos);
   ss_v3_addscl(pa, ua, sa);
   ss_v3_copy(pb, b->pos);
@@ -1761,13 +1774,8 @@ static int cap_contact(const ssShape *x, const ssShape *y, double margin, int fl
   const double tol = 1e-9; /* of the half lengths */
   const double ux[3] = {x->R[2], x->R[5], x->R[8]}, uy[3] = {y->R[2], y->R[5], y->R[8]};
   const double hx = 0.5 * x->size[1], hy = 0.5 * y->size[1], rx = x->size[0];
-  double r[3], c[3];
-  ss_v3_sub(r, x->pos, y->pos);
-  ss_v3_cross(c, ux, uy);
-  double B = ss_v3_dot(ux, uy), C = ss_v3_dot(ux, r), F = ss_v3_dot(uy, r);
-  double cc = ss_v3_dot(c, c);
-  if (!(cc > 1e-12)) return 0;
-  double sx = (B * F - C) / cc, ty = (F - B * C) / cc;
+  double c[3], sx, ty;
+  if (!axes_closest(x, y, &sx, &ty, c)) return 0;
   if (!(fabs(sx) < hx * (1 - tol) && fabs(ty) >= hy * (1 - tol) && fabs(ty) <= hy + rx + margin))
     return 0;
   /* the cap's normal, across x's axis */
