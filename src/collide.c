@@ -1529,6 +1529,22 @@ static int same_contact(const ssPairPoint *p, const ssPairPoint *q, double tol)
   return 1;
 }
 
+/* The closest points of the lines p + s da and q + t db, as s and t; 0
+ * where the lines are parallel (the sine of their angle 1e-6 or less:
+ * there corners, rims and ends meet) */
+static int lines_closest(const double p[3], const double da[3], const double q[3],
+                         const double db[3], double *s, double *t)
+{
+  double r[3];
+  ss_v3_sub(r, p, q);
+  double A = ss_v3_dot(da, da), B = ss_v3_dot(da, db), E = ss_v3_dot(db, db);
+  double C = ss_v3_dot(da, r), F = ss_v3_dot(db, r), den = A * E - B * B;
+  if (!(den > 1e-12 * A * E)) return 0;
+  *s = (B * F - C * E) / den;
+  *t = (A * F - B * C) / den;
+  return 1;
+}
+
 /* Box edges: e = 4 i + bits, i the local axis the edge runs along, bit 0
  * the sign of its place on axis (i + 1) % 3, bit 1 on axis (i + 2) % 3
  * (set: +).  Its start p0 (at -size[i]/2 along i) and its vector d (to
@@ -1598,22 +1614,16 @@ static int edge_contacts(const ssShape *a, const ssShape *b, double margin, doub
     double pa0[3], da[3];
     box_edge(a, ea, pa0, da);
     for (int eb = 0; eb < 12; eb++) {
-      double pb0[3], db[3], c[3], r[3];
+      double pb0[3], db[3], c[3], s, t;
       box_edge(b, eb, pb0, db);
-      ss_v3_cross(c, da, db);
-      double A = ss_v3_dot(da, da), E = ss_v3_dot(db, db), cc = ss_v3_dot(c, c);
-      /* parallel (sine under 1e-6): no edge-edge normal; faces and
-       * corners meet there */
-      if (!(cc > 1e-12 * A * E)) continue;
-      /* the closest points of the two lines; a pair counts only where
-       * both lie strictly inside their edges, where the clamped
-       * segments' closest points are these same points */
-      ss_v3_sub(r, pa0, pb0);
-      double B = ss_v3_dot(da, db), C = ss_v3_dot(da, r), F = ss_v3_dot(db, r);
-      double den = A * E - B * B;
-      if (!(den > 0)) continue;
-      double s = (B * F - C * E) / den, t = (A * F - B * C) / den;
+      /* the closest points of the two lines (none where parallel: no
+       * edge-edge normal, faces and corners meet there); a pair counts
+       * only where both lie strictly inside their edges, where the
+       * clamped segments' closest points are these same points */
+      if (!lines_closest(pa0, da, pb0, db, &s, &t)) continue;
       if (!(s > tol && s < 1 - tol && t > tol && t < 1 - tol)) continue;
+      ss_v3_cross(c, da, db);
+      double cc = ss_v3_dot(c, c);
       double pa[3], pb[3], n[3];
       ss_v3_copy(pa, pa0);
       ss_v3_addscl(pa, da, s);
@@ -1673,16 +1683,11 @@ static int edge_side_contacts(const ssShape *x, const ssShape *y, int base, doub
   ssPairPoint slot[4];
   int used[4] = {0};
   for (int e = 0; e < 12; e++) {
-    double p0[3], d[3], r[3];
+    double p0[3], d[3], sp, t;
     box_edge(x, e, p0, d);
-    /* the closest points of the edge's line, p0 + s d, and the axis's,
+    /* the closest points of the edge's line, p0 + sp d, and the axis's,
      * pos + t a (|a| = 1) */
-    ss_v3_sub(r, p0, y->pos);
-    double A = ss_v3_dot(d, d), B = ss_v3_dot(d, a), C = ss_v3_dot(d, r), F = ss_v3_dot(a, r);
-    double den = A - B * B;
-    /* parallel (sine under 1e-6): the corners and the rims meet there */
-    if (!(den > 1e-12 * A)) continue;
-    double sp = (B * F - C) / den, t = (A * F - B * C) / den;
+    if (!lines_closest(p0, d, y->pos, a, &sp, &t)) continue;
     if (!(sp > tol && sp < 1 - tol && fabs(t) <= hl + margin)) continue;
     double p[3];
     ss_v3_copy(p, p0);
@@ -1712,15 +1717,8 @@ static int is_round(int t)
 static int axes_closest(const ssShape *a, const ssShape *b, double *s, double *t, double c[3])
 {
   const double ua[3] = {a->R[2], a->R[5], a->R[8]}, ub[3] = {b->R[2], b->R[5], b->R[8]};
-  double r[3];
-  ss_v3_sub(r, a->pos, b->pos);
   ss_v3_cross(c, ua, ub);
-  double B = ss_v3_dot(ua, ub), C = ss_v3_dot(ua, r), F = ss_v3_dot(ub, r);
-  double cc = ss_v3_dot(c, c);
-  if (!(cc > 1e-12)) return 0;
-  *s = (B * F - C) / cc;
-  *t = (F - B * C) / cc;
-  return 1;
+  return lines_closest(a->pos, ua, b->pos, ub, s, t);
 }
 
 /* The contact of two round shapes' sides (cylinders' or capsules') where
