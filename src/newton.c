@@ -896,6 +896,25 @@ static inline __attribute__((always_inline)) void sums_H(const NSum *A, double H
     }
 }
 
+/* The PD rows' laws at y, lambda = clamp(a - b v, -bound, bound): F and,
+ * with H, dF/dv (0 where clamped), for evaluate_at, stick_eval and
+ * creep_eval */
+static inline __attribute__((always_inline)) void row_laws(const ssData *d, const Setup *s,
+                                                         const double *y, double *F, double *H)
+{
+  for (int r = 0; r < s->nrow; r++) {
+    const ssContact *c = d->contact + s->first_row + r;
+    int k = 6 * s->ngroup + r;
+    double l = c->row_a - c->row_b * y[k], h = -c->row_b;
+    if (l > c->row_bound || l < -c->row_bound) {
+      l = l > 0 ? c->row_bound : -c->row_bound;
+      h = 0;
+    }
+    F[k] = l;
+    if (H) H[36 * s->ngroup + r] = h;
+  }
+}
+
 /* What a form of the laws' loops knows of its material (evaluate_at,
  * check_run): nothing, linear soil, or nonlinear soil with the power's
  * series and a shear modulus; mat_form sets what the form knows in M, so
@@ -1013,20 +1032,7 @@ evaluate_at(const ssModel *m, const ssData *d, const Setup *s, const ssNewtonWor
     from_group(w->grp + g, A->F, Hg, F + 6 * g, H + 36 * g);
   }
   /* PD rows: lambda = clamp(a - b v, -bound, bound) */
-  for (int r = 0; r < s->nrow; r++) {
-    const ssContact *c = d->contact + s->first_row + r;
-    int k = 6 * s->ngroup + r;
-    double l = c->row_a - c->row_b * y[k], h = -c->row_b;
-    if (l > c->row_bound) {
-      l = c->row_bound;
-      h = 0;
-    } else if (l < -c->row_bound) {
-      l = -c->row_bound;
-      h = 0;
-    }
-    F[k] = l;
-    if (with_H) H[36 * s->ngroup + r] = h;
-  }
+  row_laws(d, s, y, F, with_H ? H : NULL);
   return (sticks ? STUCK : 0) | (near ? NEAR_STICK : 0);
 }
 
@@ -1972,23 +1978,6 @@ static inline void wrench_add(double A[6], const double r[3], const double l[3])
   A[5] += l[2];
 }
 
-/* The PD rows' laws at y, lambda = clamp(a - b v, -bound, bound): F and,
- * with H, dF/dv (0 where clamped), for stick_eval and creep_eval */
-static void row_laws(const ssData *d, const Setup *s, const double *y, double *F, double *H)
-{
-  for (int r = 0; r < s->nrow; r++) {
-    const ssContact *c = d->contact + s->first_row + r;
-    int k = 6 * s->ngroup + r;
-    double l = c->row_a - c->row_b * y[k], h = -c->row_b;
-    if (l > c->row_bound || l < -c->row_bound) {
-      l = l > 0 ? c->row_bound : -c->row_bound;
-      h = 0;
-    }
-    F[k] = l;
-    if (H) H[36 * s->ngroup + r] = h;
-  }
-}
-
 /* The laws for stick_solve at y: a sticking group's points (stick[g])
  * give their normal impulse alone (their tangential impulses are the
  * group's constraint wrench, added apart), the other groups' points
@@ -2831,13 +2820,15 @@ static int newton_solve(const ssModel *m, ssData *d, int first_row, int *iterati
 #define CREEP_PASSES 400
 
 /* the smoothed law of point P at its group's velocity V: lam and K (the
- * 6 entries of point_law); 0 where unloaded (lam = 0) */
+ * 6 entries of point_law), and its slip |v_t| (unsmoothed); 0 where
+ * unloaded (lam = 0) */
 static int creep_point(const Mat *M, NPoint *P, const double V[6], double eps, double lam[3],
-                       double K[6])
+                       double K[6], double *slip)
 {
   double v[3], kn;
   point_velocity(P->r, V, v);
   double ln = point_normal(M, P, v[0], &kn, 1);
+  *slip = sqrt(v[1] * v[1] + v[2] * v[2]);
   if (ln < 0) {
     lam[0] = lam[1] = lam[2] = 0;
     memset(K, 0, 6 * sizeof(double));
@@ -2890,11 +2881,10 @@ static void creep_eval(const ssData *d, const Setup *s, ssNewtonWork *w, const d
     int nl = 0;
     for (int i = i0; i < i1; i++) {
       NPoint *P = w->pt + i;
-      double *l = lam + 3 * i, v[3];
-      if (!creep_point(M, P, A->V, eps, l, K + 6 * i)) continue;
+      double *l = lam + 3 * i, sv;
+      if (!creep_point(M, P, A->V, eps, l, K + 6 * i, &sv)) continue;
       w->live[nl++] = i;
-      point_velocity(P->r, A->V, v);
-      double sv = sqrt(v[1] * v[1] + v[2] * v[2]), lv = fabs(l[0]) + fabs(l[1]) + fabs(l[2]);
+      double lv = fabs(l[0]) + fabs(l[1]) + fabs(l[2]);
       sm = sv > sm ? sv : sm;
       lm = lv > lm ? lv : lm;
       /* F' += X^T lam */
