@@ -1833,27 +1833,25 @@ int ss_shape_pair_points(const ssShape *a, const ssShape *b, double margin,
      * (id 19) against a cylinder a */
     ssPairPoint x;
     int cyl_a = a->type == SS_GEOM_CYLINDER, cyl_b = b->type == SS_GEOM_CYLINDER;
-    int on_b = cyl_a && !cyl_b;
-    if (is_round(a->type) && is_round(b->type) && axis_contact(a, b, margin, on_b, &x)) {
-      x.id = on_b ? 19 : cyl_a ? 5 : 3;
-      if (cyl_a && cyl_b)
+    int on_b = cyl_a && !cyl_b, id = -1;
+    if (is_round(a->type) && is_round(b->type)) {
+      if (axis_contact(a, b, margin, on_b, &x))
+        id = on_b ? 19 : cyl_a ? 5 : 3;
+      /* else one lying across the other's cap (a log across a post's
+       * top), on the one lying: a's slot 3 or 5, b's 19 or 21 */
+      else if (cyl_b && cap_contact(a, b, margin, 0, &x))
+        id = cyl_a ? 5 : 3;
+      else if (cyl_a && cap_contact(b, a, margin, 1, &x))
+        id = cyl_b ? 21 : 19;
+    }
+    if (id >= 0) {
+      x.id = id;
+      /* a cylinder's slot (5, 21) is its farthest rim point's, which gives
+       * way to it */
+      if (id == 5 || id == 21)
         for (int i = 0; i < k; i++)
-          if (all[i].id == 5) all[i] = x;
+          if (all[i].id == id) all[i] = x;
       put_extra(all, &k, &x, tol);
-    } else if (is_round(a->type) && is_round(b->type)) {
-      /* one lying across the other's cap (a log across a post's top),
-       * on the one lying: a's slot 3 or 5, b's 19 or 21 (a cylinder's
-       * farthest rim point's, which gives way to it) */
-      int id = -1;
-      if (cyl_b && cap_contact(a, b, margin, 0, &x)) id = cyl_a ? 5 : 3;
-      else if (cyl_a && cap_contact(b, a, margin, 1, &x)) id = cyl_b ? 21 : 19;
-      if (id >= 0) {
-        x.id = id;
-        if (id == 5 || id == 21)
-          for (int i = 0; i < k; i++)
-            if (all[i].id == id) all[i] = x;
-        put_extra(all, &k, &x, tol);
-      }
     }
   }
   if (k > max) k = max;
